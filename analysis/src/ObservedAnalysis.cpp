@@ -1,0 +1,276 @@
+#include "parcelscope/analysis/ObservedAnalysis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "BoxPairs.h"
+#include "Contacts.h"
+#include "parcelscope/core/Error.h"
+#include "parcelscope/io/GeometryOps.h"
+
+namespace parcelscope::analysis {
+
+const std::vector<ParameterDescription>& analysisParameters() {
+  static const std::vector<ParameterDescription> d = {
+      {"block-tolerance",
+       "Parcels whose boundaries come this close belong to one block; gaps narrower than this are "
+       "closed in the block outline",
+       "m", 0.0, 50.0, 1.0},
+      {"k", "Number of standard deviations in A_min/A_max = A-bar -/+ k s_A and W_min/W_max = W-bar -/+ k s_W",
+       "", 0.0, 10.0, 2.0},
+      {"min-frontage", "Boundary on the block's outer contour a parcel needs for street access", "m", 0.0,
+       1000.0, 1.0},
+      {"detect-right-of-way",
+       "1: detect parcels that are streets (holes holding parcels, or network shape) and keep them out "
+       "of blocks; 0: treat every parcel as a lot",
+       "", 0.0, 1.0, 1.0, true},
+  };
+  return d;
+}
+
+AnalysisOptions analysisOptionsFrom(const ParameterValues& v) {
+  AnalysisOptions o;
+  auto get = [&](const char* name, double fallback) {
+    auto it = v.find(name);
+    return it == v.end() ? fallback : it->second;
+  };
+  o.blockTolerance = get("block-tolerance", o.blockTolerance);
+  o.k = get("k", o.k);
+  o.minFrontage = get("min-frontage", o.minFrontage);
+  o.detectRightOfWay = get("detect-right-of-way", 1.0) != 0.0;
+  return o;
+}
+
+namespace {
+
+double mean(const std::vector<double>& v) {
+  return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+}
+
+double sampleSd(const std::vector<double>& v, double m) {
+  if (v.size() < 2) return 0.0;
+  double s = 0;
+  for (double x : v) s += (x - m) * (x - m);
+  return std::sqrt(s / static_cast<double>(v.size() - 1));
+}
+
+struct DisjointSets {
+  std::vector<int> parent;
+  explicit DisjointSets(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  }
+  void join(int a, int b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+// Minimum shared boundary (m) for two parcels to count as neighbours.
+constexpr double kMinSharedBoundary = 1.0;
+// Network-shape right-of-way: at least this many neighbours, and an MBR width at
+// least this many times the strip width 2A/P (a lot of any proportions stays below 2).
+constexpr int kNetworkMinNeighbours = 10;
+constexpr double kNetworkWidthRatio = 6.0;
+
+}  // namespace
+
+BlockStatistics blockStatistics(const std::vector<double>& areas, const std::vector<double>& widths,
+                                double k) {
+  BlockStatistics s;
+  s.parcelCount = static_cast<int>(areas.size());
+  s.meanArea = mean(areas);
+  s.sdArea = sampleSd(areas, s.meanArea);
+  s.meanWidth = mean(widths);
+  s.sdWidth = sampleSd(widths, s.meanWidth);
+  s.aMax = s.meanArea + k * s.sdArea;
+  s.wMax = s.meanWidth + k * s.sdWidth;
+  const double aFloor = std::max(0.1 * s.meanArea, 1.0);
+  const double wFloor = std::max(0.1 * s.meanWidth, 0.5);
+  s.aMin = s.meanArea - k * s.sdArea;
+  s.wMin = s.meanWidth - k * s.sdWidth;
+  if (s.aMin < aFloor) {
+    s.aMin = std::min(aFloor, s.aMax);
+    s.aMinClamped = true;
+  }
+  if (s.wMin < wFloor) {
+    s.wMin = std::min(wFloor, s.wMax);
+    s.wMinClamped = true;
+  }
+  return s;
+}
+
+ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const AnalysisOptions& options,
+                                const ProgressFn& progress) {
+  const std::size_t n = parcels.size();
+  const double tol = options.blockTolerance;
+  ObservedAnalysis out;
+  out.metrics.resize(n);
+  out.rightOfWay.assign(n, RightOfWay::No);
+  out.blockOf.assign(n, -1);
+
+  // 1. Shape metrics.
+  std::vector<Box> boxes(n);
+  std::vector<Point> inside(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    static_cast<ShapeMetrics&>(out.metrics[i]) = shapeMetrics(parcels[i].shape);
+    boxes[i] = bounds(parcels[i].shape).expanded(0.5 * tol);
+    inside[i] = interiorPoint(parcels[i].shape);
+  }
+  reportProgress(progress, 0.1, "metrics");
+
+  // 2. Shared boundaries (neighbours) and closeness, edge by edge.
+  std::vector<const Polygon*> shapes(n);
+  for (std::size_t i = 0; i < n; ++i) shapes[i] = &parcels[i].shape;
+  const auto touching = detail::contacts(shapes, std::max(tol, 1e-6));
+  for (const auto& c : touching) {
+    if (c.shared >= kMinSharedBoundary) {
+      ++out.metrics[c.a].neighbours;
+      ++out.metrics[c.b].neighbours;
+    }
+  }
+  reportProgress(progress, 0.3, "neighbours");
+  // Overlapping boxes find parcels lying inside others without touching them.
+  const auto pairs = detail::intersectingPairs(boxes);
+
+  // 3. Right-of-way parcels.
+  if (options.detectRightOfWay) {
+    for (const auto& [i, j] : pairs) {
+      for (const auto& [outer, inner] : {std::pair<int, int>{i, j}, std::pair<int, int>{j, i}}) {
+        if (parcels[outer].shape.holes.empty() || out.rightOfWay[outer] != RightOfWay::No) continue;
+        for (const Ring& hole : parcels[outer].shape.holes) {
+          const Box hb = bounds(hole);
+          const Point& p = inside[inner];
+          if (p.x >= hb.minX && p.x <= hb.maxX && p.y >= hb.minY && p.y <= hb.maxY && pointInRing(p, hole)) {
+            out.rightOfWay[outer] = RightOfWay::HolesHoldParcels;
+            break;
+          }
+        }
+      }
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const ParcelMetrics& m = out.metrics[i];
+      const double stripWidth = 2.0 * m.area / m.perimeter;
+      if (out.rightOfWay[i] == RightOfWay::No && m.neighbours >= kNetworkMinNeighbours &&
+          m.width >= kNetworkWidthRatio * stripWidth) {
+        out.rightOfWay[i] = RightOfWay::NetworkShape;
+      }
+    }
+  }
+  for (auto r : out.rightOfWay) out.rightOfWayCount += r != RightOfWay::No;
+
+  // 4. Blocks: connected groups of lots within the tolerance.
+  DisjointSets sets(n);
+  auto isLot = [&](int i) { return out.rightOfWay[i] == RightOfWay::No; };
+  for (const auto& c : touching) {
+    if (c.close && isLot(c.a) && isLot(c.b)) sets.join(c.a, c.b);
+  }
+  for (const auto& [i, j] : pairs) {
+    if (!isLot(i) || !isLot(j) || sets.find(i) == sets.find(j)) continue;
+    if (pointInPolygon(inside[i], parcels[j].shape) || pointInPolygon(inside[j], parcels[i].shape)) {
+      sets.join(i, j);
+    }
+  }
+  std::vector<int> rootBlock(n, -1);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (out.rightOfWay[i] != RightOfWay::No) continue;
+    const int r = sets.find(static_cast<int>(i));
+    if (rootBlock[r] < 0) {
+      rootBlock[r] = static_cast<int>(out.blocks.size());
+      out.blocks.emplace_back();
+      out.blocks.back().id = rootBlock[r];
+    }
+    out.blockOf[i] = rootBlock[r];
+    out.blocks[rootBlock[r]].parcels.push_back(static_cast<int>(i));
+  }
+
+  // 5. Block outlines, frontage and statistics.
+  const double frontTol = std::max(tol, 0.05);
+  for (std::size_t b = 0; b < out.blocks.size(); ++b) {
+    if (b % 50 == 0) {
+      reportProgress(progress, 0.5 + 0.5 * static_cast<double>(b) / static_cast<double>(out.blocks.size()),
+                     "blocks");
+    }
+    Block& block = out.blocks[b];
+    std::vector<const Polygon*> members;
+    for (int i : block.parcels) members.push_back(&parcels[i].shape);
+    block.parts = io::unionAndClose(members, tol);
+    if (block.parts.size() > 1) ++out.multipartBlocks;
+
+    std::vector<Ring> outline;
+    for (const Polygon& part : block.parts) outline.push_back(part.outer);
+    const auto frontage = detail::lengthAlong(members, outline, frontTol);
+    std::vector<double> areas, widths;
+    int withAccess = 0;
+    for (std::size_t k = 0; k < block.parcels.size(); ++k) {
+      const int i = block.parcels[k];
+      ParcelMetrics& m = out.metrics[i];
+      m.frontage = frontage[k];
+      m.streetAccess = m.frontage >= options.minFrontage;
+      withAccess += m.streetAccess;
+      areas.push_back(m.area);
+      widths.push_back(m.width);
+    }
+    BlockStatistics s = blockStatistics(areas, widths, options.k);
+    s.blockId = block.id;
+    for (const Polygon& part : block.parts) s.blockArea += area(part);
+    s.streetAccessShare = static_cast<double>(withAccess) / static_cast<double>(block.parcels.size());
+    out.clampedAMin += s.aMinClamped;
+    out.clampedWMin += s.wMinClamped;
+    out.statistics.push_back(s);
+  }
+  reportProgress(progress, 1.0, "blocks");
+  return out;
+}
+
+Table parcelTable(const std::vector<Parcel>& parcels, const ObservedAnalysis& a) {
+  using T = Column::Type;
+  Table t;
+  t.columns = {{"parcel_id", T::Integer, ""},     {"source_fid", T::Integer, ""},
+               {"part", T::Integer, ""},          {"block_id", T::Integer, ""},
+               {"role", T::String, ""},           {"stack_count", T::Integer, ""},
+               {"repaired", T::Integer, ""},      {"area", T::Real, "m2"},
+               {"perimeter", T::Real, "m"},       {"width", T::Real, "m"},
+               {"length", T::Real, "m"},          {"aspect_ratio", T::Real, ""},
+               {"elongation", T::Real, ""},       {"rectangularity", T::Real, ""},
+               {"p_angle", T::Real, "deg"},       {"p_area", T::Real, ""},
+               {"neighbours", T::Integer, ""},    {"frontage", T::Real, "m"},
+               {"street_access", T::Integer, ""}};
+  static const char* roles[] = {"lot", "right_of_way_holes", "right_of_way_network"};
+  for (std::size_t i = 0; i < parcels.size(); ++i) {
+    const ParcelMetrics& m = a.metrics[i];
+    t.rows.push_back({std::int64_t(i), std::int64_t(parcels[i].sourceFid), std::int64_t(parcels[i].part),
+                      std::int64_t(a.blockOf[i]), std::string(roles[static_cast<int>(a.rightOfWay[i])]),
+                      std::int64_t(parcels[i].stackCount), std::int64_t(parcels[i].repaired), m.area,
+                      m.perimeter, m.width, m.length, m.aspectRatio, m.elongation, m.rectangularity,
+                      m.pAngle, m.pArea, std::int64_t(m.neighbours), m.frontage,
+                      std::int64_t(m.streetAccess)});
+  }
+  return t;
+}
+
+Table blockTable(const ObservedAnalysis& a) {
+  using T = Column::Type;
+  Table t;
+  t.columns = {{"block_id", T::Integer, ""},       {"parcel_count", T::Integer, ""},
+               {"block_area", T::Real, "m2"},      {"parts", T::Integer, ""},
+               {"mean_area", T::Real, "m2"},       {"sd_area", T::Real, "m2"},
+               {"mean_width", T::Real, "m"},       {"sd_width", T::Real, "m"},
+               {"a_min", T::Real, "m2"},           {"a_max", T::Real, "m2"},
+               {"w_min", T::Real, "m"},            {"w_max", T::Real, "m"},
+               {"a_min_clamped", T::Integer, ""},  {"w_min_clamped", T::Integer, ""},
+               {"street_access_share", T::Real, ""}};
+  for (std::size_t b = 0; b < a.blocks.size(); ++b) {
+    const BlockStatistics& s = a.statistics[b];
+    t.rows.push_back({std::int64_t(s.blockId), std::int64_t(s.parcelCount), s.blockArea,
+                      std::int64_t(a.blocks[b].parts.size()), s.meanArea, s.sdArea, s.meanWidth, s.sdWidth,
+                      s.aMin, s.aMax, s.wMin, s.wMax, std::int64_t(s.aMinClamped),
+                      std::int64_t(s.wMinClamped), s.streetAccessShare});
+  }
+  return t;
+}
+
+}  // namespace parcelscope::analysis

@@ -1,0 +1,91 @@
+#include "parcelscope/analysis/StatsJob.h"
+
+#include "parcelscope/io/OutputDirectory.h"
+#include "parcelscope/io/Writers.h"
+
+#ifndef PARCELSCOPE_VERSION
+#define PARCELSCOPE_VERSION "unknown"
+#endif
+
+namespace parcelscope::analysis {
+
+std::string version() { return PARCELSCOPE_VERSION; }
+
+ObservedData loadObserved(const io::ReadOptions& input, const ParameterValues& parameters,
+                          const ProgressFn& progress) {
+  ObservedData data;
+  data.layer = io::readParcels(input, scaledProgress(progress, 0.0, 0.4));
+  data.analysis = analyseParcels(data.layer.parcels, analysisOptionsFrom(parameters),
+                                 scaledProgress(progress, 0.4, 1.0));
+  return data;
+}
+
+void addObservedRecord(Json& record, const ObservedData& data) {
+  const io::ParcelLayer& l = data.layer;
+  const io::CleaningReport& r = l.report;
+  Json input = Json::object()
+                   .set("path", l.path)
+                   .set("layer", l.layerName)
+                   .set("crs", l.crs.name)
+                   .set("crs_assumed", l.crs.assumedLonLat)
+                   .set("crs_overridden", l.crs.overridden)
+                   .set("local_frame", l.frame.describe());
+  std::int64_t byHoles = 0, byShape = 0;
+  for (auto w : data.analysis.rightOfWay) {
+    byHoles += w == RightOfWay::HolesHoldParcels;
+    byShape += w == RightOfWay::NetworkShape;
+  }
+  Json counts = Json::object()
+                    .set("features", r.features)
+                    .set("null_or_empty_skipped", r.nullOrEmpty)
+                    .set("non_polygonal_skipped", r.nonPolygonal)
+                    .set("multipart_features_split", r.multipartFeatures)
+                    .set("parcels_from_multipart", r.partsFromMultipart)
+                    .set("parcels_with_holes", r.withHoles)
+                    .set("invalid_repaired", r.invalidRepaired)
+                    .set("invalid_skipped", r.invalidSkipped)
+                    .set("degenerate_parts_skipped", r.degenerateSkipped)
+                    .set("duplicates_collapsed", r.duplicatesCollapsed)
+                    .set("duplicate_stacks", r.duplicateStacks)
+                    .set("parcels", r.parcels)
+                    .set("right_of_way", data.analysis.rightOfWayCount)
+                    .set("right_of_way_holes_hold_parcels", byHoles)
+                    .set("right_of_way_network_shape", byShape)
+                    .set("blocks", static_cast<std::int64_t>(data.analysis.blocks.size()))
+                    .set("multipart_blocks", data.analysis.multipartBlocks)
+                    .set("a_min_clamped", data.analysis.clampedAMin)
+                    .set("w_min_clamped", data.analysis.clampedWMin);
+  record.set("input", input).set("counts", counts);
+}
+
+Json runStats(const io::ReadOptions& input, const ParameterValues& parameters, const std::string& outDir,
+              const ProgressFn& progress) {
+  io::OutputDirectory out(outDir, {input.path});
+  ObservedData data = loadObserved(input, parameters, scaledProgress(progress, 0.0, 0.9));
+
+  reportProgress(progress, 0.9, "writing");
+  io::writeCsv(out.stage("parcels.csv"), parcelTable(data.layer.parcels, data.analysis));
+  const Table blocks = blockTable(data.analysis);
+  io::writeCsv(out.stage("blocks.csv"), blocks);
+  std::vector<std::vector<Polygon>> outlines;
+  for (const Block& b : data.analysis.blocks) outlines.push_back(b.parts);
+  io::writePolygonLayer(out.stage("blocks.gpkg"), "blocks", outlines, blocks, data.layer.frame,
+                        data.layer.crs);
+
+  Json params = Json::object();
+  for (const auto& [name, value] : parameters) params.set(name, value);
+  Json run = Json::object()
+                 .set("tool", "parcelscope")
+                 .set("version", version())
+                 .set("command", "stats")
+                 .set("gdal", io::gdalVersion())
+                 .set("parameters", params);
+  addObservedRecord(run, data);
+  run.set("outputs", Json::array().push("parcels.csv").push("blocks.csv").push("blocks.gpkg").push("run.json"));
+  io::writeJson(out.stage("run.json"), run);
+  out.commit();
+  reportProgress(progress, 1.0, "writing");
+  return run;
+}
+
+}  // namespace parcelscope::analysis

@@ -1,0 +1,42 @@
+#pragma once
+// Command-line parsing shared by the subcommands. Flags of algorithm parameters
+// come from their ParameterDescription, so the CLI cannot drift from the GUI.
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "parcelscope/core/Parameter.h"
+
+namespace parcelscope::cli {
+
+struct FlagSpec {
+  std::string name;  ///< without the leading "--"
+  std::string help;
+  bool takesValue = true;
+};
+
+class Args {
+public:
+  /// Parses `args` (after the subcommand). Throws Error(Usage) on an unknown
+  /// flag, a missing value, a parameter that is not a number or is out of range.
+  Args(const std::vector<std::string>& args, const std::vector<FlagSpec>& flags,
+       const std::vector<ParameterDescription>& parameters);
+
+  const std::vector<std::string>& positional() const { return positional_; }
+  std::optional<std::string> value(const std::string& flag) const;
+  bool has(const std::string& flag) const { return values_.count(flag) > 0; }
+  /// Defaults overridden by the user's values.
+  const ParameterValues& parameters() const { return parameters_; }
+
+private:
+  std::vector<std::string> positional_;
+  std::map<std::string, std::string> values_;
+  ParameterValues parameters_;
+};
+
+/// Help text listing flags and parameters (name, unit, range, default, help).
+std::string usageText(const std::string& synopsis, const std::vector<FlagSpec>& flags,
+                      const std::vector<ParameterDescription>& parameters);
+
+}  // namespace parcelscope::cli

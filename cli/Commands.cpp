@@ -1,0 +1,77 @@
+#include "Commands.h"
+
+#include <cstdio>
+
+#include "Args.h"
+#include "TermProgress.h"
+#include "parcelscope/analysis/StatsJob.h"
+#include "parcelscope/core/Error.h"
+
+namespace parcelscope::cli {
+
+namespace {
+const char* kOverview =
+    "parcelscope: observed and procedural parcels, measured side by side\n"
+    "\n"
+    "usage: parcelscope COMMAND [options]\n"
+    "\n"
+    "commands:\n"
+    "  stats     read observed parcels, build blocks, write per-parcel metrics,\n"
+    "            per-block statistics and generator parameters\n"
+    "  version   print the version\n"
+    "\n"
+    "'parcelscope COMMAND --help' describes a command's options.\n";
+
+std::vector<FlagSpec> inputFlags() {
+  return {{"layer", "layer to read (default: the first)"},
+          {"where", "OGR SQL attribute filter, e.g. \"ML <> 'ROAD'\""},
+          {"crs", "CRS of the input (e.g. EPSG:2286), replacing a missing or wrong one"}};
+}
+
+bool wantsHelp(const std::vector<std::string>& args) {
+  for (const auto& a : args) {
+    if (a == "--help" || a == "-h") return true;
+  }
+  return false;
+}
+}  // namespace
+
+int dispatch(const std::vector<std::string>& args) {
+  if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+    std::fputs(kOverview, args.empty() ? stderr : stdout);
+    return args.empty() ? 2 : 0;
+  }
+  const std::vector<std::string> rest(args.begin() + 1, args.end());
+  if (args[0] == "version" || args[0] == "--version") {
+    std::printf("parcelscope %s\n", analysis::version().c_str());
+    return 0;
+  }
+  if (args[0] == "stats") return statsCommand(rest);
+  throw usageError("unknown command '" + args[0] + "' (commands: stats, version)");
+}
+
+int statsCommand(const std::vector<std::string>& args) {
+  auto flags = inputFlags();
+  flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
+  flags.push_back({"quiet", "no progress or summary on stderr", false});
+  const auto& params = analysis::analysisParameters();
+  if (wantsHelp(args)) {
+    std::fputs(usageText("parcelscope stats INPUT [options] --out DIR", flags, params).c_str(), stdout);
+    std::fputs("\nwrites DIR/parcels.csv, DIR/blocks.csv, DIR/blocks.gpkg and DIR/run.json\n", stdout);
+    return 0;
+  }
+  const Args a(args, flags, params);
+  if (a.positional().size() != 1) throw usageError("expected exactly one INPUT file");
+  if (!a.value("out")) throw usageError("--out DIR is required");
+  io::ReadOptions input;
+  input.path = a.positional()[0];
+  input.layer = a.value("layer").value_or("");
+  input.where = a.value("where").value_or("");
+  input.crsOverride = a.value("crs").value_or("");
+  const bool quiet = a.has("quiet");
+  const Json run = analysis::runStats(input, a.parameters(), *a.value("out"), terminalProgress(quiet));
+  if (!quiet) std::fprintf(stderr, "%s\nwritten to %s\n", run.dump().c_str(), a.value("out")->c_str());
+  return 0;
+}
+
+}  // namespace parcelscope::cli

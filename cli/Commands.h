@@ -1,0 +1,12 @@
+#pragma once
+#include <string>
+#include <vector>
+
+namespace parcelscope::cli {
+
+/// Runs the subcommand named by args[0]; returns the exit code. Throws Error.
+int dispatch(const std::vector<std::string>& args);
+
+int statsCommand(const std::vector<std::string>& args);
+
+}  // namespace parcelscope::cli

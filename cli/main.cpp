@@ -1,0 +1,28 @@
+// parcelscope: the batch command line. Each subcommand is a thin shell around a
+// library function; errors map to exit codes 1 (failure) and 2 (usage).
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "Commands.h"
+#include "parcelscope/core/Error.h"
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  const std::string command = args.empty() ? "" : args.front();
+  try {
+    return parcelscope::cli::dispatch(args);
+  } catch (const parcelscope::Error& e) {
+    std::fprintf(stderr, "parcelscope%s: %s\n", command.empty() ? "" : (" " + command).c_str(), e.what());
+    if (e.kind() == parcelscope::Error::Kind::Usage) {
+      std::fprintf(stderr, "run 'parcelscope %s --help' for usage\n", command.c_str());
+      return 2;
+    }
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "parcelscope%s: internal error: %s\n", command.empty() ? "" : (" " + command).c_str(),
+                 e.what());
+    return 1;
+  }
+}

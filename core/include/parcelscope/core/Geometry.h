@@ -1,0 +1,87 @@
+#pragma once
+// Plain geometry types used across ParcelScope. Coordinates are metres in the
+// local projected plane chosen at import (io/ does every reprojection), with the
+// origin near the data so that exact-arithmetic libraries stay accurate.
+#include <vector>
+
+namespace parcelscope {
+
+struct Point {
+  double x = 0;
+  double y = 0;
+};
+
+/// A closed ring stored without repeating its first vertex.
+using Ring = std::vector<Point>;
+
+/// A polygon with holes. Normalised form (see `normalise`): outer ring
+/// counter-clockwise, holes clockwise, no repeated consecutive vertices.
+struct Polygon {
+  Ring outer;
+  std::vector<Ring> holes;
+};
+
+struct Box {
+  double minX = 0, minY = 0, maxX = 0, maxY = 0;
+  double width() const { return maxX - minX; }
+  double height() const { return maxY - minY; }
+  bool intersects(const Box& o) const {
+    return minX <= o.maxX && o.minX <= maxX && minY <= o.maxY && o.minY <= maxY;
+  }
+  Box expanded(double d) const { return {minX - d, minY - d, maxX + d, maxY + d}; }
+};
+
+/// Signed area of a ring in m² (positive when counter-clockwise), shoelace formula.
+double signedArea(const Ring& ring);
+/// Area in m²: outer area minus hole areas.
+double area(const Polygon& polygon);
+/// Length of a ring's boundary in m.
+double ringLength(const Ring& ring);
+/// Total boundary length in m, outer ring and holes.
+double perimeter(const Polygon& polygon);
+Box bounds(const Ring& ring);
+Box bounds(const Polygon& polygon);
+/// Area-weighted centroid of the polygon (holes subtracted).
+Point centroid(const Polygon& polygon);
+
+/// Removes repeated consecutive vertices and a closing vertex equal to the first,
+/// makes the outer ring counter-clockwise and holes clockwise, and drops holes
+/// with fewer than 3 vertices. Returns false if the outer ring is degenerate
+/// (fewer than 3 distinct vertices or zero area).
+bool normalise(Polygon& polygon);
+
+/// Even-odd point-in-ring test; points on the boundary may go either way.
+bool pointInRing(const Point& p, const Ring& ring);
+/// True when `p` is inside the outer ring and outside every hole.
+bool pointInPolygon(const Point& p, const Polygon& polygon);
+/// A point strictly inside the polygon (not merely its centroid, which can lie
+/// outside a concave shape). Falls back to the first vertex for degenerate input.
+Point interiorPoint(const Polygon& polygon);
+
+/// Distance in m from point p to segment [a, b].
+double pointSegmentDistance(const Point& p, const Point& a, const Point& b);
+/// Smallest distance in m between the boundaries of two polygons (0 if they cross).
+double boundaryDistance(const Polygon& a, const Polygon& b);
+
+/// True when the boundaries of `a` and `b` come within `distance` m of each
+/// other, or one polygon lies inside the other. Stops at the first close pair.
+bool withinDistance(const Polygon& a, const Polygon& b, double distance);
+
+/// Convex hull of a point set, counter-clockwise, without collinear points.
+Ring convexHull(std::vector<Point> points);
+
+/// An oriented rectangle: centre, unit axis `u` along the long side, and side lengths.
+struct OrientedBox {
+  Point center;
+  Point u{1, 0};       ///< unit vector along the long side
+  double length = 0;   ///< long side (m)
+  double width = 0;    ///< short side (m)
+  double area() const { return length * width; }
+};
+
+/// Minimum-area enclosing rectangle of a ring (rotating calipers over the convex
+/// hull: the optimum has a side on a hull edge). Ties are broken towards the
+/// first hull edge, so the result is deterministic.
+OrientedBox minimumAreaBox(const Ring& ring);
+
+}  // namespace parcelscope

@@ -1,0 +1,301 @@
+#include "parcelscope/core/Geometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace parcelscope {
+
+double signedArea(const Ring& ring) {
+  const std::size_t n = ring.size();
+  if (n < 3) return 0.0;
+  // Shifted to the first vertex to keep the products small.
+  const Point o = ring[0];
+  double twice = 0.0;
+  for (std::size_t i = 1; i + 1 < n; ++i) {
+    const double ax = ring[i].x - o.x, ay = ring[i].y - o.y;
+    const double bx = ring[i + 1].x - o.x, by = ring[i + 1].y - o.y;
+    twice += ax * by - bx * ay;
+  }
+  return 0.5 * twice;
+}
+
+double area(const Polygon& polygon) {
+  double a = std::fabs(signedArea(polygon.outer));
+  for (const auto& h : polygon.holes) a -= std::fabs(signedArea(h));
+  return a;
+}
+
+double ringLength(const Ring& ring) {
+  double l = 0.0;
+  for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
+    const Point& a = ring[i];
+    const Point& b = ring[(i + 1) % n];
+    l += std::hypot(b.x - a.x, b.y - a.y);
+  }
+  return l;
+}
+
+double perimeter(const Polygon& polygon) {
+  double l = ringLength(polygon.outer);
+  for (const auto& h : polygon.holes) l += ringLength(h);
+  return l;
+}
+
+Box bounds(const Ring& ring) {
+  Box b{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+        std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest()};
+  for (const auto& p : ring) {
+    b.minX = std::min(b.minX, p.x);
+    b.minY = std::min(b.minY, p.y);
+    b.maxX = std::max(b.maxX, p.x);
+    b.maxY = std::max(b.maxY, p.y);
+  }
+  return b;
+}
+
+Box bounds(const Polygon& polygon) { return bounds(polygon.outer); }
+
+Point centroid(const Polygon& polygon) {
+  double cx = 0, cy = 0, a = 0;
+  auto accumulate = [&](const Ring& r) {
+    const Point o = polygon.outer.empty() ? Point{} : polygon.outer[0];
+    for (std::size_t i = 0, n = r.size(); i < n; ++i) {
+      const double x0 = r[i].x - o.x, y0 = r[i].y - o.y;
+      const double x1 = r[(i + 1) % n].x - o.x, y1 = r[(i + 1) % n].y - o.y;
+      const double c = x0 * y1 - x1 * y0;
+      a += c;
+      cx += (x0 + x1) * c;
+      cy += (y0 + y1) * c;
+    }
+  };
+  accumulate(polygon.outer);
+  for (const auto& h : polygon.holes) accumulate(h);
+  if (std::fabs(a) < 1e-300) return polygon.outer.empty() ? Point{} : polygon.outer[0];
+  const Point o = polygon.outer[0];
+  return {o.x + cx / (3.0 * a), o.y + cy / (3.0 * a)};
+}
+
+namespace {
+void dedupe(Ring& r) {
+  Ring out;
+  out.reserve(r.size());
+  for (const auto& p : r) {
+    if (out.empty() || out.back().x != p.x || out.back().y != p.y) out.push_back(p);
+  }
+  while (out.size() > 1 && out.front().x == out.back().x && out.front().y == out.back().y) {
+    out.pop_back();
+  }
+  r.swap(out);
+}
+}  // namespace
+
+bool normalise(Polygon& polygon) {
+  dedupe(polygon.outer);
+  if (polygon.outer.size() < 3 || signedArea(polygon.outer) == 0.0) return false;
+  if (signedArea(polygon.outer) < 0) std::reverse(polygon.outer.begin(), polygon.outer.end());
+  std::vector<Ring> holes;
+  for (auto& h : polygon.holes) {
+    dedupe(h);
+    if (h.size() < 3 || signedArea(h) == 0.0) continue;
+    if (signedArea(h) > 0) std::reverse(h.begin(), h.end());
+    holes.push_back(std::move(h));
+  }
+  polygon.holes.swap(holes);
+  return true;
+}
+
+bool pointInRing(const Point& p, const Ring& ring) {
+  bool inside = false;
+  for (std::size_t i = 0, n = ring.size(), j = n - 1; i < n; j = i++) {
+    const Point& a = ring[i];
+    const Point& b = ring[j];
+    if ((a.y > p.y) != (b.y > p.y)) {
+      const double x = a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y);
+      if (p.x < x) inside = !inside;
+    }
+  }
+  return inside;
+}
+
+bool pointInPolygon(const Point& p, const Polygon& polygon) {
+  if (!pointInRing(p, polygon.outer)) return false;
+  for (const auto& h : polygon.holes) {
+    if (pointInRing(p, h)) return false;
+  }
+  return true;
+}
+
+Point interiorPoint(const Polygon& polygon) {
+  if (polygon.outer.empty()) return {};
+  const Point c = centroid(polygon);
+  if (pointInPolygon(c, polygon)) return c;
+  // Scan line through the middle of the bounding box: take the midpoint of the
+  // widest interval inside the polygon.
+  const Box b = bounds(polygon);
+  double bestLen = -1;
+  Point best = polygon.outer[0];
+  for (double t : {0.5, 0.25, 0.75, 0.125, 0.375, 0.625, 0.875}) {
+    const double y = b.minY + t * b.height();
+    std::vector<double> xs;
+    auto collect = [&](const Ring& r) {
+      for (std::size_t i = 0, n = r.size(), j = n - 1; i < n; j = i++) {
+        const Point& p = r[i];
+        const Point& q = r[j];
+        if ((p.y > y) != (q.y > y)) xs.push_back(p.x + (y - p.y) * (q.x - p.x) / (q.y - p.y));
+      }
+    };
+    collect(polygon.outer);
+    for (const auto& h : polygon.holes) collect(h);
+    std::sort(xs.begin(), xs.end());
+    for (std::size_t i = 0; i + 1 < xs.size(); i += 2) {
+      if (xs[i + 1] - xs[i] > bestLen) {
+        bestLen = xs[i + 1] - xs[i];
+        best = {0.5 * (xs[i] + xs[i + 1]), y};
+      }
+    }
+    if (bestLen > 0) break;
+  }
+  return best;
+}
+
+double pointSegmentDistance(const Point& p, const Point& a, const Point& b) {
+  const double dx = b.x - a.x, dy = b.y - a.y;
+  const double len2 = dx * dx + dy * dy;
+  double t = len2 > 0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / len2 : 0.0;
+  t = std::clamp(t, 0.0, 1.0);
+  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
+}
+
+namespace {
+double cross(const Point& o, const Point& a, const Point& b) {
+  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
+
+bool segmentsCross(const Point& a, const Point& b, const Point& c, const Point& d) {
+  const double d1 = cross(c, d, a), d2 = cross(c, d, b);
+  const double d3 = cross(a, b, c), d4 = cross(a, b, d);
+  return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0)) && d1 != 0 && d2 != 0 && d3 != 0 &&
+         d4 != 0;
+}
+
+double segmentDistance(const Point& a, const Point& b, const Point& c, const Point& d) {
+  if (segmentsCross(a, b, c, d)) return 0.0;
+  return std::min(std::min(pointSegmentDistance(a, c, d), pointSegmentDistance(b, c, d)),
+                  std::min(pointSegmentDistance(c, a, b), pointSegmentDistance(d, a, b)));
+}
+
+template <typename F>
+void forEachEdge(const Polygon& p, F&& f) {
+  auto ring = [&](const Ring& r) {
+    for (std::size_t i = 0, n = r.size(); i < n; ++i) f(r[i], r[(i + 1) % n]);
+  };
+  ring(p.outer);
+  for (const auto& h : p.holes) ring(h);
+}
+}  // namespace
+
+double boundaryDistance(const Polygon& a, const Polygon& b) {
+  double best = std::numeric_limits<double>::max();
+  forEachEdge(a, [&](const Point& p, const Point& q) {
+    if (best == 0.0) return;
+    forEachEdge(b, [&](const Point& r, const Point& s) {
+      if (best == 0.0) return;
+      best = std::min(best, segmentDistance(p, q, r, s));
+    });
+  });
+  return best;
+}
+
+bool withinDistance(const Polygon& a, const Polygon& b, double distance) {
+  if (!bounds(a).expanded(distance).intersects(bounds(b))) return false;
+  bool close = false;
+  forEachEdge(a, [&](const Point& p, const Point& q) {
+    if (close) return;
+    const Box ea = Box{std::min(p.x, q.x), std::min(p.y, q.y), std::max(p.x, q.x), std::max(p.y, q.y)}
+                       .expanded(distance);
+    forEachEdge(b, [&](const Point& r, const Point& s) {
+      if (close) return;
+      const Box eb{std::min(r.x, s.x), std::min(r.y, s.y), std::max(r.x, s.x), std::max(r.y, s.y)};
+      if (ea.intersects(eb) && segmentDistance(p, q, r, s) <= distance) close = true;
+    });
+  });
+  if (close) return true;
+  return pointInPolygon(b.outer[0], a) || pointInPolygon(a.outer[0], b);
+}
+
+Ring convexHull(std::vector<Point> pts) {
+  std::sort(pts.begin(), pts.end(),
+            [](const Point& a, const Point& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  pts.erase(std::unique(pts.begin(), pts.end(),
+                        [](const Point& a, const Point& b) { return a.x == b.x && a.y == b.y; }),
+            pts.end());
+  if (pts.size() < 3) return pts;
+  Ring hull(2 * pts.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {  // lower hull
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
+    hull[k++] = pts[i];
+  }
+  for (std::size_t i = pts.size() - 1, t = k + 1; i > 0; --i) {  // upper hull
+    while (k >= t && cross(hull[k - 2], hull[k - 1], pts[i - 1]) <= 0) --k;
+    hull[k++] = pts[i - 1];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+OrientedBox minimumAreaBox(const Ring& ring) {
+  OrientedBox best;
+  const Ring hull = convexHull(ring);
+  if (hull.size() < 3) {
+    if (hull.size() == 2) {
+      const double dx = hull[1].x - hull[0].x, dy = hull[1].y - hull[0].y;
+      const double l = std::hypot(dx, dy);
+      best.center = {0.5 * (hull[0].x + hull[1].x), 0.5 * (hull[0].y + hull[1].y)};
+      if (l > 0) best.u = {dx / l, dy / l};
+      best.length = l;
+    } else if (hull.size() == 1) {
+      best.center = hull[0];
+    }
+    return best;
+  }
+  double bestArea = std::numeric_limits<double>::max();
+  const std::size_t n = hull.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point& a = hull[i];
+    const Point& b = hull[(i + 1) % n];
+    const double l = std::hypot(b.x - a.x, b.y - a.y);
+    if (l == 0) continue;
+    const Point e{(b.x - a.x) / l, (b.y - a.y) / l};
+    const Point nrm{-e.y, e.x};
+    double minE = std::numeric_limits<double>::max(), maxE = std::numeric_limits<double>::lowest();
+    double minN = minE, maxN = maxE;
+    for (const Point& p : hull) {
+      const double pe = (p.x - a.x) * e.x + (p.y - a.y) * e.y;
+      const double pn = (p.x - a.x) * nrm.x + (p.y - a.y) * nrm.y;
+      minE = std::min(minE, pe);
+      maxE = std::max(maxE, pe);
+      minN = std::min(minN, pn);
+      maxN = std::max(maxN, pn);
+    }
+    const double w = maxE - minE, h = maxN - minN;
+    if (w * h < bestArea * (1 - 1e-12)) {
+      bestArea = w * h;
+      const double ce = 0.5 * (minE + maxE), cn = 0.5 * (minN + maxN);
+      best.center = {a.x + ce * e.x + cn * nrm.x, a.y + ce * e.y + cn * nrm.y};
+      if (w >= h) {
+        best.u = e;
+        best.length = w;
+        best.width = h;
+      } else {
+        best.u = nrm;
+        best.length = h;
+        best.width = w;
+      }
+    }
+  }
+  return best;
+}
+
+}  // namespace parcelscope

@@ -1,0 +1,24 @@
+#pragma once
+// Robust polygon operations backed by GEOS through GDAL/OGR. io/ is the only
+// module that links GDAL, so the few overlay operations the analysis needs are
+// offered here on ParcelScope's plain types.
+#include <vector>
+
+#include "parcelscope/core/Geometry.h"
+
+namespace parcelscope::io {
+
+/// Union of `polygons`, then a morphological closing by `closeDistance` metres
+/// (buffer out by half of it, back in by half of it) so that parts separated by
+/// gaps narrower than `closeDistance` join and slivers narrower than it vanish.
+/// Holes wider than `closeDistance` are kept. Returns normalised polygons.
+/// Throws Error(Geometry) if GEOS fails even after a buffer(0) repair.
+std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, double closeDistance);
+
+/// True when the polygon is valid in the OGC simple-features sense (GEOS IsValid).
+bool isValid(const Polygon& polygon);
+
+/// Area in m² of the intersection of two polygons (GEOS).
+double intersectionArea(const Polygon& a, const Polygon& b);
+
+}  // namespace parcelscope::io

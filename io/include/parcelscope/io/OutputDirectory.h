@@ -1,0 +1,35 @@
+#pragma once
+// An output directory that is never left half-written. Files are written into a
+// hidden staging folder beside the target; commit() moves them into the target
+// (each move an atomic rename) and removes the staging folder. Without commit(),
+// the destructor removes the staging folder and the target is untouched.
+#include <string>
+#include <vector>
+
+namespace parcelscope::io {
+
+class OutputDirectory {
+public:
+  /// Throws Error(Usage) when `target` is an existing file, or when it holds or
+  /// is one of `inputs` (outputs must never overwrite an input); Error(IO) when
+  /// the staging folder cannot be created.
+  OutputDirectory(std::string target, const std::vector<std::string>& inputs);
+  ~OutputDirectory();
+  OutputDirectory(const OutputDirectory&) = delete;
+  OutputDirectory& operator=(const OutputDirectory&) = delete;
+
+  /// Where to write the output file `name` before commit().
+  std::string stage(const std::string& name);
+  /// Moves every staged file into the target. Throws Error(IO) on failure.
+  void commit();
+  const std::string& target() const { return target_; }
+
+private:
+  std::string target_;
+  std::string staging_;
+  std::vector<std::string> inputs_;
+  std::vector<std::string> names_;
+  bool committed_ = false;
+};
+
+}  // namespace parcelscope::io

@@ -1,0 +1,65 @@
+#pragma once
+// Reading observed parcels from any polygon source GDAL/OGR reads (GeoJSON,
+// TopoJSON, GeoPackage, Shapefile, FlatGeobuf, ...), projecting them to a local
+// metric plane and cleaning them. Cleaning is never silent: every repair, split,
+// collapse and skip is counted in CleaningReport.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "parcelscope/core/Parcel.h"
+#include "parcelscope/core/Progress.h"
+#include "parcelscope/io/LocalFrame.h"
+
+namespace parcelscope::io {
+
+struct ReadOptions {
+  std::string path;
+  std::string layer;        ///< layer name; empty = the first layer
+  std::string where;        ///< OGR SQL attribute filter; empty = none
+  std::string crsOverride;  ///< e.g. "EPSG:2286"; replaces a missing or wrong CRS
+};
+
+struct CleaningReport {
+  std::int64_t features = 0;            ///< features read (after --where)
+  std::int64_t nullOrEmpty = 0;         ///< skipped: null or empty geometry
+  std::int64_t nonPolygonal = 0;        ///< skipped: points or lines only
+  std::int64_t multipartFeatures = 0;   ///< features with more than one polygon part
+  std::int64_t partsFromMultipart = 0;  ///< parcels those features were split into
+  std::int64_t withHoles = 0;           ///< parcels that keep one or more holes
+  std::int64_t invalidRepaired = 0;     ///< invalid polygons repaired by make-valid
+  std::int64_t invalidSkipped = 0;      ///< invalid polygons make-valid could not save
+  std::int64_t degenerateSkipped = 0;   ///< parts of zero area or fewer than 3 vertices
+  std::int64_t duplicatesCollapsed = 0; ///< features dropped as exact copies of another
+  std::int64_t duplicateStacks = 0;     ///< distinct geometries that had copies
+  std::int64_t parcels = 0;             ///< parcels kept
+};
+
+struct CrsInfo {
+  std::string wkt;          ///< CRS of the input (or of --crs); empty when none was declared
+  std::string name;         ///< human-readable name, e.g. "WGS 84" or "assumed OGC:CRS84"
+  bool assumedLonLat = false;  ///< no CRS declared; coordinates look like degrees
+  bool overridden = false;     ///< came from --crs
+};
+
+struct ParcelLayer {
+  std::string path;
+  std::string layerName;
+  std::vector<Parcel> parcels;  ///< local metres, normalised
+  LocalFrame frame;
+  CrsInfo crs;
+  CleaningReport report;
+};
+
+/// Reads, projects and cleans the polygons of one layer.
+/// Throws Error(Input) with a one-line message naming the file (and the feature
+/// or layer) when the file is missing or unreadable, the layer or the filter is
+/// wrong, the layer holds no polygon, or the CRS cannot be used (including
+/// lon/lat claimed for coordinates that cannot be degrees); Error(Usage) when
+/// `crsOverride` is not a CRS GDAL knows.
+ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress = {});
+
+/// Names of the layers of a vector dataset (for `--layer` help and the GUI).
+std::vector<std::string> listLayers(const std::string& path);
+
+}  // namespace parcelscope::io

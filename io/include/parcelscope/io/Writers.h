@@ -1,0 +1,35 @@
+#pragma once
+// Writing tables, vector layers and run records. Every writer writes to the path
+// it is given; atomicity comes from OutputDirectory (write into its staging
+// folder, then commit).
+#include <string>
+#include <vector>
+
+#include "parcelscope/core/Geometry.h"
+#include "parcelscope/core/Json.h"
+#include "parcelscope/core/Table.h"
+#include "parcelscope/io/LocalFrame.h"
+#include "parcelscope/io/ParcelReader.h"
+
+namespace parcelscope::io {
+
+/// RFC 4180 CSV with a header row; reals with up to 10 significant digits.
+/// Throws Error(IO) on failure.
+void writeCsv(const std::string& path, const Table& table);
+
+/// Writes `json.dump()` followed by a newline. Throws Error(IO) on failure.
+void writeJson(const std::string& path, const Json& json);
+
+/// Writes a GeoPackage with one polygon layer. Feature i has geometry
+/// `geometries[i]` (one or more polygons, written as a MultiPolygon) and the
+/// attributes of `attributes.rows[i]`. Coordinates are mapped back from local
+/// metres with `frame` and tagged with `crs` (OGC:CRS84 when the CRS was assumed).
+/// Throws Error(IO) on failure.
+void writePolygonLayer(const std::string& path, const std::string& layerName,
+                       const std::vector<std::vector<Polygon>>& geometries, const Table& attributes,
+                       const LocalFrame& frame, const CrsInfo& crs);
+
+/// The GDAL version string, for run records.
+std::string gdalVersion();
+
+}  // namespace parcelscope::io

@@ -1,0 +1,59 @@
+#include "parcelscope/io/LocalFrame.h"
+
+#include <GeographicLib/TransverseMercator.hpp>
+#include <sstream>
+
+namespace parcelscope::io {
+
+LocalFrame::LocalFrame() = default;
+
+LocalFrame LocalFrame::geographic(double lon0, double lat0, double a, double f) {
+  LocalFrame frame;
+  frame.tm_ = std::make_shared<GeographicLib::TransverseMercator>(a, f, 1.0);
+  frame.lon0_ = lon0;
+  frame.lat0_ = lat0;
+  double x = 0, y = 0;
+  frame.tm_->Forward(lon0, lat0, lon0, x, y);
+  frame.x0_ = x;
+  frame.y0_ = y;
+  return frame;
+}
+
+LocalFrame LocalFrame::projected(double metresPerUnit, double x0, double y0) {
+  LocalFrame frame;
+  frame.unit_ = metresPerUnit;
+  frame.x0_ = x0;
+  frame.y0_ = y0;
+  return frame;
+}
+
+Point LocalFrame::toLocal(double x, double y) const {
+  if (tm_) {
+    double e = 0, n = 0;
+    tm_->Forward(lon0_, y, x, e, n);
+    return {e - x0_, n - y0_};
+  }
+  return {(x - x0_) * unit_, (y - y0_) * unit_};
+}
+
+Point LocalFrame::toSource(const Point& p) const {
+  if (tm_) {
+    double lat = 0, lon = 0;
+    tm_->Reverse(lon0_, p.x + x0_, p.y + y0_, lat, lon);
+    return {lon, lat};
+  }
+  return {p.x / unit_ + x0_, p.y / unit_ + y0_};
+}
+
+std::string LocalFrame::describe() const {
+  std::ostringstream s;
+  s.precision(10);
+  if (tm_) {
+    s << "transverse Mercator centred on lon " << lon0_ << ", lat " << lat0_;
+  } else {
+    s << "input CRS, " << unit_ << " m per unit, origin at (" << x0_ << ", " << y0_ << ")";
+  }
+  return s.str();
+}
+
+}  // namespace parcelscope::io

@@ -1,0 +1,78 @@
+#include "parcelscope/io/OutputDirectory.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+
+#include "parcelscope/core/Error.h"
+
+namespace fs = std::filesystem;
+
+namespace parcelscope::io {
+
+namespace {
+bool sameFile(const fs::path& a, const fs::path& b) {
+  std::error_code ec;
+  return fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec);
+}
+}  // namespace
+
+OutputDirectory::OutputDirectory(std::string target, const std::vector<std::string>& inputs)
+    : target_(std::move(target)), inputs_(inputs) {
+  std::error_code ec;
+  if (target_.empty()) throw usageError("--out: an output directory is required");
+  if (fs::exists(target_, ec) && !fs::is_directory(target_, ec)) {
+    throw usageError(target_ + ": --out names an existing file, not a directory");
+  }
+  for (const auto& in : inputs_) {
+    if (sameFile(target_, in)) throw usageError(target_ + ": --out is an input");
+  }
+  fs::path t = fs::absolute(fs::path(target_)).lexically_normal();
+  if (t.filename().empty()) t = t.parent_path();
+  const fs::path parent = t.parent_path();
+  if (!fs::exists(parent, ec)) {
+    fs::create_directories(parent, ec);
+    if (ec) throw ioError(target_ + ": cannot create parent directory (" + ec.message() + ")");
+  }
+  staging_ = (parent / ("." + t.filename().string() + ".partial-" + std::to_string(::getpid()))).string();
+  fs::remove_all(staging_, ec);
+  if (!fs::create_directory(staging_, ec)) {
+    throw ioError(target_ + ": cannot create staging directory " + staging_ + " (" + ec.message() + ")");
+  }
+}
+
+OutputDirectory::~OutputDirectory() {
+  std::error_code ec;
+  fs::remove_all(staging_, ec);
+}
+
+std::string OutputDirectory::stage(const std::string& name) {
+  const fs::path final = fs::path(target_) / name;
+  for (const auto& in : inputs_) {
+    if (sameFile(final, in)) throw usageError(final.string() + ": output would overwrite an input");
+  }
+  names_.push_back(name);
+  return (fs::path(staging_) / name).string();
+}
+
+void OutputDirectory::commit() {
+  std::error_code ec;
+  if (!fs::exists(target_, ec)) {
+    fs::rename(staging_, target_, ec);  // the whole folder appears at once
+    if (!ec) {
+      committed_ = true;
+      return;
+    }
+    fs::create_directories(target_, ec);
+    if (ec) throw ioError(target_ + ": cannot create output directory (" + ec.message() + ")");
+  }
+  for (const auto& name : names_) {
+    const fs::path from = fs::path(staging_) / name;
+    if (!fs::exists(from, ec)) continue;
+    fs::rename(from, fs::path(target_) / name, ec);
+    if (ec) throw ioError((fs::path(target_) / name).string() + ": cannot move into place (" + ec.message() + ")");
+  }
+  committed_ = true;
+}
+
+}  // namespace parcelscope::io

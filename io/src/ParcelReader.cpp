@@ -1,0 +1,296 @@
+#include "parcelscope/io/ParcelReader.h"
+
+#include <cpl_error.h>
+#include <gdal_priv.h>
+#include <ogr_spatialref.h>
+#include <ogrsf_frmts.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <sstream>
+#include <unordered_map>
+
+#include "OgrConvert.h"
+#include "parcelscope/core/Error.h"
+
+namespace parcelscope::io {
+
+namespace {
+
+using detail::QuietErrors;
+
+std::string lastGdalMessage() {
+  std::string m = CPLGetLastErrorMsg();
+  return m.empty() ? "unknown GDAL error" : m;
+}
+
+GDALDatasetUniquePtr openVector(const std::string& path) {
+  detail::ensureGdalRegistered();
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw inputError(path + ": no such file");
+  QuietErrors quiet;
+  CPLErrorReset();
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
+  if (!ds) {
+    throw inputError(path + ": not a vector format GDAL can read (" + lastGdalMessage() + ")");
+  }
+  if (ds->GetLayerCount() == 0) throw inputError(path + ": holds no vector layer");
+  return ds;
+}
+
+struct Feature {
+  std::int64_t fid = -1;
+  std::unique_ptr<OGRGeometry> geometry;
+  int stackCount = 1;
+};
+
+struct Envelope {
+  double minX = std::numeric_limits<double>::max(), minY = minX;
+  double maxX = std::numeric_limits<double>::lowest(), maxY = maxX;
+  void merge(const OGREnvelope& e) {
+    minX = std::min(minX, e.MinX);
+    minY = std::min(minY, e.MinY);
+    maxX = std::max(maxX, e.MaxX);
+    maxY = std::max(maxY, e.MaxY);
+  }
+  bool looksLikeDegrees() const {
+    return minX >= -180.0 && maxX <= 180.0 && minY >= -90.0 && maxY <= 90.0;
+  }
+};
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+// Chooses the local frame and records the CRS, or throws when the CRS cannot be used.
+LocalFrame chooseFrame(const std::string& path, const OGRSpatialReference* srs,
+                       const Envelope& env, CrsInfo& crs) {
+  const double cx = 0.5 * (env.minX + env.maxX);
+  const double cy = 0.5 * (env.minY + env.maxY);
+  const std::string hint = "; give the real CRS with --crs EPSG:N";
+  if (!srs) {
+    if (!env.looksLikeDegrees()) {
+      throw inputError(path + ": the layer declares no CRS and its coordinates (x " + fmt(env.minX) +
+                       " to " + fmt(env.maxX) + ", y " + fmt(env.minY) + " to " + fmt(env.maxY) +
+                       ") are not degrees" + hint);
+    }
+    crs.assumedLonLat = true;
+    crs.name = "assumed OGC:CRS84 (no CRS declared)";
+    return LocalFrame::geographic(cx, cy);
+  }
+  const char* name = srs->GetName();
+  crs.name = name ? name : "unnamed CRS";
+  if (const char* code = srs->GetAuthorityCode(nullptr)) {
+    const char* auth = srs->GetAuthorityName(nullptr);
+    crs.name += std::string(" (") + (auth ? auth : "") + ":" + code + ")";
+  }
+  if (srs->IsGeographic()) {
+    if (!env.looksLikeDegrees()) {
+      throw inputError(path + ": the layer claims lon/lat (" + crs.name + ") but its coordinates (x " +
+                       fmt(env.minX) + " to " + fmt(env.maxX) + ", y " + fmt(env.minY) + " to " +
+                       fmt(env.maxY) + ") cannot be degrees" + hint);
+    }
+    OGRErr err = OGRERR_NONE;
+    const double a = srs->GetSemiMajor(&err);
+    const double invf = srs->GetInvFlattening(&err);
+    return LocalFrame::geographic(cx, cy, a, invf > 0 ? 1.0 / invf : 0.0);
+  }
+  if (srs->IsProjected()) {
+    const double unit = srs->GetLinearUnits();
+    if (!(unit > 0)) throw inputError(path + ": CRS " + crs.name + " has no usable linear unit");
+    return LocalFrame::projected(unit, cx, cy);
+  }
+  throw inputError(path + ": CRS " + crs.name +
+                   " is neither geographic nor projected, so parcels cannot be measured" + hint);
+}
+
+// Projects every vertex of `g` to the local frame, in place.
+void projectInPlace(OGRGeometry& g, const LocalFrame& frame) {
+  const auto type = wkbFlatten(g.getGeometryType());
+  if (type == wkbPolygon) {
+    for (OGRLinearRing* ring : *g.toPolygon()) {
+      for (int i = 0, n = ring->getNumPoints(); i < n; ++i) {
+        const Point p = frame.toLocal(ring->getX(i), ring->getY(i));
+        ring->setPoint(i, p.x, p.y);
+      }
+    }
+  } else if (OGR_GT_IsSubClassOf(type, wkbGeometryCollection)) {
+    for (OGRGeometry* part : *g.toGeometryCollection()) projectInPlace(*part, frame);
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> listLayers(const std::string& path) {
+  auto ds = openVector(path);
+  std::vector<std::string> names;
+  for (int i = 0; i < ds->GetLayerCount(); ++i) names.emplace_back(ds->GetLayer(i)->GetName());
+  return names;
+}
+
+ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) {
+  const std::string& path = options.path;
+  auto ds = openVector(path);
+  QuietErrors quiet;
+
+  OGRLayer* layer = nullptr;
+  if (options.layer.empty()) {
+    layer = ds->GetLayer(0);
+  } else {
+    layer = ds->GetLayerByName(options.layer.c_str());
+    if (!layer) {
+      std::string names;
+      for (int i = 0; i < ds->GetLayerCount(); ++i) {
+        names += (i ? ", " : "") + std::string(ds->GetLayer(i)->GetName());
+      }
+      throw inputError(path + ": no layer named '" + options.layer + "' (layers: " + names + ")");
+    }
+  }
+
+  ParcelLayer result;
+  result.path = path;
+  result.layerName = layer->GetName();
+  CleaningReport& report = result.report;
+
+  if (!options.where.empty()) {
+    CPLErrorReset();
+    if (layer->SetAttributeFilter(options.where.c_str()) != OGRERR_NONE) {
+      throw inputError(path + ": --where \"" + options.where + "\" is not a valid filter on layer " +
+                       result.layerName + " (" + lastGdalMessage() + ")");
+    }
+  }
+
+  // CRS: --crs replaces whatever the file declares.
+  OGRSpatialReference overrideSrs;
+  const OGRSpatialReference* srs = layer->GetSpatialRef();
+  if (!options.crsOverride.empty()) {
+    CPLErrorReset();
+    if (overrideSrs.SetFromUserInput(options.crsOverride.c_str()) != OGRERR_NONE) {
+      throw usageError(path + ": --crs " + options.crsOverride + " is not a CRS GDAL knows (" +
+                       lastGdalMessage() + ")");
+    }
+    overrideSrs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    srs = &overrideSrs;
+    result.crs.overridden = true;
+  }
+
+  // Pass 1: read features, collapse exact duplicate geometries, find the extent.
+  const GIntBig total = layer->GetFeatureCount(FALSE);
+  std::vector<Feature> features;
+  std::unordered_map<std::string, std::size_t> byGeometry;
+  Envelope env;
+  layer->ResetReading();
+  for (auto& feature : *layer) {
+    ++report.features;
+    if (report.features % 2000 == 0 && total > 0) {
+      reportProgress(progress, 0.6 * static_cast<double>(report.features) / static_cast<double>(total),
+                     "reading");
+    }
+    OGRGeometry* g = feature->GetGeometryRef();
+    if (!g || g->IsEmpty()) {
+      ++report.nullOrEmpty;
+      continue;
+    }
+    std::string wkb(static_cast<std::size_t>(g->WkbSize()), '\0');
+    g->exportToWkb(wkbNDR, reinterpret_cast<unsigned char*>(wkb.data()), wkbVariantIso);
+    auto [it, inserted] = byGeometry.emplace(std::move(wkb), features.size());
+    if (!inserted) {
+      Feature& original = features[it->second];
+      if (original.stackCount == 1) ++report.duplicateStacks;
+      ++original.stackCount;
+      ++report.duplicatesCollapsed;
+      continue;
+    }
+    OGREnvelope e;
+    g->getEnvelope(&e);
+    env.merge(e);
+    features.push_back({feature->GetFID(), std::unique_ptr<OGRGeometry>(feature->StealGeometry()), 1});
+  }
+  if (CPLGetLastErrorType() == CE_Failure && report.features == 0) {
+    throw inputError(path + ": reading layer " + result.layerName + " failed (" + lastGdalMessage() + ")");
+  }
+  if (features.empty()) {
+    throw inputError(path + ": layer " + result.layerName + " holds no polygon geometry (" +
+                     std::to_string(report.features) + " features read" +
+                     (options.where.empty() ? "" : " with --where") + ")");
+  }
+
+  result.frame = chooseFrame(path, srs, env, result.crs);
+  if (srs) {
+    char* wkt = nullptr;
+    const char* wktOptions[] = {"FORMAT=WKT2_2018", nullptr};
+    if (srs->exportToWkt(&wkt, wktOptions) == OGRERR_NONE && wkt) result.crs.wkt = wkt;
+    CPLFree(wkt);
+  }
+
+  // Pass 2: project, repair, split into parts, normalise.
+  std::size_t done = 0;
+  for (Feature& f : features) {
+    if (++done % 2000 == 0) {
+      reportProgress(progress, 0.6 + 0.4 * static_cast<double>(done) / static_cast<double>(features.size()),
+                     "cleaning");
+    }
+    std::vector<std::unique_ptr<OGRPolygon>> polygons;
+    if (!detail::collectPolygons(*f.geometry, polygons) && polygons.empty()) {
+      ++report.nonPolygonal;
+      continue;
+    }
+    bool repaired = false;
+    for (auto& p : polygons) projectInPlace(*p, result.frame);
+    // Validity is judged on the whole feature so that wrongly nested parts of a
+    // multipolygon (a hole stored as a part) are repaired into holes.
+    std::unique_ptr<OGRGeometry> whole;
+    if (polygons.size() == 1) {
+      whole = std::move(polygons.front());
+    } else {
+      auto multi = std::make_unique<OGRMultiPolygon>();
+      for (auto& p : polygons) multi->addGeometryDirectly(p.release());
+      whole = std::move(multi);
+    }
+    polygons.clear();
+    if (!whole->IsValid()) {
+      std::unique_ptr<OGRGeometry> fixed(whole->MakeValid());
+      if (!fixed || fixed->IsEmpty()) {
+        ++report.invalidSkipped;
+        continue;
+      }
+      whole = std::move(fixed);
+      repaired = true;
+    }
+    detail::collectPolygons(*whole, polygons);
+    int part = 0;
+    for (auto& p : polygons) {
+      Parcel parcel;
+      parcel.shape = detail::fromOgr(*p);
+      if (!normalise(parcel.shape)) {
+        ++report.degenerateSkipped;
+        continue;
+      }
+      parcel.sourceFid = f.fid;
+      parcel.part = part++;
+      parcel.stackCount = f.stackCount;
+      parcel.repaired = repaired;
+      if (!parcel.shape.holes.empty()) ++report.withHoles;
+      result.parcels.push_back(std::move(parcel));
+    }
+    if (repaired) (part > 0 ? report.invalidRepaired : report.invalidSkipped)++;
+    if (part > 1) {
+      ++report.multipartFeatures;
+      report.partsFromMultipart += part;
+    }
+  }
+  report.parcels = static_cast<std::int64_t>(result.parcels.size());
+  if (result.parcels.empty()) {
+    throw inputError(path + ": layer " + result.layerName + " holds no usable polygon (" +
+                     std::to_string(report.features) + " features, all skipped)");
+  }
+  reportProgress(progress, 1.0, "cleaning");
+  return result;
+}
+
+}  // namespace parcelscope::io
