@@ -7,6 +7,7 @@
 #include "BoxPairs.h"
 #include "Contacts.h"
 #include "parcelscope/core/Error.h"
+#include "parcelscope/core/Parallel.h"
 #include "parcelscope/io/GeometryOps.h"
 
 namespace parcelscope::analysis {
@@ -71,8 +72,9 @@ struct DisjointSets {
 
 // Minimum shared boundary (m) for two parcels to count as neighbours.
 constexpr double kMinSharedBoundary = 1.0;
-// Network-shape right-of-way: at least this many neighbours, and an MBR width at
-// least this many times the strip width 2A/P (a lot of any proportions stays below 2).
+// Right-of-way: an MBR width at least kNetworkWidthRatio times the strip width
+// 2A/P (a rectangular lot of any proportions stays below 2), and either holes
+// holding other parcels or at least kNetworkMinNeighbours neighbours.
 constexpr int kNetworkMinNeighbours = 10;
 constexpr double kNetworkWidthRatio = 6.0;
 
@@ -138,14 +140,18 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
 
   // 3. Right-of-way parcels.
   if (options.detectRightOfWay) {
+    // A street net stored as a parcel is a thin strip (its MBR is many strip
+    // widths wide) that either encloses other parcels in its holes or touches
+    // many of them. Lots with an enclave, or long thin lots, fail one of the two.
+    std::vector<char> enclosing(n, 0);
     for (const auto& [i, j] : pairs) {
       for (const auto& [outer, inner] : {std::pair<int, int>{i, j}, std::pair<int, int>{j, i}}) {
-        if (parcels[outer].shape.holes.empty() || out.rightOfWay[outer] != RightOfWay::No) continue;
+        if (enclosing[outer]) continue;
         for (const Ring& hole : parcels[outer].shape.holes) {
           const Box hb = bounds(hole);
           const Point& p = inside[inner];
           if (p.x >= hb.minX && p.x <= hb.maxX && p.y >= hb.minY && p.y <= hb.maxY && pointInRing(p, hole)) {
-            out.rightOfWay[outer] = RightOfWay::HolesHoldParcels;
+            enclosing[outer] = 1;
             break;
           }
         }
@@ -154,8 +160,10 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
     for (std::size_t i = 0; i < n; ++i) {
       const ParcelMetrics& m = out.metrics[i];
       const double stripWidth = 2.0 * m.area / m.perimeter;
-      if (out.rightOfWay[i] == RightOfWay::No && m.neighbours >= kNetworkMinNeighbours &&
-          m.width >= kNetworkWidthRatio * stripWidth) {
+      if (m.width < kNetworkWidthRatio * stripWidth) continue;
+      if (enclosing[i]) {
+        out.rightOfWay[i] = RightOfWay::HolesHoldParcels;
+      } else if (m.neighbours >= kNetworkMinNeighbours) {
         out.rightOfWay[i] = RightOfWay::NetworkShape;
       }
     }
@@ -189,15 +197,21 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
 
   // 5. Block outlines, frontage and statistics.
   const double frontTol = std::max(tol, 0.05);
+  parallelFor(
+      out.blocks.size(),
+      [&](std::size_t b) {
+        std::vector<const Polygon*> members;
+        for (int i : out.blocks[b].parcels) members.push_back(&parcels[i].shape);
+        out.blocks[b].parts = io::unionAndClose(members, tol);
+      },
+      [&](std::size_t done) {
+        reportProgress(progress, 0.5 + 0.4 * static_cast<double>(done) / static_cast<double>(out.blocks.size()),
+                       "blocks");
+      });
   for (std::size_t b = 0; b < out.blocks.size(); ++b) {
-    if (b % 50 == 0) {
-      reportProgress(progress, 0.5 + 0.5 * static_cast<double>(b) / static_cast<double>(out.blocks.size()),
-                     "blocks");
-    }
     Block& block = out.blocks[b];
     std::vector<const Polygon*> members;
     for (int i : block.parcels) members.push_back(&parcels[i].shape);
-    block.parts = io::unionAndClose(members, tol);
     if (block.parts.size() > 1) ++out.multipartBlocks;
 
     std::vector<Ring> outline;

@@ -26,18 +26,19 @@ std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, 
   if (polygons.empty()) return {};
   OGRMultiPolygon multi;
   for (const Polygon* p : polygons) multi.addGeometryDirectly(detail::toOgr(*p).release());
-  constexpr int kQuadSegments = 4;
-  std::unique_ptr<OGRGeometry> result;
-  if (closeDistance > 0) {
-    // Buffering a collection unions it; the inward buffer restores the outline.
-    std::unique_ptr<OGRGeometry> grown(multi.Buffer(0.5 * closeDistance, kQuadSegments));
+  constexpr int kQuadSegments = 1;
+  std::unique_ptr<OGRGeometry> result(multi.UnionCascaded());
+  if (!result) result.reset(multi.Buffer(0.0));
+  const bool simple = result && wkbFlatten(result->getGeometryType()) == wkbPolygon &&
+                      result->toPolygon()->getNumInteriorRings() == 0;
+  if (result && closeDistance > 0 && !simple) {
+    // Gaps or holes: close them where narrower than the tolerance. Buffering
+    // out unions the parts; buffering back in restores the outline.
+    std::unique_ptr<OGRGeometry> grown(result->Buffer(0.5 * closeDistance, kQuadSegments));
     if (grown) result.reset(grown->Buffer(-0.5 * closeDistance, kQuadSegments));
-  } else {
-    result.reset(multi.UnionCascaded());
-    if (!result) result.reset(multi.Buffer(0.0));
   }
   if (!result) throw geometryError("union of " + std::to_string(polygons.size()) + " parcels failed");
-  if (closeDistance > 0) {
+  if (closeDistance > 0 && !simple) {
     // The round joins of the closing leave runs of vertices a few millimetres
     // apart; drop them (the outline moves by at most a tenth of the tolerance).
     std::unique_ptr<OGRGeometry> simple(result->SimplifyPreserveTopology(std::min(0.05, 0.1 * closeDistance)));

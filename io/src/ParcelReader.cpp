@@ -14,12 +14,17 @@
 
 #include "OgrConvert.h"
 #include "parcelscope/core/Error.h"
+#include "parcelscope/core/Parallel.h"
 
 namespace parcelscope::io {
 
 namespace {
 
 using detail::QuietErrors;
+
+// Parts smaller than this (m², a 3 cm square) are make-valid leftovers or
+// zero-area slivers, not parcels.
+constexpr double kMinPartArea = 1e-3;
 
 std::string lastGdalMessage() {
   std::string m = CPLGetLastErrorMsg();
@@ -122,6 +127,60 @@ void projectInPlace(OGRGeometry& g, const LocalFrame& frame) {
   } else if (OGR_GT_IsSubClassOf(type, wkbGeometryCollection)) {
     for (OGRGeometry* part : *g.toGeometryCollection()) projectInPlace(*part, frame);
   }
+}
+
+// One feature after projection, repair and splitting.
+struct Cleaned {
+  std::vector<Parcel> parcels;
+  bool nonPolygonal = false, repaired = false, repairFailed = false;
+  int degenerate = 0;
+};
+
+Cleaned cleanFeature(const Feature& f, const LocalFrame& frame) {
+  QuietErrors quiet;  // error handlers are per thread
+  Cleaned c;
+  std::vector<std::unique_ptr<OGRPolygon>> polygons;
+  if (!detail::collectPolygons(*f.geometry, polygons) && polygons.empty()) {
+    c.nonPolygonal = true;
+    return c;
+  }
+  for (auto& p : polygons) projectInPlace(*p, frame);
+  // Validity is judged on the whole feature so that wrongly nested parts of a
+  // multipolygon (a hole stored as a part) are repaired into holes.
+  std::unique_ptr<OGRGeometry> whole;
+  if (polygons.size() == 1) {
+    whole = std::move(polygons.front());
+  } else {
+    auto multi = std::make_unique<OGRMultiPolygon>();
+    for (auto& p : polygons) multi->addGeometryDirectly(p.release());
+    whole = std::move(multi);
+  }
+  polygons.clear();
+  if (!whole->IsValid()) {
+    std::unique_ptr<OGRGeometry> fixed(whole->MakeValid());
+    if (!fixed || fixed->IsEmpty()) {
+      c.repairFailed = true;
+      return c;
+    }
+    whole = std::move(fixed);
+    c.repaired = true;
+  }
+  detail::collectPolygons(*whole, polygons);
+  int part = 0;
+  for (auto& p : polygons) {
+    Parcel parcel;
+    parcel.shape = detail::fromOgr(*p);
+    if (!normalise(parcel.shape) || area(parcel.shape) < kMinPartArea) {
+      ++c.degenerate;
+      continue;
+    }
+    parcel.sourceFid = f.fid;
+    parcel.part = part++;
+    parcel.stackCount = f.stackCount;
+    parcel.repaired = c.repaired;
+    c.parcels.push_back(std::move(parcel));
+  }
+  return c;
 }
 
 }  // namespace
@@ -228,60 +287,27 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
     CPLFree(wkt);
   }
 
-  // Pass 2: project, repair, split into parts, normalise.
-  std::size_t done = 0;
-  for (Feature& f : features) {
-    if (++done % 2000 == 0) {
-      reportProgress(progress, 0.6 + 0.4 * static_cast<double>(done) / static_cast<double>(features.size()),
-                     "cleaning");
-    }
-    std::vector<std::unique_ptr<OGRPolygon>> polygons;
-    if (!detail::collectPolygons(*f.geometry, polygons) && polygons.empty()) {
-      ++report.nonPolygonal;
-      continue;
-    }
-    bool repaired = false;
-    for (auto& p : polygons) projectInPlace(*p, result.frame);
-    // Validity is judged on the whole feature so that wrongly nested parts of a
-    // multipolygon (a hole stored as a part) are repaired into holes.
-    std::unique_ptr<OGRGeometry> whole;
-    if (polygons.size() == 1) {
-      whole = std::move(polygons.front());
-    } else {
-      auto multi = std::make_unique<OGRMultiPolygon>();
-      for (auto& p : polygons) multi->addGeometryDirectly(p.release());
-      whole = std::move(multi);
-    }
-    polygons.clear();
-    if (!whole->IsValid()) {
-      std::unique_ptr<OGRGeometry> fixed(whole->MakeValid());
-      if (!fixed || fixed->IsEmpty()) {
-        ++report.invalidSkipped;
-        continue;
-      }
-      whole = std::move(fixed);
-      repaired = true;
-    }
-    detail::collectPolygons(*whole, polygons);
-    int part = 0;
-    for (auto& p : polygons) {
-      Parcel parcel;
-      parcel.shape = detail::fromOgr(*p);
-      if (!normalise(parcel.shape)) {
-        ++report.degenerateSkipped;
-        continue;
-      }
-      parcel.sourceFid = f.fid;
-      parcel.part = part++;
-      parcel.stackCount = f.stackCount;
-      parcel.repaired = repaired;
-      if (!parcel.shape.holes.empty()) ++report.withHoles;
-      result.parcels.push_back(std::move(parcel));
-    }
-    if (repaired) (part > 0 ? report.invalidRepaired : report.invalidSkipped)++;
-    if (part > 1) {
+  // Pass 2: project, repair, split into parts, normalise; features in parallel,
+  // merged in input order.
+  std::vector<Cleaned> cleaned(features.size());
+  parallelFor(
+      features.size(), [&](std::size_t k) { cleaned[k] = cleanFeature(features[k], result.frame); },
+      [&](std::size_t done) {
+        reportProgress(progress, 0.6 + 0.4 * static_cast<double>(done) / static_cast<double>(features.size()),
+                       "cleaning");
+      });
+  for (Cleaned& c : cleaned) {
+    report.nonPolygonal += c.nonPolygonal;
+    report.degenerateSkipped += c.degenerate;
+    if (c.repairFailed || (c.repaired && c.parcels.empty())) ++report.invalidSkipped;
+    if (c.repaired && !c.parcels.empty()) ++report.invalidRepaired;
+    if (c.parcels.size() > 1) {
       ++report.multipartFeatures;
-      report.partsFromMultipart += part;
+      report.partsFromMultipart += static_cast<std::int64_t>(c.parcels.size());
+    }
+    for (Parcel& p : c.parcels) {
+      if (!p.shape.holes.empty()) ++report.withHoles;
+      result.parcels.push_back(std::move(p));
     }
   }
   report.parcels = static_cast<std::int64_t>(result.parcels.size());

@@ -38,8 +38,8 @@ struct ParcelMetrics : ShapeMetrics {
 /// Why a parcel was judged to be a right-of-way (a street stored as a parcel).
 enum class RightOfWay : std::uint8_t {
   No = 0,
-  HolesHoldParcels,  ///< one of its holes contains another parcel (blocks inside a street net)
-  NetworkShape       ///< thin and branching: many neighbours, far wider MBR than its strip width
+  HolesHoldParcels,  ///< thin (MBR width >= 6 strip widths 2A/P) and its holes contain other parcels
+  NetworkShape       ///< thin (as above) and at least 10 neighbours
 };
 
 struct BlockStatistics {

@@ -29,7 +29,7 @@ struct CleaningReport {
   std::int64_t withHoles = 0;           ///< parcels that keep one or more holes
   std::int64_t invalidRepaired = 0;     ///< invalid polygons repaired by make-valid
   std::int64_t invalidSkipped = 0;      ///< invalid polygons make-valid could not save
-  std::int64_t degenerateSkipped = 0;   ///< parts of zero area or fewer than 3 vertices
+  std::int64_t degenerateSkipped = 0;   ///< parts under 0.001 m² or with fewer than 3 vertices
   std::int64_t duplicatesCollapsed = 0; ///< features dropped as exact copies of another
   std::int64_t duplicateStacks = 0;     ///< distinct geometries that had copies
   std::int64_t parcels = 0;             ///< parcels kept

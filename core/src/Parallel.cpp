@@ -1,0 +1,57 @@
+#include "parcelscope/core/Parallel.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace parcelscope {
+
+unsigned workerCount() { return std::max(1u, std::thread::hardware_concurrency()); }
+
+void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
+                 const std::function<void(std::size_t)>& tick) {
+  std::atomic<std::size_t> next{0}, done{0};
+  std::atomic<bool> stop{false};
+  std::exception_ptr error;
+  std::mutex errorMutex;
+  auto fail = [&](std::exception_ptr e) {
+    std::lock_guard<std::mutex> lock(errorMutex);
+    if (!error) error = e;
+    stop = true;
+  };
+  auto work = [&] {
+    for (std::size_t i; !stop && (i = next.fetch_add(1)) < n;) {
+      try {
+        body(i);
+      } catch (...) {
+        fail(std::current_exception());
+      }
+      done.fetch_add(1);
+    }
+  };
+  const unsigned threads = static_cast<unsigned>(std::min<std::size_t>(workerCount(), n));
+  const bool ticking = tick && threads > 1;
+  std::vector<std::thread> pool;
+  for (unsigned t = ticking ? 0 : 1; t < threads; ++t) pool.emplace_back(work);
+  if (ticking) {
+    // The calling thread reports progress while the workers run.
+    while (!stop && done.load() < n) {
+      try {
+        tick(done.load());
+      } catch (...) {
+        fail(std::current_exception());
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  } else {
+    work();
+  }
+  for (auto& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+}
+
+}  // namespace parcelscope
