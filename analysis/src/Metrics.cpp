@@ -24,11 +24,11 @@ double cornerAngleDeviation(const Ring& ring) {
     const double ax = cur.x - prev.x, ay = cur.y - prev.y;
     const double bx = next.x - cur.x, by = next.y - cur.y;
     if ((ax == 0 && ay == 0) || (bx == 0 && by == 0)) continue;
-    // Signed turn angle; for a counter-clockwise ring, interior = 180 - turn.
-    const double turn = std::atan2(ax * by - ay * bx, ax * bx + ay * by) * kDeg;
-    if (std::fabs(turn) <= kCornerTurnDegrees) continue;
-    const double interior = 180.0 - turn;
-    sum += std::fabs(interior - 90.0);
+    // Turn angle at the vertex; a right-angled corner turns by 90 degrees whether
+    // it is convex (interior 90) or reflex (interior 270).
+    const double turn = std::fabs(std::atan2(ax * by - ay * bx, ax * bx + ay * by)) * kDeg;
+    if (turn <= kCornerTurnDegrees) continue;
+    sum += std::fabs(turn - 90.0);
     ++corners;
   }
   return corners ? sum / corners : 0.0;

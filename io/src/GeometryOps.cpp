@@ -1,5 +1,7 @@
 #include "parcelscope/io/GeometryOps.h"
 
+#include <geos_c.h>
+
 #include <algorithm>
 #include <memory>
 
@@ -19,6 +21,22 @@ std::vector<Polygon> polygonsOf(const OGRGeometry& g) {
   }
   return out;
 }
+// GEOS buffer with mitred joins (OGR's Buffer only offers round joins).
+std::unique_ptr<OGRGeometry> mitreBuffer(const OGRGeometry& g, double distance) {
+  GEOSContextHandle_t ctx = OGRGeometry::createGEOSContext();
+  std::unique_ptr<OGRGeometry> out;
+  if (GEOSGeom in = g.exportToGEOS(ctx)) {
+    constexpr double kMitreLimit = 5.0;  // spikes sharper than ~23 degrees are bevelled
+    if (GEOSGeom b = GEOSBufferWithStyle_r(ctx, in, distance, 8, GEOSBUF_CAP_FLAT, GEOSBUF_JOIN_MITRE, kMitreLimit)) {
+      out.reset(OGRGeometryFactory::createFromGEOS(ctx, b));
+      GEOSGeom_destroy_r(ctx, b);
+    }
+    GEOSGeom_destroy_r(ctx, in);
+  }
+  OGRGeometry::freeGEOSContext(ctx);
+  return out;
+}
+
 }  // namespace
 
 std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, double closeDistance) {
@@ -26,23 +44,23 @@ std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, 
   if (polygons.empty()) return {};
   OGRMultiPolygon multi;
   for (const Polygon* p : polygons) multi.addGeometryDirectly(detail::toOgr(*p).release());
-  constexpr int kQuadSegments = 1;
   std::unique_ptr<OGRGeometry> result(multi.UnionCascaded());
   if (!result) result.reset(multi.Buffer(0.0));
   const bool simple = result && wkbFlatten(result->getGeometryType()) == wkbPolygon &&
                       result->toPolygon()->getNumInteriorRings() == 0;
   if (result && closeDistance > 0 && !simple) {
     // Gaps or holes: close them where narrower than the tolerance. Buffering
-    // out unions the parts; buffering back in restores the outline.
-    std::unique_ptr<OGRGeometry> grown(result->Buffer(0.5 * closeDistance, kQuadSegments));
-    if (grown) result.reset(grown->Buffer(-0.5 * closeDistance, kQuadSegments));
+    // out unions the parts; buffering back in restores the outline. Mitred
+    // joins give corners back exactly (round joins would cut them).
+    std::unique_ptr<OGRGeometry> grown(mitreBuffer(*result, 0.5 * closeDistance));
+    if (grown) result = mitreBuffer(*grown, -0.5 * closeDistance);
   }
   if (!result) throw geometryError("union of " + std::to_string(polygons.size()) + " parcels failed");
   if (closeDistance > 0 && !simple) {
     // The round joins of the closing leave runs of vertices a few millimetres
     // apart; drop them (the outline moves by at most a tenth of the tolerance).
-    std::unique_ptr<OGRGeometry> simple(result->SimplifyPreserveTopology(std::min(0.05, 0.1 * closeDistance)));
-    if (simple && simple->IsValid()) result = std::move(simple);
+    std::unique_ptr<OGRGeometry> simpler(result->SimplifyPreserveTopology(std::min(0.05, 0.1 * closeDistance)));
+    if (simpler && simpler->IsValid()) result = std::move(simpler);
   }
   // Parts smaller than half a tolerance square are artefacts of the closing.
   const double minArea = closeDistance > 0 ? 0.5 * closeDistance * closeDistance : 1e-6;

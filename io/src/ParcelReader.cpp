@@ -26,8 +26,15 @@ using detail::QuietErrors;
 // zero-area slivers, not parcels.
 constexpr double kMinPartArea = 1e-3;
 
+// GDAL's last message on one line (some span several, with a caret marker).
 std::string lastGdalMessage() {
-  std::string m = CPLGetLastErrorMsg();
+  std::string m, raw = CPLGetLastErrorMsg();
+  for (char c : raw) {
+    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+    if (c == ' ' && (m.empty() || m.back() == ' ')) continue;
+    m += c;
+  }
+  while (!m.empty() && m.back() == ' ') m.pop_back();
   return m.empty() ? "unknown GDAL error" : m;
 }
 

@@ -25,10 +25,11 @@ struct ShapeMetrics {
   /// rectangularity = area / MBR area, dimensionless, (0, 1]; 1 is a rectangle.
   /// As momepy.rectangularity (Dibble et al. 2019).
   double rectangularity = 1;
-  /// p_angle = mean over the corners of the outer ring of |interior angle - 90|,
-  /// degrees, [0, 180). Yang et al. 2013, section 6. A corner is a vertex where the
-  /// boundary turns by more than kCornerTurnDegrees; a ring without such corners
-  /// (a smooth curve) gets 0.
+  /// p_angle = mean over the corners of the outer ring of the deviation from a
+  /// right angle, | |turn| - 90 | where turn is the exterior (turning) angle, so
+  /// a convex 90-degree and a reflex 270-degree corner both count 0; degrees,
+  /// [0, 90). Yang et al. 2013, section 6. A corner is a vertex where the boundary
+  /// turns by more than kCornerTurnDegrees; a ring without corners gets 0.
   double pAngle = 0;
   /// p_area = MBR area / area, dimensionless, [1, inf). Yang et al. 2013, section 6
   /// (an "undesirable" parcel has p_angle > 15 or p_area > 1.2).

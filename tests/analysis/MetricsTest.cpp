@@ -1,0 +1,73 @@
+#include "parcelscope/analysis/Metrics.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "TestUtil.h"
+
+namespace parcelscope::analysis {
+namespace {
+
+using test::poly;
+using test::rect;
+
+TEST(Metrics, RectangleTwentyByTen) {
+  const ShapeMetrics m = shapeMetrics(rect(0, 0, 20, 10));
+  EXPECT_DOUBLE_EQ(m.area, 200);
+  EXPECT_DOUBLE_EQ(m.perimeter, 60);
+  EXPECT_NEAR(m.width, 10, 1e-12);
+  EXPECT_NEAR(m.length, 20, 1e-12);
+  EXPECT_NEAR(m.aspectRatio, 2, 1e-12);
+  EXPECT_NEAR(m.elongation, 0.5, 1e-12);
+  EXPECT_NEAR(m.rectangularity, 1, 1e-12);
+  EXPECT_NEAR(m.pAngle, 0, 1e-9);
+  EXPECT_NEAR(m.pArea, 1, 1e-12);
+}
+
+TEST(Metrics, LShapeHasRightAnglesButFillsThreeQuartersOfItsBox) {
+  // 10 x 10 square without its 5 x 5 top-right quarter; the reflex corner is a right angle too.
+  const ShapeMetrics m = shapeMetrics(poly({{0, 0}, {10, 0}, {10, 5}, {5, 5}, {5, 10}, {0, 10}}));
+  EXPECT_DOUBLE_EQ(m.area, 75);
+  EXPECT_DOUBLE_EQ(m.perimeter, 40);
+  EXPECT_NEAR(m.width, 10, 1e-9);
+  EXPECT_NEAR(m.rectangularity, 0.75, 1e-9);
+  EXPECT_NEAR(m.pArea, 4.0 / 3.0, 1e-9);
+  EXPECT_NEAR(m.pAngle, 0, 1e-9);
+}
+
+TEST(Metrics, EquilateralTriangleDeviatesThirtyDegrees) {
+  const double h = 10 * std::sqrt(3.0) / 2;
+  const ShapeMetrics m = shapeMetrics(poly({{0, 0}, {10, 0}, {5, h}}));
+  EXPECT_NEAR(m.area, 10 * h / 2, 1e-9);
+  EXPECT_NEAR(m.pAngle, 30, 1e-9);
+  // The minimum box of a triangle has a side on a triangle side: 10 x h.
+  EXPECT_NEAR(m.width, h, 1e-9);
+  EXPECT_NEAR(m.length, 10, 1e-9);
+  EXPECT_NEAR(m.rectangularity, 0.5, 1e-9);
+}
+
+TEST(Metrics, ParallelogramCornersDeviateThirtyDegrees) {
+  const double s = std::sqrt(3.0);
+  const ShapeMetrics m = shapeMetrics(poly({{0, 0}, {10, 0}, {10 + 5, 5 * s}, {5, 5 * s}}));
+  EXPECT_NEAR(m.pAngle, 30, 1e-9);
+  EXPECT_NEAR(m.area, 50 * s, 1e-9);
+}
+
+TEST(Metrics, CollinearVerticesAreNotCorners) {
+  const ShapeMetrics m = shapeMetrics(poly({{0, 0}, {5, 0.1}, {10, 0}, {10, 10}, {0, 10}}));
+  EXPECT_NEAR(m.pAngle, 0.0, 1.2);  // the 2.3-degree kink is below the corner threshold
+}
+
+TEST(Metrics, SharedBoundaryOfAdjacentAndNearlyAdjacentLots) {
+  const Polygon a = rect(0, 0, 10, 10);
+  EXPECT_NEAR(sharedBoundaryLength(a, rect(10, 0, 20, 10), 0.5), 10, 1e-9);
+  EXPECT_NEAR(sharedBoundaryLength(a, rect(10.3, 4, 20, 30), 0.5), 6, 1e-9);  // gap 0.3, overlap 4..10
+  EXPECT_NEAR(sharedBoundaryLength(a, rect(11, 0, 20, 10), 0.5), 0, 1e-12);  // gap wider than tolerance
+  EXPECT_NEAR(sharedBoundaryLength(a, rect(10, 10, 20, 20), 0.5), 0, 1e-12); // corner touch only
+  // A neighbour digitised with an extra vertex along the shared edge.
+  EXPECT_NEAR(sharedBoundaryLength(a, poly({{10, 0}, {20, 0}, {20, 10}, {10, 10}, {10, 5}}), 0.5), 10, 1e-9);
+}
+
+}  // namespace
+}  // namespace parcelscope::analysis

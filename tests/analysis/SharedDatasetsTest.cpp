@@ -1,0 +1,112 @@
+// Every shared real dataset reads and analyses with plausible counts. The
+// ranges come from ../shared/datasets/README.md and a look at the data; they
+// are wide enough for harmless changes and narrow enough to catch a reader
+// that drops, duplicates or merges parcels.
+#include <gtest/gtest.h>
+
+#include "TestUtil.h"
+#include "parcelscope/analysis/StatsJob.h"
+#include "parcelscope/core/Error.h"
+
+namespace parcelscope::analysis {
+namespace {
+
+struct Expect {
+  const char* file;
+  const char* crs;
+  std::int64_t minParcels, maxParcels, minBlocks, maxBlocks;
+  double minMedianArea, maxMedianArea;
+};
+
+void PrintTo(const Expect& e, std::ostream* os) { *os << e.file; }
+
+class SharedDataset : public ::testing::TestWithParam<Expect> {};
+
+double median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+TEST_P(SharedDataset, ReadsWithPlausibleParcelAndBlockCounts) {
+  PARCELSCOPE_REQUIRE_SHARED_DATASETS();
+  const Expect& e = GetParam();
+  io::ReadOptions in;
+  in.path = test::sharedDataset(e.file);
+  in.crsOverride = e.crs;
+  const ObservedData d = loadObserved(in, defaultValues(analysisParameters()));
+  const auto parcels = static_cast<std::int64_t>(d.layer.parcels.size());
+  const auto blocks = static_cast<std::int64_t>(d.analysis.blocks.size());
+  std::printf("%s: %lld parcels, %lld blocks, %lld right-of-way\n", e.file, static_cast<long long>(parcels),
+              static_cast<long long>(blocks), static_cast<long long>(d.analysis.rightOfWayCount));
+  EXPECT_GE(parcels, e.minParcels);
+  EXPECT_LE(parcels, e.maxParcels);
+  EXPECT_GE(blocks, e.minBlocks);
+  EXPECT_LE(blocks, e.maxBlocks);
+  std::vector<double> areas;
+  for (const auto& m : d.analysis.metrics) areas.push_back(m.area);
+  EXPECT_GE(median(areas), e.minMedianArea);
+  EXPECT_LE(median(areas), e.maxMedianArea);
+  // Every lot is in a block, every block's parcels sum to about its area.
+  for (std::size_t b = 0; b < d.analysis.blocks.size(); ++b) {
+    double sum = 0;
+    for (int i : d.analysis.blocks[b].parcels) sum += d.analysis.metrics[i].area;
+    EXPECT_GT(d.analysis.statistics[b].blockArea, 0.5 * sum) << "block " << b;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Datasets, SharedDataset,
+    ::testing::Values(
+        Expect{"cambridge_ma/ASSESSING_ParcelsFY2014.topojson", "", 13000, 13200, 650, 800, 200, 600},
+        Expect{"paris_18e/cadastre-75118-parcelles.json", "", 6800, 6830, 250, 450, 150, 350},
+        Expect{"malibu_ca/parcels.geojson", "", 7400, 7700, 60, 200, 1500, 5000},
+        Expect{"eatonville_wa/parcels.geojson", "EPSG:2286", 1250, 1350, 20, 300, 500, 10000},
+        Expect{"seoul_jamsil/parcels.geojson", "", 2300, 2400, 40, 200, 100, 2000},
+        Expect{"rhone_69114/parcelles.json", "", 5950, 6050, 80, 400, 200, 5000}),
+    [](const ::testing::TestParamInfo<Expect>& param) {
+      std::string n = param.param.file;
+      return n.substr(0, n.find('/'));
+    });
+
+TEST(SharedDatasets, EatonvilleWithoutCrsIsRefusedNamingCrsFlag) {
+  PARCELSCOPE_REQUIRE_SHARED_DATASETS();
+  io::ReadOptions in;
+  in.path = test::sharedDataset("eatonville_wa/parcels.geojson");
+  try {
+    loadObserved(in, defaultValues(analysisParameters()));
+    FAIL() << "eatonville_wa read as degrees";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--crs"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SharedDatasets, CambridgeStreetNetworkIsRightOfWay) {
+  PARCELSCOPE_REQUIRE_SHARED_DATASETS();
+  io::ReadOptions in;
+  in.path = test::sharedDataset("cambridge_ma/ASSESSING_ParcelsFY2014.topojson");
+  const auto params = defaultValues(analysisParameters());
+  const ObservedData d = loadObserved(in, params);
+  // The README: the road polygons join almost the whole city into one block.
+  std::size_t largest = 0;
+  for (const auto& b : d.analysis.blocks) largest = std::max(largest, b.parcels.size());
+  EXPECT_LT(largest, 500u);
+  EXPECT_EQ(d.layer.report.invalidRepaired, 35);
+  EXPECT_EQ(d.layer.report.nullOrEmpty, 1);
+  // The same data filtered by attribute gives about the same blocks.
+  in.where = "ML <> 'ROAD'";
+  const ObservedData f = loadObserved(in, params);
+  EXPECT_NEAR(static_cast<double>(f.analysis.blocks.size()), static_cast<double>(d.analysis.blocks.size()),
+              0.05 * static_cast<double>(d.analysis.blocks.size()));
+}
+
+TEST(SharedDatasets, MalibuCondominiumStacksCollapse) {
+  PARCELSCOPE_REQUIRE_SHARED_DATASETS();
+  io::ReadOptions in;
+  in.path = test::sharedDataset("malibu_ca/parcels.geojson");
+  const ObservedData d = loadObserved(in, defaultValues(analysisParameters()));
+  EXPECT_EQ(d.layer.report.duplicatesCollapsed, 1155);
+  EXPECT_EQ(d.layer.report.duplicateStacks, 102);
+}
+
+}  // namespace
+}  // namespace parcelscope::analysis

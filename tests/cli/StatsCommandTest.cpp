@@ -1,0 +1,105 @@
+// The command line as a user runs it: exit codes, one-line errors, and outputs
+// that appear whole or not at all.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "TestUtil.h"
+
+namespace parcelscope {
+namespace {
+
+namespace fs = std::filesystem;
+using test::TempDir;
+
+struct CliRun {
+  int code;
+  std::string output;  // stdout and stderr
+};
+
+CliRun run(const std::string& args) {
+  const std::string cmd = std::string("'") + PARCELSCOPE_CLI + "' " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  CliRun r{-1, ""};
+  if (!pipe) return r;
+  char buf[4096];
+  while (std::size_t n = fread(buf, 1, sizeof buf, pipe)) r.output.append(buf, n);
+  const int status = pclose(pipe);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+const std::string kSample = std::string(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_town.geojson";
+
+TEST(StatsCommand, WritesAllOutputsForTheBundledSample) {
+  TempDir dir;
+  const std::string out = dir.file("out");
+  const CliRun r = run("stats '" + kSample + "' --where \"use <> 'ROW'\" --out '" + out + "' --quiet");
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* f : {"parcels.csv", "blocks.csv", "blocks.gpkg", "run.json"}) {
+    EXPECT_TRUE(fs::exists(out + "/" + f)) << f;
+  }
+  std::ifstream blocks(out + "/blocks.csv");
+  std::string header, line;
+  std::getline(blocks, header);
+  EXPECT_EQ(header.rfind("block_id,parcel_count,block_area", 0), 0u) << header;
+  int rows = 0;
+  while (std::getline(blocks, line)) ++rows;
+  EXPECT_EQ(rows, 10);  // the sample town has ten blocks (datasets/README.md)
+  std::stringstream json;
+  json << std::ifstream(out + "/run.json").rdbuf();
+  for (const char* key : {"\"version\"", "\"duplicates_collapsed\": 3", "\"invalid_repaired\": 1",
+                          "\"null_or_empty_skipped\": 1", "\"block-tolerance\""}) {
+    EXPECT_NE(json.str().find(key), std::string::npos) << key << " in " << json.str();
+  }
+}
+
+TEST(StatsCommand, UsageErrorsExitTwo) {
+  EXPECT_EQ(run("").code, 2);
+  EXPECT_EQ(run("frobnicate").code, 2);
+  EXPECT_EQ(run("stats '" + kSample + "'").code, 2);  // no --out
+  const CliRun r = run("stats '" + kSample + "' --out /tmp/x --k -1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--k"), std::string::npos) << r.output;
+  EXPECT_EQ(run("stats --help").code, 0);
+}
+
+TEST(StatsCommand, BadInputFailsWithOneLineNamingTheFileAndLeavesNoOutput) {
+  TempDir dir;
+  const std::string out = dir.file("out");
+  const CliRun missing = run("stats '" + dir.file("nope.geojson") + "' --out '" + out + "' --quiet");
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.output.find("nope.geojson"), std::string::npos) << missing.output;
+  EXPECT_EQ(std::count(missing.output.begin(), missing.output.end(), '\n'), 1) << missing.output;
+  EXPECT_FALSE(fs::exists(out));
+  // Nothing else was left behind (no staging folder).
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 0);
+
+  const auto garbage = dir.write("bad.json", "{ nope");
+  const CliRun bad = run("stats '" + garbage + "' --out '" + out + "' --quiet");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.output.find("bad.json"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(out));
+
+  const CliRun crs = run("stats '" + kSample + "' --crs EPSG:99999999 --out '" + out + "' --quiet");
+  EXPECT_EQ(crs.code, 2) << crs.output;
+  EXPECT_NE(crs.output.find("EPSG:99999999"), std::string::npos) << crs.output;
+}
+
+TEST(StatsCommand, RefusesToWriteOverTheInput) {
+  TempDir dir;
+  const auto input = dir.file("parcels.csv");
+  fs::copy_file(kSample, input);
+  const auto before = fs::file_size(input);
+  // The input is named parcels.csv inside the output folder: it must not be replaced.
+  const CliRun r = run("stats '" + input + "' --out '" + dir.path().string() + "' --quiet");
+  EXPECT_NE(r.code, 0) << r.output;
+  EXPECT_EQ(fs::file_size(input), before);
+}
+
+}  // namespace
+}  // namespace parcelscope

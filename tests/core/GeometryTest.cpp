@@ -1,0 +1,99 @@
+#include "parcelscope/core/Geometry.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "TestUtil.h"
+
+namespace parcelscope {
+namespace {
+
+using test::poly;
+using test::rect;
+
+TEST(Geometry, AreaAndPerimeterOfRectangleWithHole) {
+  Polygon p = rect(0, 0, 20, 10);
+  p.holes.push_back({{5, 2}, {5, 4}, {7, 4}, {7, 2}});
+  EXPECT_DOUBLE_EQ(area(p), 200.0 - 4.0);
+  EXPECT_DOUBLE_EQ(perimeter(p), 60.0 + 8.0);
+}
+
+TEST(Geometry, NormaliseOrientsOuterCounterClockwiseAndHolesClockwise) {
+  Polygon p = poly({{0, 0}, {0, 10}, {10, 10}, {10, 0}, {0, 0}}, {{{2, 2}, {4, 2}, {4, 4}, {2, 4}}});
+  ASSERT_TRUE(normalise(p));
+  EXPECT_EQ(p.outer.size(), 4u);  // closing vertex dropped
+  EXPECT_GT(signedArea(p.outer), 0);
+  EXPECT_LT(signedArea(p.holes[0]), 0);
+}
+
+TEST(Geometry, NormaliseRejectsZeroAreaRing) {
+  Polygon p = poly({{0, 0}, {5, 0}, {10, 0}});
+  EXPECT_FALSE(normalise(p));
+}
+
+TEST(Geometry, MinimumAreaBoxOfRotatedRectangle) {
+  const double a = 0.3, c = std::cos(a), s = std::sin(a);
+  Ring r;
+  for (Point p : {Point{0, 0}, Point{40, 0}, Point{40, 10}, Point{0, 10}}) {
+    r.push_back({1000 + p.x * c - p.y * s, -500 + p.x * s + p.y * c});
+  }
+  const OrientedBox box = minimumAreaBox(r);
+  EXPECT_NEAR(box.length, 40, 1e-9);
+  EXPECT_NEAR(box.width, 10, 1e-9);
+  EXPECT_NEAR(std::fabs(box.u.x * c + box.u.y * s), 1.0, 1e-12);  // long axis along the rectangle
+  EXPECT_NEAR(box.center.x, 1000 + 20 * c - 5 * s, 1e-9);
+}
+
+TEST(Geometry, MinimumAreaBoxIsNoLargerThanAxisAlignedBoxOnRandomPolygons) {
+  std::mt19937 rng(7);
+  std::printf("seed 7\n");
+  std::uniform_real_distribution<double> u(-50, 50);
+  for (int k = 0; k < 200; ++k) {
+    Ring r;
+    for (int i = 0; i < 12; ++i) r.push_back({u(rng), u(rng)});
+    const OrientedBox box = minimumAreaBox(r);
+    const Box b = bounds(r);
+    EXPECT_LE(box.area(), b.width() * b.height() * (1 + 1e-12));
+    // Every vertex lies inside the box.
+    for (const Point& p : r) {
+      const double along = (p.x - box.center.x) * box.u.x + (p.y - box.center.y) * box.u.y;
+      const double across = -(p.x - box.center.x) * box.u.y + (p.y - box.center.y) * box.u.x;
+      EXPECT_LE(std::fabs(along), 0.5 * box.length + 1e-9);
+      EXPECT_LE(std::fabs(across), 0.5 * box.width + 1e-9);
+    }
+  }
+}
+
+TEST(Geometry, PointInPolygonRespectsHoles) {
+  Polygon p = rect(0, 0, 10, 10);
+  p.holes.push_back({{4, 4}, {4, 6}, {6, 6}, {6, 4}});
+  EXPECT_TRUE(pointInPolygon({1, 1}, p));
+  EXPECT_FALSE(pointInPolygon({5, 5}, p));
+  EXPECT_FALSE(pointInPolygon({11, 5}, p));
+}
+
+TEST(Geometry, InteriorPointOfConcaveShapeIsInside) {
+  // A U shape whose centroid falls in the notch.
+  Polygon u = poly({{0, 0}, {30, 0}, {30, 30}, {20, 30}, {20, 5}, {10, 5}, {10, 30}, {0, 30}});
+  ASSERT_TRUE(normalise(u));
+  EXPECT_FALSE(pointInPolygon(centroid(u), u));
+  EXPECT_TRUE(pointInPolygon(interiorPoint(u), u));
+}
+
+TEST(Geometry, WithinDistanceDetectsGapsAndContainment) {
+  const Polygon a = rect(0, 0, 10, 10);
+  EXPECT_TRUE(withinDistance(a, rect(10.5, 0, 20, 10), 1.0));
+  EXPECT_FALSE(withinDistance(a, rect(11.5, 0, 20, 10), 1.0));
+  EXPECT_TRUE(withinDistance(a, rect(3, 3, 4, 4), 0.1));  // inside
+  EXPECT_NEAR(boundaryDistance(a, rect(12, 0, 20, 10)), 2.0, 1e-12);
+}
+
+TEST(Geometry, ConvexHullDropsInteriorAndCollinearPoints) {
+  const Ring hull = convexHull({{0, 0}, {5, 0}, {10, 0}, {10, 10}, {0, 10}, {5, 5}});
+  EXPECT_EQ(hull.size(), 4u);
+  EXPECT_DOUBLE_EQ(signedArea(hull), 100.0);
+}
+
+}  // namespace
+}  // namespace parcelscope

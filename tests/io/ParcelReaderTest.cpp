@@ -1,0 +1,164 @@
+#include "parcelscope/io/ParcelReader.h"
+
+#include <gdal_priv.h>
+#include <gdal_utils.h>
+#include <gtest/gtest.h>
+
+#include <GeographicLib/Geodesic.hpp>
+#include <GeographicLib/PolygonArea.hpp>
+#include <cmath>
+
+#include "TestUtil.h"
+#include "io/Fixtures.h"
+#include "parcelscope/core/Error.h"
+
+namespace parcelscope::io {
+namespace {
+
+using test::TempDir;
+
+double totalArea(const ParcelLayer& l) {
+  double a = 0;
+  for (const auto& p : l.parcels) a += area(p.shape);
+  return a;
+}
+
+// Expects readParcels to throw an Error of `kind` whose one-line message holds every `part`.
+void expectError(const ReadOptions& options, Error::Kind kind, std::initializer_list<std::string> parts) {
+  try {
+    readParcels(options);
+    ADD_FAILURE() << "no error for " << options.path;
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), kind) << e.what();
+    const std::string m = e.what();
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    for (const auto& p : parts) EXPECT_NE(m.find(p), std::string::npos) << "'" << p << "' not in: " << m;
+  }
+}
+
+// Converts `source` to `format` with GDAL's own translator (as ogr2ogr would).
+std::string convert(const std::string& source, const std::string& target, const char* format) {
+  GDALAllRegister();
+  GDALDatasetH src = GDALOpenEx(source.c_str(), GDAL_OF_VECTOR, nullptr, nullptr, nullptr);
+  EXPECT_NE(src, nullptr);
+  const char* argv[] = {"-f", format, "-skipfailures", "-nlt", "PROMOTE_TO_MULTI", nullptr};
+  GDALVectorTranslateOptions* o = GDALVectorTranslateOptionsNew(const_cast<char**>(argv), nullptr);
+  int usageError = 0;
+  GDALDatasetH out = GDALVectorTranslate(target.c_str(), nullptr, 1, &src, o, &usageError);
+  EXPECT_NE(out, nullptr) << format;
+  GDALClose(out);
+  GDALVectorTranslateOptionsFree(o);
+  GDALClose(src);
+  return target;
+}
+
+TEST(ParcelReader, CleaningCountsEveryRepairSplitCollapseAndSkip) {
+  TempDir dir;
+  const auto path = dir.write("quirks.geojson", test::quirksGeoJson());
+  const ParcelLayer l = readParcels({path, "", "", ""});
+  const CleaningReport& r = l.report;
+  EXPECT_EQ(r.features, 7);
+  EXPECT_EQ(r.nullOrEmpty, 1);
+  EXPECT_EQ(r.nonPolygonal, 1);
+  EXPECT_EQ(r.duplicatesCollapsed, 1);
+  EXPECT_EQ(r.duplicateStacks, 1);
+  EXPECT_EQ(r.invalidRepaired, 1);  // the bow-tie, made valid as two triangles
+  EXPECT_EQ(r.multipartFeatures, 2);
+  EXPECT_EQ(r.partsFromMultipart, 4);
+  EXPECT_EQ(r.withHoles, 1);
+  EXPECT_EQ(r.parcels, 6);
+  ASSERT_EQ(l.parcels.size(), 6u);
+  EXPECT_EQ(l.parcels[0].stackCount, 2);
+  EXPECT_TRUE(l.crs.name.find("4326") != std::string::npos) << l.crs.name;
+  for (const auto& p : l.parcels) {
+    EXPECT_GT(signedArea(p.shape.outer), 0);
+    for (const auto& h : p.shape.holes) EXPECT_LT(signedArea(h), 0);
+  }
+}
+
+TEST(ParcelReader, ProjectedAreaMatchesGeodesicArea) {
+  TempDir dir;
+  const double lon = 2.35, lat = 48.85, d = 0.001;
+  const auto path = dir.write(
+      "sq.geojson", test::collection(test::feature(
+                        R"({"type":"Polygon","coordinates":[)" + test::squareRing(lon, lat, d) + "]}", 1)));
+  const ParcelLayer l = readParcels({path, "", "", ""});
+  GeographicLib::PolygonArea geodesic(GeographicLib::Geodesic::WGS84());
+  for (auto [x, y] : {std::pair{lon, lat}, {lon + d, lat}, {lon + d, lat + d}, {lon, lat + d}}) {
+    geodesic.AddPoint(y, x);
+  }
+  double perimeterM = 0, areaM2 = 0;
+  geodesic.Compute(false, true, perimeterM, areaM2);
+  EXPECT_NEAR(totalArea(l) / std::fabs(areaM2), 1.0, 1e-5);
+  // The frame is centred on the data, so coordinates are small.
+  EXPECT_LT(std::fabs(l.parcels[0].shape.outer[0].x), 100.0);
+}
+
+TEST(ParcelReader, ReadsEveryFormatWithTheSameParcels) {
+  TempDir dir;
+  const auto geojson = dir.write("quirks.geojson", test::quirksGeoJson());
+  const ParcelLayer reference = readParcels({geojson, "", "", ""});
+  for (auto [format, name] : {std::pair{"GPKG", "q.gpkg"}, {"ESRI Shapefile", "q.shp"}, {"FlatGeobuf", "q.fgb"}}) {
+    SCOPED_TRACE(format);
+    const auto path = convert(geojson, dir.file(name), format);
+    const ParcelLayer l = readParcels({path, "", "", ""});
+    EXPECT_EQ(l.parcels.size(), reference.parcels.size());
+    EXPECT_NEAR(totalArea(l), totalArea(reference), 1e-6 * totalArea(reference));
+  }
+  const auto topo = dir.write("t.topojson", R"({"type":"Topology",
+    "arcs":[[[2.35,48.85],[2.3501,48.85],[2.3501,48.8501],[2.35,48.8501],[2.35,48.85]],
+            [[2.3501,48.85],[2.3502,48.85],[2.3502,48.8501],[2.3501,48.8501],[2.3501,48.85]]],
+    "objects":{"parcels":{"type":"GeometryCollection","geometries":[
+      {"type":"Polygon","arcs":[[0]],"properties":{"id":1}},
+      {"type":"Polygon","arcs":[[1]],"properties":{"id":2}}]}}})");
+  const ParcelLayer t = readParcels({topo, "", "", ""});
+  EXPECT_EQ(t.parcels.size(), 2u);
+  EXPECT_TRUE(t.crs.assumedLonLat || t.crs.name.find("4326") != std::string::npos) << t.crs.name;
+  EXPECT_NEAR(totalArea(t), 2 * 0.0001 * 111195.0 * 0.0001 * 111195.0 * std::cos(48.85 * M_PI / 180), 2.0);
+}
+
+TEST(ParcelReader, WhereFilterAndLayerSelection) {
+  TempDir dir;
+  const auto path = dir.write("quirks.geojson", test::quirksGeoJson());
+  const ParcelLayer l = readParcels({path, "quirks", "use = 'lot'", ""});
+  EXPECT_EQ(l.report.features, 6);  // every feature but the null one has use = 'lot' (odd pid)
+  expectError({path, "nope", "", ""}, Error::Kind::Input, {path, "nope", "quirks"});
+  expectError({path, "", "use ===", ""}, Error::Kind::Input, {path, "--where"});
+}
+
+TEST(ParcelReader, RefusesMissingUnreadableAndPolygonFreeInput) {
+  TempDir dir;
+  expectError({dir.file("absent.geojson"), "", "", ""}, Error::Kind::Input, {"absent.geojson", "no such file"});
+  const auto garbage = dir.write("garbage.geojson", "this is not { json");
+  expectError({garbage, "", "", ""}, Error::Kind::Input, {"garbage.geojson", "not a vector format"});
+  const auto points = dir.write(
+      "points.geojson", test::collection(test::feature(R"({"type":"Point","coordinates":[2.35,48.85]})", 1)));
+  expectError({points, "", "", ""}, Error::Kind::Input, {"points.geojson", "no usable polygon"});
+}
+
+TEST(ParcelReader, RefusesLonLatClaimForCoordinatesThatCannotBeDegrees) {
+  TempDir dir;
+  // 100 x 100 US survey feet in Washington State Plane South, stored without a CRS.
+  const auto path = dir.write("feet.geojson", test::collection(test::feature(
+      R"({"type":"Polygon","coordinates":[[[1195000,565000],[1195100,565000],[1195100,565100],[1195000,565100],[1195000,565000]]]})",
+      1)));
+  expectError({path, "", "", ""}, Error::Kind::Input, {"feet.geojson", "cannot be degrees", "--crs"});
+  const ParcelLayer l = readParcels({path, "", "", "EPSG:2286"});
+  EXPECT_TRUE(l.crs.overridden);
+  EXPECT_NEAR(totalArea(l), 100 * 100 * 0.3048006096 * 0.3048006096, 1e-6);
+  expectError({path, "", "", "EPSG:99999999"}, Error::Kind::Usage, {"--crs", "EPSG:99999999"});
+}
+
+TEST(ParcelReader, RefusesProjectedCoordinatesWithoutCrs) {
+  TempDir dir;
+  const auto geojson = dir.write("feet.geojson", test::collection(test::feature(
+      R"({"type":"Polygon","coordinates":[[[1195000,565000],[1195100,565000],[1195100,565100],[1195000,565100],[1195000,565000]]]})",
+      1)));
+  // A shapefile without .prj declares no CRS at all.
+  const auto shp = convert(geojson, dir.file("feet.shp"), "ESRI Shapefile");
+  std::filesystem::remove(dir.file("feet.prj"));
+  expectError({shp, "", "", ""}, Error::Kind::Input, {"feet.shp", "declares no CRS", "--crs"});
+}
+
+}  // namespace
+}  // namespace parcelscope::io
