@@ -52,6 +52,14 @@ std::string convert(const std::string& source, const std::string& target, const 
   return target;
 }
 
+// 100 x 100 US survey feet in Washington State Plane South (EPSG:2286), stored
+// without a CRS, so GeoJSON readers take it for lon/lat.
+std::string feetGeoJson() {
+  return test::collection(test::feature(
+      R"({"type":"Polygon","coordinates":[[[1195000,565000],[1195100,565000],[1195100,565100],[1195000,565100],[1195000,565000]]]})",
+      1));
+}
+
 TEST(ParcelReader, CleaningCountsEveryRepairSplitCollapseAndSkip) {
   TempDir dir;
   const auto path = dir.write("quirks.geojson", test::quirksGeoJson());
@@ -138,10 +146,7 @@ TEST(ParcelReader, RefusesMissingUnreadableAndPolygonFreeInput) {
 
 TEST(ParcelReader, RefusesLonLatClaimForCoordinatesThatCannotBeDegrees) {
   TempDir dir;
-  // 100 x 100 US survey feet in Washington State Plane South, stored without a CRS.
-  const auto path = dir.write("feet.geojson", test::collection(test::feature(
-      R"({"type":"Polygon","coordinates":[[[1195000,565000],[1195100,565000],[1195100,565100],[1195000,565100],[1195000,565000]]]})",
-      1)));
+  const auto path = dir.write("feet.geojson", feetGeoJson());
   expectError({path, "", "", ""}, Error::Kind::Input, {"feet.geojson", "cannot be degrees", "--crs"});
   const ParcelLayer l = readParcels({path, "", "", "EPSG:2286"});
   EXPECT_TRUE(l.crs.overridden);
@@ -151,9 +156,7 @@ TEST(ParcelReader, RefusesLonLatClaimForCoordinatesThatCannotBeDegrees) {
 
 TEST(ParcelReader, RefusesProjectedCoordinatesWithoutCrs) {
   TempDir dir;
-  const auto geojson = dir.write("feet.geojson", test::collection(test::feature(
-      R"({"type":"Polygon","coordinates":[[[1195000,565000],[1195100,565000],[1195100,565100],[1195000,565100],[1195000,565000]]]})",
-      1)));
+  const auto geojson = dir.write("feet.geojson", feetGeoJson());
   // A shapefile without .prj declares no CRS at all.
   const auto shp = convert(geojson, dir.file("feet.shp"), "ESRI Shapefile");
   std::filesystem::remove(dir.file("feet.prj"));
