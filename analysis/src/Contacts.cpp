@@ -77,8 +77,8 @@ void sumCovers(std::vector<Cover>& covers, const std::vector<EdgeInfo>& edges, S
 bool coveredInterval(const Point& p, const Point& q, const Point& r, const Point& s, double tolerance,
                      double& lo, double& hi) {
   static const double sinMax = std::sin(10.0 * kPi / 180.0);
-  const double len = std::hypot(q.x - p.x, q.y - p.y);
-  const double l2 = std::hypot(s.x - r.x, s.y - r.y);
+  const double len = norm(q.x - p.x, q.y - p.y);
+  const double l2 = norm(s.x - r.x, s.y - r.y);
   if (len == 0 || l2 == 0) return false;
   const double ux = (q.x - p.x) / len, uy = (q.y - p.y) / len;
   const double vx = (s.x - r.x) / l2, vy = (s.y - r.y) / l2;

@@ -114,16 +114,18 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
   out.rightOfWay.assign(n, RightOfWay::No);
   out.blockOf.assign(n, -1);
 
+  out.timings.start("metrics");
   // 1. Shape metrics.
   std::vector<Box> boxes(n);
   std::vector<Point> inside(n);
-  for (std::size_t i = 0; i < n; ++i) {
+  parallelFor(n, [&](std::size_t i) {
     static_cast<ShapeMetrics&>(out.metrics[i]) = shapeMetrics(parcels[i].shape);
     boxes[i] = bounds(parcels[i].shape).expanded(0.5 * tol);
     inside[i] = interiorPoint(parcels[i].shape);
-  }
+  });
   reportProgress(progress, 0.1, "metrics");
 
+  out.timings.start("contacts");
   // 2. Shared boundaries (neighbours) and closeness, edge by edge.
   std::vector<const Polygon*> shapes(n);
   for (std::size_t i = 0; i < n; ++i) shapes[i] = &parcels[i].shape;
@@ -138,6 +140,7 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
   // Overlapping boxes find parcels lying inside others without touching them.
   const auto pairs = detail::intersectingPairs(boxes);
 
+  out.timings.start("right_of_way");
   // 3. Right-of-way parcels.
   if (options.detectRightOfWay) {
     // A street net stored as a parcel is a thin strip (its MBR is many strip
@@ -170,6 +173,7 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
   }
   for (auto r : out.rightOfWay) out.rightOfWayCount += r != RightOfWay::No;
 
+  out.timings.start("grouping");
   // 4. Blocks: connected groups of lots within the tolerance.
   DisjointSets sets(n);
   auto isLot = [&](int i) { return out.rightOfWay[i] == RightOfWay::No; };
@@ -197,6 +201,7 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
 
   // 5. Block outlines, frontage and statistics.
   const double frontTol = std::max(tol, 0.05);
+  out.timings.start("block_outlines");
   parallelFor(
       out.blocks.size(),
       [&](std::size_t b) {
@@ -208,6 +213,7 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
         reportProgress(progress, 0.5 + 0.4 * static_cast<double>(done) / static_cast<double>(out.blocks.size()),
                        "blocks");
       });
+  out.timings.start("frontage_and_statistics");
   for (std::size_t b = 0; b < out.blocks.size(); ++b) {
     Block& block = out.blocks[b];
     std::vector<const Polygon*> members;
@@ -237,6 +243,7 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
     out.statistics.push_back(s);
   }
   reportProgress(progress, 1.0, "blocks");
+  out.timings.stop();
   return out;
 }
 

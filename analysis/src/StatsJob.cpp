@@ -55,7 +55,11 @@ void addObservedRecord(Json& record, const ObservedData& data) {
                     .set("multipart_blocks", data.analysis.multipartBlocks)
                     .set("a_min_clamped", data.analysis.clampedAMin)
                     .set("w_min_clamped", data.analysis.clampedWMin);
-  record.set("input", input).set("counts", counts);
+  Json seconds = Json::object();
+  for (const auto* t : {&data.layer.timings, &data.analysis.timings}) {
+    for (const auto& [stage, s] : t->stages()) seconds.set(stage, s);
+  }
+  record.set("input", input).set("counts", counts).set("seconds", seconds);
 }
 
 Json runStats(const io::ReadOptions& input, const ParameterValues& parameters, const std::string& outDir,

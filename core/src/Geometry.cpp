@@ -31,7 +31,7 @@ double ringLength(const Ring& ring) {
   for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
     const Point& a = ring[i];
     const Point& b = ring[(i + 1) % n];
-    l += std::hypot(b.x - a.x, b.y - a.y);
+    l += norm(b.x - a.x, b.y - a.y);
   }
   return l;
 }
@@ -164,7 +164,7 @@ double pointSegmentDistance(const Point& p, const Point& a, const Point& b) {
   const double len2 = dx * dx + dy * dy;
   double t = len2 > 0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / len2 : 0.0;
   t = std::clamp(t, 0.0, 1.0);
-  return std::hypot(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
+  return norm(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
 }
 
 namespace {
@@ -224,6 +224,33 @@ bool withinDistance(const Polygon& a, const Polygon& b, double distance) {
   return pointInPolygon(b.outer[0], a) || pointInPolygon(a.outer[0], b);
 }
 
+bool isClearlySimple(const Ring& r) {
+  const std::size_t n = r.size();
+  if (n < 3 || n > 64) return false;
+  const Box b = bounds(r);
+  const double eps = 1e-9 * std::max(b.width(), b.height());
+  if (!(eps > 0) || std::fabs(signedArea(r)) <= eps * eps) return false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point& p = r[i];
+    const Point& q = r[(i + 1) % n];
+    const Point& s = r[(i + 2) % n];
+    if (norm(q.x - p.x, q.y - p.y) <= eps) return false;
+    // Fold-back: the next edge returns along this one.
+    const double cr = (q.x - p.x) * (s.y - q.y) - (q.y - p.y) * (s.x - q.x);
+    const double dot = (q.x - p.x) * (s.x - q.x) + (q.y - p.y) * (s.y - q.y);
+    if (dot < 0 && std::fabs(cr) <= eps * norm(q.x - p.x, q.y - p.y)) return false;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point& a = r[i];
+    const Point& a2 = r[(i + 1) % n];
+    for (std::size_t j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;  // adjacent through the closing vertex
+      if (segmentDistance(a, a2, r[j], r[(j + 1) % n]) <= eps) return false;
+    }
+  }
+  return true;
+}
+
 Ring convexHull(std::vector<Point> pts) {
   std::sort(pts.begin(), pts.end(),
             [](const Point& a, const Point& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
@@ -251,7 +278,7 @@ OrientedBox minimumAreaBox(const Ring& ring) {
   if (hull.size() < 3) {
     if (hull.size() == 2) {
       const double dx = hull[1].x - hull[0].x, dy = hull[1].y - hull[0].y;
-      const double l = std::hypot(dx, dy);
+      const double l = norm(dx, dy);
       best.center = {0.5 * (hull[0].x + hull[1].x), 0.5 * (hull[0].y + hull[1].y)};
       if (l > 0) best.u = {dx / l, dy / l};
       best.length = l;
@@ -265,7 +292,7 @@ OrientedBox minimumAreaBox(const Ring& ring) {
   for (std::size_t i = 0; i < n; ++i) {
     const Point& a = hull[i];
     const Point& b = hull[(i + 1) % n];
-    const double l = std::hypot(b.x - a.x, b.y - a.y);
+    const double l = norm(b.x - a.x, b.y - a.y);
     if (l == 0) continue;
     const Point e{(b.x - a.x) / l, (b.y - a.y) / l};
     const Point nrm{-e.y, e.x};

@@ -45,7 +45,7 @@ void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
       } catch (...) {
         fail(std::current_exception());
       }
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
   } else {
     work();

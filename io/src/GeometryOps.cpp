@@ -56,12 +56,6 @@ std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, 
     if (grown) result = mitreBuffer(*grown, -0.5 * closeDistance);
   }
   if (!result) throw geometryError("union of " + std::to_string(polygons.size()) + " parcels failed");
-  if (closeDistance > 0 && !simple) {
-    // The round joins of the closing leave runs of vertices a few millimetres
-    // apart; drop them (the outline moves by at most a tenth of the tolerance).
-    std::unique_ptr<OGRGeometry> simpler(result->SimplifyPreserveTopology(std::min(0.05, 0.1 * closeDistance)));
-    if (simpler && simpler->IsValid()) result = std::move(simpler);
-  }
   // Parts smaller than half a tolerance square are artefacts of the closing.
   const double minArea = closeDistance > 0 ? 0.5 * closeDistance * closeDistance : 1e-6;
   std::vector<Polygon> parts;

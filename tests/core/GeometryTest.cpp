@@ -97,3 +97,19 @@ TEST(Geometry, ConvexHullDropsInteriorAndCollinearPoints) {
 
 }  // namespace
 }  // namespace parcelscope
+
+namespace parcelscope {
+namespace {
+
+TEST(Geometry, ClearlySimpleAcceptsPlainRingsAndDefersDoubtfulOnes) {
+  EXPECT_TRUE(isClearlySimple(test::rect(0, 0, 10, 5).outer));
+  EXPECT_FALSE(isClearlySimple({{0, 0}, {10, 10}, {10, 0}, {0, 10}}));             // bow-tie
+  EXPECT_FALSE(isClearlySimple({{0, 0}, {10, 0}, {10, 10}, {5, 0}, {0, 10}}));      // touches itself
+  EXPECT_FALSE(isClearlySimple({{0, 0}, {10, 0}, {5, 0}, {5, 5}}));                 // folds back
+  Ring many;
+  for (int i = 0; i < 100; ++i) many.push_back({std::cos(i * 0.0628), std::sin(i * 0.0628)});
+  EXPECT_FALSE(isClearlySimple(many));  // too many vertices to check by brute force: GEOS decides
+}
+
+}  // namespace
+}  // namespace parcelscope

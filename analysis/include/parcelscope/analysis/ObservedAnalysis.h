@@ -9,6 +9,7 @@
 #include "parcelscope/core/Parcel.h"
 #include "parcelscope/core/Progress.h"
 #include "parcelscope/core/Table.h"
+#include "parcelscope/core/Timings.h"
 
 namespace parcelscope::analysis {
 
@@ -71,6 +72,7 @@ struct ObservedAnalysis {
   std::int64_t rightOfWayCount = 0;
   std::int64_t multipartBlocks = 0;      ///< blocks whose closed union has several parts
   std::int64_t clampedAMin = 0, clampedWMin = 0;
+  Timings timings;  ///< per analysis stage
 };
 
 /// Metrics, right-of-way detection, blocks and block statistics for `parcels`

@@ -31,6 +31,10 @@ struct Box {
   Box expanded(double d) const { return {minX - d, minY - d, maxX + d, maxY + d}; }
 };
 
+/// Length of the vector (dx, dy). Plain sqrt: local coordinates are small, and
+/// std::hypot's overflow care costs several times more on hot paths.
+inline double norm(double dx, double dy) { return __builtin_sqrt(dx * dx + dy * dy); }
+
 /// Signed area of a ring in m² (positive when counter-clockwise), shoelace formula.
 double signedArea(const Ring& ring);
 /// Area in m²: outer area minus hole areas.
@@ -66,6 +70,12 @@ double boundaryDistance(const Polygon& a, const Polygon& b);
 /// True when the boundaries of `a` and `b` come within `distance` m of each
 /// other, or one polygon lies inside the other. Stops at the first close pair.
 bool withinDistance(const Polygon& a, const Polygon& b, double distance);
+
+/// A fast, conservative validity test for one ring: true only when the ring
+/// clearly is simple (no edge comes within 1e-9 of the ring's size of a
+/// non-adjacent edge, no zero-length edge, no fold-back, non-zero area) and has
+/// at most 64 vertices. False means "not proven": ask GEOS.
+bool isClearlySimple(const Ring& ring);
 
 /// Convex hull of a point set, counter-clockwise, without collinear points.
 Ring convexHull(std::vector<Point> points);

@@ -9,6 +9,7 @@
 
 #include "parcelscope/core/Parcel.h"
 #include "parcelscope/core/Progress.h"
+#include "parcelscope/core/Timings.h"
 #include "parcelscope/io/LocalFrame.h"
 
 namespace parcelscope::io {
@@ -49,6 +50,7 @@ struct ParcelLayer {
   LocalFrame frame;
   CrsInfo crs;
   CleaningReport report;
+  Timings timings;  ///< "read" and "clean"
 };
 
 /// Reads, projects and cleans the polygons of one layer.
