@@ -37,17 +37,6 @@ void addEdges(const Polygon& polygon, int index, double grow, std::vector<EdgeIn
   for (const auto& h : polygon.holes) addRingEdges(h, index, grow, edges, boxes);
 }
 
-double cross(const Point& o, const Point& a, const Point& b) {
-  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
-}
-
-double segmentDistance(const Point& a, const Point& b, const Point& c, const Point& d) {
-  const double d1 = cross(c, d, a), d2 = cross(c, d, b), d3 = cross(a, b, c), d4 = cross(a, b, d);
-  if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) return 0.0;
-  return std::min(std::min(pointSegmentDistance(a, c, d), pointSegmentDistance(b, c, d)),
-                  std::min(pointSegmentDistance(c, a, b), pointSegmentDistance(d, a, b)));
-}
-
 // (edge of the measured polygon, other polygon, interval) records, grouped to
 // take the union of intervals per edge and polygon pair.
 struct Cover {

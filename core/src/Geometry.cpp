@@ -179,12 +179,15 @@ bool segmentsCross(const Point& a, const Point& b, const Point& c, const Point& 
          d4 != 0;
 }
 
+}  // namespace
+
 double segmentDistance(const Point& a, const Point& b, const Point& c, const Point& d) {
   if (segmentsCross(a, b, c, d)) return 0.0;
   return std::min(std::min(pointSegmentDistance(a, c, d), pointSegmentDistance(b, c, d)),
                   std::min(pointSegmentDistance(c, a, b), pointSegmentDistance(d, a, b)));
 }
 
+namespace {
 template <typename F>
 void forEachEdge(const Polygon& p, F&& f) {
   auto ring = [&](const Ring& r) {

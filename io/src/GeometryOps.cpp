@@ -71,14 +71,26 @@ bool isValid(const Polygon& polygon) {
 }
 
 double intersectionArea(const Polygon& a, const Polygon& b) {
+  // Snap-rounded overlay on a 1e-6 m grid: floating overlay (GEOS 3.11) can
+  // return a whole polygon as the intersection of two polygons whose shared
+  // edge differs in the last bits; snap rounding is fully robust.
+  constexpr double kGrid = 1e-6;
   detail::QuietErrors quiet;
-  auto ga = detail::toOgr(a);
-  auto gb = detail::toOgr(b);
-  std::unique_ptr<OGRGeometry> i(ga->Intersection(gb.get()));
-  if (!i) throw geometryError("intersection failed");
-  double total = 0;
-  for (const auto& p : polygonsOf(*i)) total += area(p);
-  return total;
+  GEOSContextHandle_t ctx = OGRGeometry::createGEOSContext();
+  double result = -1;
+  GEOSGeom ga = detail::toOgr(a)->exportToGEOS(ctx);
+  GEOSGeom gb = detail::toOgr(b)->exportToGEOS(ctx);
+  if (ga && gb) {
+    if (GEOSGeom i = GEOSIntersectionPrec_r(ctx, ga, gb, kGrid)) {
+      if (GEOSArea_r(ctx, i, &result) != 1) result = -1;
+      GEOSGeom_destroy_r(ctx, i);
+    }
+  }
+  if (ga) GEOSGeom_destroy_r(ctx, ga);
+  if (gb) GEOSGeom_destroy_r(ctx, gb);
+  OGRGeometry::freeGEOSContext(ctx);
+  if (result < 0) throw geometryError("intersection failed");
+  return result;
 }
 
 }  // namespace parcelscope::io

@@ -64,6 +64,8 @@ Point interiorPoint(const Polygon& polygon);
 
 /// Distance in m from point p to segment [a, b].
 double pointSegmentDistance(const Point& p, const Point& a, const Point& b);
+/// Distance in m between segments [a, b] and [c, d] (0 when they cross).
+double segmentDistance(const Point& a, const Point& b, const Point& c, const Point& d);
 /// Smallest distance in m between the boundaries of two polygons (0 if they cross).
 double boundaryDistance(const Polygon& a, const Polygon& b);
 

@@ -18,7 +18,9 @@ std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, 
 /// True when the polygon is valid in the OGC simple-features sense (GEOS IsValid).
 bool isValid(const Polygon& polygon);
 
-/// Area in m² of the intersection of two polygons (GEOS).
+/// Area in m² of the intersection of two polygons (GEOS, snap-rounded to a
+/// 1e-6 m grid, so the result is within about perimeter x 1e-6 m² of exact).
+/// Throws Error(Geometry) if GEOS fails.
 double intersectionArea(const Polygon& a, const Polygon& b);
 
 }  // namespace parcelscope::io

@@ -1,0 +1,59 @@
+#pragma once
+// OBB recursive subdivision of a block into parcels (Vanegas et al. 2012,
+// section 4.3 and Algorithm 2), with the paper's edge-aligned OBBs, child seeds
+// drawn before recursion and snapping to block contour vertices.
+//
+// Stopping rule (the paper's pseudocode is garbled; this one makes the bounds
+// mean what a user expects):
+//   - a parcel whose area is at most A_max and whose width (OBB short side) is
+//     at most W_max is final;
+//   - otherwise it is split, but only by a split all of whose pieces have
+//     area >= A_min and width >= W_min (and street access, see xi); several
+//     split lines are tried (the random one first); when none qualifies the
+//     parcel stays as it is and is counted as oversize.
+// So parcels never fall below A_min or W_min unless the block itself does, and
+// exceed A_max or W_max only where the geometry leaves no admissible split.
+#include <cstdint>
+#include <vector>
+
+#include "parcelscope/core/Geometry.h"
+#include "parcelscope/core/Parameter.h"
+
+namespace parcelscope::generation {
+
+struct ObbParameters {
+  double aMin = 200;         ///< m², smallest parcel area a split may create
+  double aMax = 800;         ///< m², parcels above this are split
+  double wMin = 8;           ///< m, smallest parcel width (OBB short side) a split may create
+  double wMax = 30;          ///< m, parcels wider than this are split
+  double omega = 0.3;        ///< split irregularity in [0, 1]: random shift of the split line
+  double xi = 1.0;           ///< street-access preference in [0, 1]
+  double snapDistance = 2.0; ///< m, split lines this close to a block contour vertex pass through it
+  double minFrontage = 1.0;  ///< m of block contour a parcel needs to count as having street access
+};
+
+/// The descriptions of every OBB parameter (CLI flags, GUI sliders, run record),
+/// including "seed".
+const std::vector<ParameterDescription>& obbParameterDescriptions();
+/// Parameters from values named as in obbParameterDescriptions(); missing names keep defaults.
+ObbParameters obbParametersFrom(const ParameterValues& values);
+
+struct Subdivision {
+  std::vector<Polygon> parcels;   ///< tile the block (normalised, local metres)
+  int oversize = 0;               ///< parcels above A_max or W_max with no admissible split
+  int withoutAccess = 0;          ///< parcels without street access
+  bool failed = false;            ///< the block could not be split (invalid for exact geometry); parcels = {block}
+  std::string failure;            ///< why, when failed
+};
+
+/// Subdivides one block (normalised polygon, holes allowed) into parcels.
+/// Deterministic: the same block, parameters and seed give the same parcels.
+/// Never throws on bad geometry: a block the exact kernel rejects comes back
+/// whole with failed = true.
+Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, std::uint64_t seed);
+
+/// Seed of block `blockId` in a run with seed `runSeed` (splitmix64 mix), so a
+/// block's parcels do not depend on the other blocks.
+std::uint64_t blockSeed(std::uint64_t runSeed, std::int64_t blockId);
+
+}  // namespace parcelscope::generation

@@ -1,0 +1,329 @@
+#include "parcelscope/generation/ObbSubdivision.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "PolygonSplit.h"
+#include "parcelscope/analysis/Metrics.h"
+#include "parcelscope/io/GeometryOps.h"
+
+namespace parcelscope::generation {
+
+const std::vector<ParameterDescription>& obbParameterDescriptions() {
+  static const std::vector<ParameterDescription> d = {
+      {"a-min", "Smallest parcel area a split may create", "m2", 0.0, 1e8, 200.0},
+      {"a-max", "Parcels larger than this are split", "m2", 0.0, 1e8, 800.0},
+      {"w-min", "Smallest parcel width (OBB short side) a split may create", "m", 0.0, 1e5, 8.0},
+      {"w-max", "Parcels wider than this are split", "m", 0.0, 1e5, 30.0},
+      {"omega", "Split irregularity: the split line moves up to omega x 1/4 of the parcel's length off centre",
+       "", 0.0, 1.0, 0.3},
+      {"xi", "Street-access preference: probability that a split leaving a parcel without street access is "
+             "replaced by one that does not",
+       "", 0.0, 1.0, 1.0},
+      {"snap", "Split lines passing this close to a block contour vertex are moved through it", "m", 0.0, 1000.0,
+       2.0},
+      {"min-frontage", "Block contour a parcel needs to count as having street access", "m", 0.0, 1000.0, 1.0},
+      {"seed", "Seed of the random choices; the same seed gives the same parcels", "", 0.0, 4294967295.0, 1.0,
+       true},
+  };
+  return d;
+}
+
+ObbParameters obbParametersFrom(const ParameterValues& v) {
+  ObbParameters p;
+  auto get = [&](const char* name, double& target) {
+    if (auto it = v.find(name); it != v.end()) target = it->second;
+  };
+  get("a-min", p.aMin);
+  get("a-max", p.aMax);
+  get("w-min", p.wMin);
+  get("w-max", p.wMax);
+  get("omega", p.omega);
+  get("xi", p.xi);
+  get("snap", p.snapDistance);
+  get("min-frontage", p.minFrontage);
+  return p;
+}
+
+namespace {
+
+std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
+// A tiny deterministic generator: the same seed gives the same sequence on
+// every platform (unlike the std distributions).
+struct Rng {
+  std::uint64_t state;
+  std::uint64_t next() { return state = splitmix64(state); }
+  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }  // [0, 1)
+};
+
+// The OBB of Vanegas et al.: the smallest box with a side along one of the
+// ring's own edges (edge-aligned, so small edits elsewhere do not turn it).
+OrientedBox edgeAlignedBox(const Ring& ring) {
+  const Ring hull = convexHull(ring);
+  OrientedBox best;
+  double bestArea = std::numeric_limits<double>::max();
+  for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
+    const Point& a = ring[i];
+    const Point& b = ring[(i + 1) % n];
+    const double l = norm(b.x - a.x, b.y - a.y);
+    if (l <= 0) continue;
+    const Point e{(b.x - a.x) / l, (b.y - a.y) / l};
+    double minE = std::numeric_limits<double>::max(), maxE = std::numeric_limits<double>::lowest();
+    double minN = minE, maxN = maxE;
+    for (const Point& p : hull) {
+      const double pe = p.x * e.x + p.y * e.y;
+      const double pn = -p.x * e.y + p.y * e.x;
+      minE = std::min(minE, pe);
+      maxE = std::max(maxE, pe);
+      minN = std::min(minN, pn);
+      maxN = std::max(maxN, pn);
+    }
+    const double w = maxE - minE, h = maxN - minN;
+    if (w * h < bestArea * (1 - 1e-9)) {
+      bestArea = w * h;
+      const double ce = 0.5 * (minE + maxE), cn = 0.5 * (minN + maxN);
+      best.center = {ce * e.x - cn * e.y, ce * e.y + cn * e.x};
+      if (w >= h) {
+        best.u = e;
+        best.length = w;
+        best.width = h;
+      } else {
+        best.u = {-e.y, e.x};
+        best.length = h;
+        best.width = w;
+      }
+    }
+  }
+  return best;
+}
+
+class Subdivider {
+public:
+  Subdivider(const Polygon& block, const ObbParameters& p, Subdivision& out)
+      : block_(block), outline_{block.outer, {}}, p_(p), out_(out) {
+    for (const Point& v : block.outer) contour_.push_back(v);
+    for (const Ring& h : block.holes) contour_.insert(contour_.end(), h.begin(), h.end());
+    const Box b = bounds(block);
+    accessTolerance_ = std::max(1e-6, 1e-9 * (b.width() + b.height()));
+  }
+
+  void run(std::uint64_t seed) { recurse(block_, seed, hasAccess(block_), 0); }
+
+private:
+  struct Candidate {
+    bool rotated;   // split line along the long axis instead of across it
+    double offset;  // shift of the pivot from the OBB centre (m)
+  };
+
+  bool hasAccess(const Polygon& piece) const {
+    return analysis::sharedBoundaryLength(piece, outline_, accessTolerance_) >= p_.minFrontage;
+  }
+
+  void emit(const Polygon& piece, bool access, bool oversize) {
+    out_.parcels.push_back(piece);
+    if (!access) ++out_.withoutAccess;
+    if (oversize) ++out_.oversize;
+  }
+
+  // Moves the pivot onto a block contour vertex within the snap distance of the line.
+  Point snap(const Point& pivot, const Point& dir, const Box& near) const {
+    if (p_.snapDistance <= 0) return pivot;
+    const Box zone = near.expanded(p_.snapDistance);
+    double best = p_.snapDistance;
+    Point snapped = pivot;
+    for (const Point& v : contour_) {
+      if (v.x < zone.minX || v.x > zone.maxX || v.y < zone.minY || v.y > zone.maxY) continue;
+      const double d = std::fabs((v.x - pivot.x) * dir.y - (v.y - pivot.y) * dir.x);  // |dir| = 1
+      if (d < best) {
+        best = d;
+        snapped = v;
+      }
+    }
+    return snapped;
+  }
+
+  // The pieces of `piece` cut by the line through `through` along `dir`, or
+  // nothing when the line misses, a piece is below A_min or W_min, or a piece
+  // is not a valid polygon once rounded to doubles.
+  std::vector<Polygon> admissibleSplit(const Polygon& piece, const Point& through, const Point& dir) const {
+    const detail::SplitPieces split = detail::splitByLine(piece, through, dir);
+    if (split.left.empty() || split.right.empty()) return {};
+    std::vector<Polygon> parts = split.left;
+    parts.insert(parts.end(), split.right.begin(), split.right.end());
+    for (const Polygon& part : parts) {
+      if (area(part) < p_.aMin || minimumAreaBox(part.outer).width < p_.wMin) return {};
+    }
+    for (const Polygon& part : parts) {
+      if (!cutIsClean(part, through, dir) || !io::isValid(part)) return {};
+    }
+    return parts;
+  }
+
+  // True when the edges a cut created (those on the cut line) keep a clear
+  // distance from every other edge of the piece and do not fold back. A cut
+  // that grazes a vertex or runs along an edge is exact, but its pieces would
+  // carry slivers that rounding to doubles can turn invalid.
+  static bool cutIsClean(const Polygon& part, const Point& through, const Point& dir) {
+    const Box b = bounds(part);
+    const double size = b.width() + b.height();
+    const double onLine = 1e-9 * size + 1e-12, clearance = 1e-6 * size;
+    auto offLine = [&](const Point& q) { return std::fabs((q.x - through.x) * dir.y - (q.y - through.y) * dir.x); };
+    std::vector<const Ring*> rings{&part.outer};
+    for (const Ring& h : part.holes) rings.push_back(&h);
+    for (std::size_t ri = 0; ri < rings.size(); ++ri) {
+      const Ring& r = *rings[ri];
+      for (std::size_t i = 0, n = r.size(); i < n; ++i) {
+        const Point& p = r[i];
+        const Point& q = r[(i + 1) % n];
+        if (offLine(p) > onLine || offLine(q) > onLine) continue;  // not a cut edge
+        for (std::size_t rj = 0; rj < rings.size(); ++rj) {
+          const Ring& t = *rings[rj];
+          for (std::size_t j = 0, m = t.size(); j < m; ++j) {
+            if (rj == ri && (j == i || j == (i + 1) % n || (j + 1) % m == i)) continue;  // itself, neighbours
+            if (segmentDistance(p, q, t[j], t[(j + 1) % m]) <= clearance) return false;
+          }
+        }
+        // Fold-back at either end: the neighbouring edge returns along the cut.
+        for (const auto& [x, y] : {std::pair<Point, Point>{r[(i + n - 1) % n], p}, {q, r[(i + 2) % n]}}) {
+          const Point e1{y.x - x.x, y.y - x.y}, e2{q.x - p.x, q.y - p.y};
+          const double cr = e1.x * e2.y - e1.y * e2.x, dot = e1.x * e2.x + e1.y * e2.y;
+          if (dot < 0 && std::fabs(cr) <= 1e-9 * norm(e1.x, e1.y) * norm(e2.x, e2.y)) return false;
+        }
+      }
+    }
+    return true;
+  }
+
+  void recurse(const Polygon& piece, std::uint64_t seed, bool access, int depth) {
+    const double a = area(piece);
+    const OrientedBox measured = minimumAreaBox(piece.outer);
+    const bool fits = a <= p_.aMax && measured.width <= p_.wMax;
+    if (fits || depth > 60) {
+      emit(piece, access, !fits);
+      return;
+    }
+    // Random choices and the children's seeds are drawn before any recursion.
+    Rng rng{seed};
+    const bool wantAccess = access && rng.uniform() < p_.xi;
+    const double shiftAcross = (2 * rng.uniform() - 1) * p_.omega;
+    const double shiftAlong = (2 * rng.uniform() - 1) * p_.omega;
+    const std::uint64_t childBase = rng.next();
+
+    const OrientedBox box = edgeAlignedBox(piece.outer);
+    const Point u = box.u, v{-box.u.y, box.u.x};
+    std::vector<Candidate> candidates = {{false, 0.25 * box.length * shiftAcross}};
+    bool accessTried = false;
+    auto addFallbacks = [&] {
+      for (double f : {0.0, 0.15, -0.15, 0.3, -0.3}) candidates.push_back({false, f * box.length});
+      for (double f : {0.25 * shiftAlong, 0.0, 0.15, -0.15, 0.3, -0.3}) candidates.push_back({true, f * box.width});
+    };
+    const Box near = bounds(piece);
+    for (std::size_t c = 0; c < candidates.size(); ++c) {
+      const Candidate cand = candidates[c];
+      const Point dir = cand.rotated ? u : v;
+      const Point shiftAxis = cand.rotated ? v : u;
+      const Point pivot{box.center.x + shiftAxis.x * cand.offset, box.center.y + shiftAxis.y * cand.offset};
+      // The snapped line first; if it makes an inadmissible split (for example a
+      // sliver along a contour edge parallel to it), the line as drawn.
+      std::vector<Polygon> parts;
+      bool admissible = false;
+      const Point snapped = snap(pivot, dir, near);
+      for (const Point& through : {snapped, pivot}) {
+        parts = admissibleSplit(piece, through, dir);
+        admissible = !parts.empty();
+        if (admissible || (through.x == pivot.x && through.y == pivot.y)) break;
+      }
+      std::vector<char> partAccess(parts.size(), 0);
+      bool allAccess = true;
+      if (admissible) {
+        for (std::size_t k = 0; k < parts.size(); ++k) {
+          partAccess[k] = hasAccess(parts[k]);
+          allAccess = allAccess && partAccess[k];
+        }
+      }
+      if (admissible && wantAccess && !allAccess) {
+        // Vanegas et al.: rotate the split line by 90 degrees (with probability xi).
+        if (!accessTried) {
+          accessTried = true;
+          candidates.insert(candidates.begin() + static_cast<long>(c) + 1, {true, 0.25 * box.width * shiftAlong});
+        }
+        admissible = false;
+      }
+      if (c == 0) addFallbacks();
+      if (!admissible) continue;
+      // Children in a fixed order (along the OBB axes) so seeds follow position.
+      std::vector<std::size_t> order(parts.size());
+      for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+      std::vector<Point> centres;
+      for (const Polygon& part : parts) centres.push_back(centroid(part));
+      std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+        const double px = centres[x].x * u.x + centres[x].y * u.y, py = centres[y].x * u.x + centres[y].y * u.y;
+        if (px != py) return px < py;
+        return centres[x].x * v.x + centres[x].y * v.y < centres[y].x * v.x + centres[y].y * v.y;
+      });
+      for (std::size_t k = 0; k < order.size(); ++k) {
+        recurse(parts[order[k]], splitmix64(childBase + k), partAccess[order[k]] != 0, depth + 1);
+      }
+      return;
+    }
+    emit(piece, access, true);
+  }
+
+  const Polygon& block_;
+  Polygon outline_;
+  ObbParameters p_;
+  Subdivision& out_;
+  std::vector<Point> contour_;
+  double accessTolerance_ = 1e-6;
+};
+
+}  // namespace
+
+std::uint64_t blockSeed(std::uint64_t runSeed, std::int64_t blockId) {
+  return splitmix64(splitmix64(runSeed) ^ static_cast<std::uint64_t>(blockId));
+}
+
+Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, std::uint64_t seed) {
+  Subdivision out;
+  ObbParameters p = parameters;
+  p.aMax = std::max(p.aMax, p.aMin);
+  p.wMax = std::max(p.wMax, p.wMin);
+  // Work near the origin: the exact kernel is faster, and areas are accurate.
+  const Box b = bounds(block);
+  const Point o{0.5 * (b.minX + b.maxX), 0.5 * (b.minY + b.maxY)};
+  auto shift = [](const Polygon& in, double dx, double dy) {
+    Polygon r = in;
+    for (Point& q : r.outer) q = {q.x + dx, q.y + dy};
+    for (Ring& h : r.holes)
+      for (Point& q : h) q = {q.x + dx, q.y + dy};
+    return r;
+  };
+  Polygon local = shift(block, -o.x, -o.y);
+  try {
+    if (!normalise(local) || !detail::isValidForSplit(local)) {
+      out.failed = true;
+      out.failure = "block is not a valid polygon with holes for exact splitting";
+    } else {
+      Subdivider(local, p, out).run(seed);
+    }
+  } catch (const std::exception& e) {
+    out = Subdivision{};
+    out.failed = true;
+    out.failure = e.what();
+  }
+  if (out.failed) {
+    out.parcels = {block};
+    return out;
+  }
+  for (Polygon& parcel : out.parcels) parcel = shift(parcel, o.x, o.y);
+  return out;
+}
+
+}  // namespace parcelscope::generation

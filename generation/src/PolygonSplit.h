@@ -1,0 +1,23 @@
+#pragma once
+// Exact splitting of a polygon with holes by a line (CGAL Boolean set
+// operations on the exact-constructions kernel). Pieces on the two sides share
+// their cut vertices exactly, so after rounding to doubles they still tile.
+#include <string>
+#include <vector>
+
+#include "parcelscope/core/Geometry.h"
+
+namespace parcelscope::generation::detail {
+
+/// True when CGAL accepts the polygon as a valid polygon with holes (simple
+/// rings, outer counter-clockwise, holes clockwise and inside, not crossing).
+bool isValidForSplit(const Polygon& polygon);
+
+/// Pieces of `polygon` left and right of the line through `pivot` with
+/// direction `dir` (non-zero). Every piece is normalised.
+struct SplitPieces {
+  std::vector<Polygon> left, right;
+};
+SplitPieces splitByLine(const Polygon& polygon, const Point& pivot, const Point& dir);
+
+}  // namespace parcelscope::generation::detail

@@ -1,0 +1,227 @@
+#include "parcelscope/generation/ObbSubdivision.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "TestUtil.h"
+#include "generation/TilingCheck.h"
+#include "parcelscope/analysis/Metrics.h"
+
+namespace parcelscope::generation {
+namespace {
+
+using test::poly;
+using test::rect;
+
+ObbParameters params(double aMin, double aMax, double wMin, double wMax, double omega = 0.3, double xi = 1.0) {
+  ObbParameters p;
+  p.aMin = aMin;
+  p.aMax = aMax;
+  p.wMin = wMin;
+  p.wMax = wMax;
+  p.omega = omega;
+  p.xi = xi;
+  return p;
+}
+
+TEST(ObbSubdivision, RectangleSplitsIntoParcelsWithinBounds) {
+  const Polygon block = rect(0, 0, 200, 60);
+  const Subdivision s = subdivideObb(block, params(300, 900, 8, 40), 42);
+  ASSERT_FALSE(s.failed) << s.failure;
+  EXPECT_TILES(block, s.parcels, "rectangle");
+  EXPECT_GE(s.parcels.size(), 14u);  // 12000 m2 / 900
+  for (const Polygon& p : s.parcels) {
+    EXPECT_GE(area(p), 300 - 1e-9);
+    EXPECT_LE(area(p), 900 + 1e-9);
+    const OrientedBox b = minimumAreaBox(p.outer);
+    EXPECT_GE(b.width, 8 - 1e-9);
+    EXPECT_LE(b.width, 40 + 1e-9);
+  }
+  EXPECT_EQ(s.oversize, 0);
+  EXPECT_EQ(s.withoutAccess, 0);
+}
+
+TEST(ObbSubdivision, SameSeedSameParcelsOtherSeedOtherParcels) {
+  const Polygon block = poly({{0, 0}, {180, -20}, {220, 90}, {30, 110}});
+  const auto p = params(200, 700, 6, 35, 0.8);
+  const Subdivision a = subdivideObb(block, p, 7), b = subdivideObb(block, p, 7), c = subdivideObb(block, p, 8);
+  ASSERT_EQ(a.parcels.size(), b.parcels.size());
+  for (std::size_t i = 0; i < a.parcels.size(); ++i) {
+    ASSERT_EQ(a.parcels[i].outer.size(), b.parcels[i].outer.size());
+    for (std::size_t k = 0; k < a.parcels[i].outer.size(); ++k) {
+      EXPECT_EQ(a.parcels[i].outer[k].x, b.parcels[i].outer[k].x);
+      EXPECT_EQ(a.parcels[i].outer[k].y, b.parcels[i].outer[k].y);
+    }
+  }
+  bool differs = a.parcels.size() != c.parcels.size();
+  for (std::size_t i = 0; !differs && i < a.parcels.size(); ++i) {
+    differs = a.parcels[i].outer[0].x != c.parcels[i].outer[0].x;
+  }
+  EXPECT_TRUE(differs);
+}
+
+TEST(ObbSubdivision, WithoutStreetAccessPreferenceInnerParcelsAppear) {
+  // A deep block: with xi = 0 some splits leave parcels without frontage; with xi = 1 none do.
+  const Polygon block = rect(0, 0, 150, 150);
+  int withoutAccess = 0;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    withoutAccess += subdivideObb(block, params(150, 500, 5, 30, 0.3, 0.0), seed).withoutAccess;
+    EXPECT_EQ(subdivideObb(block, params(150, 500, 5, 30, 0.3, 1.0), seed).withoutAccess, 0);
+  }
+  EXPECT_GT(withoutAccess, 0);
+}
+
+TEST(ObbSubdivision, BlockSmallerThanBoundsStaysWhole) {
+  const Polygon block = rect(0, 0, 10, 10);
+  const Subdivision s = subdivideObb(block, params(200, 800, 8, 30), 1);
+  ASSERT_EQ(s.parcels.size(), 1u);
+  EXPECT_DOUBLE_EQ(area(s.parcels[0]), 100);
+}
+
+TEST(ObbSubdivision, HolesAreKeptOutOfParcels) {
+  Polygon block = rect(0, 0, 120, 120);
+  block.holes.push_back({{40, 40}, {40, 80}, {80, 80}, {80, 40}});
+  normalise(block);
+  const Subdivision s = subdivideObb(block, params(200, 900, 8, 40), 3);
+  ASSERT_FALSE(s.failed) << s.failure;
+  EXPECT_TILES(block, s.parcels, "courtyard block");
+}
+
+TEST(ObbSubdivision, SelfIntersectingBlockComesBackWholeAndFlagged) {
+  const Polygon bowtie = poly({{0, 0}, {100, 100}, {100, 0}, {0, 100}});
+  const Subdivision s = subdivideObb(bowtie, params(100, 500, 5, 30), 1);
+  EXPECT_TRUE(s.failed);
+  EXPECT_EQ(s.parcels.size(), 1u);
+}
+
+TEST(ObbSubdivision, SplitSnapsToNearbyContourVertex) {
+  // A kink in the street line at x = 101 lies 1 m from the middle split at x = 100.
+  const Polygon block = poly({{0, 0}, {101, 0}, {200, 0}, {200, 40}, {0, 40}});
+  ObbParameters p = params(1000, 5000, 5, 45, 0.0);
+  p.snapDistance = 2.0;
+  const Subdivision s = subdivideObb(block, p, 1);
+  ASSERT_EQ(s.parcels.size(), 2u);
+  EXPECT_NEAR(std::max(area(s.parcels[0]), area(s.parcels[1])), 101 * 40, 1e-6);
+  p.snapDistance = 0.0;
+  const Subdivision t = subdivideObb(block, p, 1);
+  EXPECT_NEAR(std::min(area(t.parcels[0]), area(t.parcels[1])), 100 * 40, 1e-6);
+}
+
+// ---- Randomised shapes ------------------------------------------------------
+
+Polygon rotateShift(Polygon p, double angle, double dx, double dy) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  auto f = [&](Point q) { return Point{dx + q.x * c - q.y * s, dy + q.x * s + q.y * c}; };
+  for (Point& q : p.outer) q = f(q);
+  for (Ring& h : p.holes)
+    for (Point& q : h) q = f(q);
+  return p;
+}
+
+Polygon randomShape(std::mt19937_64& rng, int kind) {
+  std::uniform_real_distribution<double> u(0, 1);
+  const double w = 60 + 200 * u(rng), h = 40 + 120 * u(rng);
+  Polygon p;
+  switch (kind) {
+    case 0: {  // convex
+      std::vector<Point> pts;
+      for (int i = 0; i < 12; ++i) pts.push_back({w * u(rng), h * u(rng)});
+      p.outer = convexHull(pts);
+      break;
+    }
+    case 1: {  // star-shaped concave
+      const int n = 7 + static_cast<int>(u(rng) * 10);
+      for (int i = 0; i < n; ++i) {
+        const double a = 2 * M_PI * i / n, r = 0.5 + 0.5 * u(rng);
+        p.outer.push_back({w * r * std::cos(a), h * r * std::sin(a)});
+      }
+      break;
+    }
+    case 2: {  // L
+      const double a = w * (0.3 + 0.4 * u(rng)), b = h * (0.3 + 0.4 * u(rng));
+      p = poly({{0, 0}, {w, 0}, {w, b}, {a, b}, {a, h}, {0, h}});
+      break;
+    }
+    case 3: {  // U
+      const double t = w * (0.2 + 0.1 * u(rng)), b = h * (0.2 + 0.3 * u(rng));
+      p = poly({{0, 0}, {w, 0}, {w, h}, {w - t, h}, {w - t, b}, {t, b}, {t, h}, {0, h}});
+      break;
+    }
+    case 4: {  // comb
+      const int teeth = 3 + static_cast<int>(u(rng) * 3);
+      const double tw = w / (2 * teeth - 1), base = h * 0.3;
+      p.outer = {{0, 0}, {w, 0}};
+      for (int i = teeth - 1; i >= 0; --i) {
+        const double x0 = 2 * i * tw, x1 = x0 + tw;
+        p.outer.push_back({x1, base});
+        p.outer.push_back({x1, h});
+        p.outer.push_back({x0, h});
+        p.outer.push_back({x0, base});
+      }
+      p.outer.erase(p.outer.begin() + 2);  // (w, base) duplicates the last tooth's corner
+      p.outer.pop_back();                  // (0, base) lies on the first edge back to (0, 0)
+      break;
+    }
+    case 5: {  // holes
+      p = rect(0, 0, w, h);
+      p.holes.push_back({{0.2 * w, 0.3 * h}, {0.2 * w, 0.7 * h}, {0.45 * w, 0.7 * h}, {0.45 * w, 0.3 * h}});
+      if (u(rng) < 0.5) p.holes.push_back({{0.6 * w, 0.4 * h}, {0.6 * w, 0.6 * h}, {0.8 * w, 0.6 * h}, {0.8 * w, 0.4 * h}});
+      break;
+    }
+    default: {  // near-degenerate: a rectangle with micro-edges and almost collinear vertices
+      p.outer = {{0, 0}, {w * 0.5, 1e-7}, {w * 0.5 + 1e-6, 0}, {w, 0}, {w, h}, {w * 0.3, h + 1e-5}, {0, h}};
+      break;
+    }
+  }
+  normalise(p);
+  // Random orientation; every fifth shape far from the origin.
+  const double far = (kind + static_cast<int>(u(rng) * 5)) % 5 == 0 ? 3e6 : 0.0;
+  return rotateShift(p, 2 * M_PI * u(rng), far + 500 * u(rng), far - 500 * u(rng));
+}
+
+TEST(ObbSubdivision, RandomShapesAreTiledValidlyAndReproducibly) {
+  const std::uint64_t seed = 20261121;
+  std::printf("random shapes seed %llu\n", static_cast<unsigned long long>(seed));
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  int shapes = 0, parcels = 0, accessExceptions = 0;
+  for (int i = 0; i < 1400; ++i) {
+    const int kind = i % 7;
+    const Polygon block = randomShape(rng, kind);
+    const double a = area(block);
+    ObbParameters p;
+    p.aMax = a / (3 + 20 * u(rng));
+    p.aMin = p.aMax * (0.15 + 0.3 * u(rng));
+    p.wMin = std::sqrt(p.aMin) * 0.3;
+    p.wMax = std::sqrt(p.aMax) * (1.0 + u(rng));
+    p.omega = u(rng);
+    p.xi = i % 3 == 0 ? 1.0 : u(rng);
+    const std::uint64_t s = rng();
+    const Subdivision sub = subdivideObb(block, p, s);
+    const std::string what = "shape " + std::to_string(i) + " kind " + std::to_string(kind);
+    ASSERT_FALSE(sub.failed) << what << ": " << sub.failure;
+    EXPECT_TILES(block, sub.parcels, what);
+    for (const Polygon& q : sub.parcels) {
+      if (sub.parcels.size() > 1) {
+        EXPECT_GE(area(q), p.aMin * (1 - 1e-9)) << what;
+      }
+    }
+    if (p.xi == 1.0) accessExceptions += sub.withoutAccess;
+    if (i % 50 == 0) {  // reproducible from the seed
+      const Subdivision again = subdivideObb(block, p, s);
+      ASSERT_EQ(again.parcels.size(), sub.parcels.size()) << what;
+      for (std::size_t k = 0; k < sub.parcels.size(); ++k) {
+        EXPECT_EQ(area(again.parcels[k]), area(sub.parcels[k])) << what;
+      }
+    }
+    ++shapes;
+    parcels += static_cast<int>(sub.parcels.size());
+  }
+  std::printf("%d shapes, %d parcels, %d without street access at xi = 1\n", shapes, parcels, accessExceptions);
+  EXPECT_EQ(accessExceptions, 0);
+}
+
+}  // namespace
+}  // namespace parcelscope::generation
