@@ -43,6 +43,7 @@ Args::Args(const std::vector<std::string>& args, const std::vector<FlagSpec>& fl
       if (val.empty() || *end != '\0') throw usageError("--" + name + " " + val + " is not a number");
       checkValue(*param, v);
       parameters_[name] = v;
+      given_.insert(name);
     } else {
       values_[name] = val;
     }

@@ -3,6 +3,7 @@
 // come from their ParameterDescription, so the CLI cannot drift from the GUI.
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -28,11 +29,14 @@ public:
   bool has(const std::string& flag) const { return values_.count(flag) > 0; }
   /// Defaults overridden by the user's values.
   const ParameterValues& parameters() const { return parameters_; }
+  /// Whether the user gave parameter `name` (as opposed to its default).
+  bool given(const std::string& name) const { return given_.count(name) > 0; }
 
 private:
   std::vector<std::string> positional_;
   std::map<std::string, std::string> values_;
   ParameterValues parameters_;
+  std::set<std::string> given_;
 };
 
 /// Help text listing flags and parameters (name, unit, range, default, help).

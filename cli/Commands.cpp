@@ -5,6 +5,7 @@
 #include "Args.h"
 #include "TermProgress.h"
 #include "parcelscope/analysis/StatsJob.h"
+#include "parcelscope/generation/GenerateJob.h"
 #include "parcelscope/core/Error.h"
 
 namespace parcelscope::cli {
@@ -18,6 +19,7 @@ const char* kOverview =
     "commands:\n"
     "  stats     read observed parcels, build blocks, write per-parcel metrics,\n"
     "            per-block statistics and generator parameters\n"
+    "  generate  subdivide blocks into procedural parcels (OBB style)\n"
     "  version   print the version\n"
     "\n"
     "'parcelscope COMMAND --help' describes a command's options.\n";
@@ -47,7 +49,8 @@ int dispatch(const std::vector<std::string>& args) {
     return 0;
   }
   if (args[0] == "stats") return statsCommand(rest);
-  throw usageError("unknown command '" + args[0] + "' (commands: stats, version)");
+  if (args[0] == "generate") return generateCommand(rest);
+  throw usageError("unknown command '" + args[0] + "' (commands: stats, generate, version)");
 }
 
 int statsCommand(const std::vector<std::string>& args) {
@@ -70,6 +73,50 @@ int statsCommand(const std::vector<std::string>& args) {
   input.crsOverride = a.value("crs").value_or("");
   const bool quiet = a.has("quiet");
   const Json run = analysis::runStats(input, a.parameters(), *a.value("out"), terminalProgress(quiet));
+  if (!quiet) std::fprintf(stderr, "%s\nwritten to %s\n", run.dump().c_str(), a.value("out")->c_str());
+  return 0;
+}
+
+int generateCommand(const std::vector<std::string>& args) {
+  auto flags = inputFlags();
+  flags.push_back({"style", "subdivision style: obb (Vanegas et al. 2012, 4.3)"});
+  flags.push_back({"from-parcels", "INPUT holds observed parcels: build blocks and per-block bounds as 'stats' does",
+                   false});
+  flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
+  flags.push_back({"quiet", "no progress or summary on stderr", false});
+  // One list of parameters; a name shared by both (min-frontage) appears once.
+  std::vector<ParameterDescription> params = generation::obbParameterDescriptions();
+  for (const auto& d : analysis::analysisParameters()) {
+    bool seen = false;
+    for (const auto& p : params) seen = seen || p.name == d.name;
+    if (!seen) params.push_back(d);
+  }
+  if (wantsHelp(args)) {
+    std::fputs(usageText("parcelscope generate INPUT --style obb [options] [--seed N] --out DIR", flags, params)
+                   .c_str(),
+               stdout);
+    std::fputs("\nINPUT holds block polygons (e.g. blocks.gpkg from 'parcelscope stats', whose a_min, a_max,\n"
+               "w_min and w_max fields are used per block unless given here), or observed parcels with\n"
+               "--from-parcels. Writes DIR/parcels.gpkg, DIR/parcels.csv and DIR/run.json.\n",
+               stdout);
+    return 0;
+  }
+  const Args a(args, flags, params);
+  if (a.positional().size() != 1) throw usageError("expected exactly one INPUT file");
+  if (!a.value("out")) throw usageError("--out DIR is required");
+  generation::GenerateRequest request;
+  request.input.path = a.positional()[0];
+  request.input.layer = a.value("layer").value_or("");
+  request.input.where = a.value("where").value_or("");
+  request.input.crsOverride = a.value("crs").value_or("");
+  request.fromParcels = a.has("from-parcels");
+  request.style = a.value("style").value_or("obb");
+  request.parameters = a.parameters();
+  for (const auto& p : params) {
+    if (a.given(p.name)) request.explicitParameters.insert(p.name);
+  }
+  const bool quiet = a.has("quiet");
+  const Json run = generation::runGenerate(request, *a.value("out"), terminalProgress(quiet));
   if (!quiet) std::fprintf(stderr, "%s\nwritten to %s\n", run.dump().c_str(), a.value("out")->c_str());
   return 0;
 }

@@ -8,5 +8,6 @@ namespace parcelscope::cli {
 int dispatch(const std::vector<std::string>& args);
 
 int statsCommand(const std::vector<std::string>& args);
+int generateCommand(const std::vector<std::string>& args);
 
 }  // namespace parcelscope::cli

@@ -247,28 +247,66 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
   return out;
 }
 
+std::vector<ParcelMetrics> measureParcels(const std::vector<Polygon>& shapes, const std::vector<Block>& blocks,
+                                          double tolerance, double minFrontage) {
+  std::vector<ParcelMetrics> metrics(shapes.size());
+  parallelFor(shapes.size(), [&](std::size_t i) {
+    static_cast<ShapeMetrics&>(metrics[i]) = shapeMetrics(shapes[i]);
+  });
+  std::vector<const Polygon*> all;
+  for (const Polygon& s : shapes) all.push_back(&s);
+  for (const auto& c : detail::contacts(all, std::max(tolerance, 1e-6))) {
+    if (c.shared >= kMinSharedBoundary) {
+      ++metrics[c.a].neighbours;
+      ++metrics[c.b].neighbours;
+    }
+  }
+  for (const Block& block : blocks) {
+    std::vector<const Polygon*> members;
+    for (int i : block.parcels) members.push_back(&shapes[i]);
+    std::vector<Ring> outline;
+    for (const Polygon& part : block.parts) outline.push_back(part.outer);
+    const auto frontage = detail::lengthAlong(members, outline, std::max(tolerance, 0.05));
+    for (std::size_t k = 0; k < block.parcels.size(); ++k) {
+      ParcelMetrics& m = metrics[block.parcels[k]];
+      m.frontage = frontage[k];
+      m.streetAccess = m.frontage >= minFrontage;
+    }
+  }
+  return metrics;
+}
+
+std::vector<Column> metricColumns() {
+  using T = Column::Type;
+  return {{"area", T::Real, "m2"},           {"perimeter", T::Real, "m"},     {"width", T::Real, "m"},
+          {"length", T::Real, "m"},          {"aspect_ratio", T::Real, ""},   {"elongation", T::Real, ""},
+          {"rectangularity", T::Real, ""},   {"p_angle", T::Real, "deg"},     {"p_area", T::Real, ""},
+          {"neighbours", T::Integer, ""},    {"frontage", T::Real, "m"},      {"street_access", T::Integer, ""}};
+}
+
+std::vector<Value> metricValues(const ParcelMetrics& m) {
+  return {m.area,         m.perimeter,    m.width, m.length, m.aspectRatio, m.elongation, m.rectangularity,
+          m.pAngle,       m.pArea,        std::int64_t(m.neighbours), m.frontage, std::int64_t(m.streetAccess)};
+}
+
 Table parcelTable(const std::vector<Parcel>& parcels, const ObservedAnalysis& a) {
   using T = Column::Type;
   Table t;
-  t.columns = {{"parcel_id", T::Integer, ""},     {"source_fid", T::Integer, ""},
-               {"part", T::Integer, ""},          {"block_id", T::Integer, ""},
-               {"role", T::String, ""},           {"stack_count", T::Integer, ""},
-               {"repaired", T::Integer, ""},      {"area", T::Real, "m2"},
-               {"perimeter", T::Real, "m"},       {"width", T::Real, "m"},
-               {"length", T::Real, "m"},          {"aspect_ratio", T::Real, ""},
-               {"elongation", T::Real, ""},       {"rectangularity", T::Real, ""},
-               {"p_angle", T::Real, "deg"},       {"p_area", T::Real, ""},
-               {"neighbours", T::Integer, ""},    {"frontage", T::Real, "m"},
-               {"street_access", T::Integer, ""}};
+  t.columns = {{"parcel_id", T::Integer, ""}, {"source_fid", T::Integer, ""}, {"part", T::Integer, ""},
+               {"block_id", T::Integer, ""},  {"role", T::String, ""},        {"stack_count", T::Integer, ""},
+               {"repaired", T::Integer, ""}};
+  for (Column& c : metricColumns()) t.columns.push_back(std::move(c));
   static const char* roles[] = {"lot", "right_of_way_holes", "right_of_way_network"};
   for (std::size_t i = 0; i < parcels.size(); ++i) {
-    const ParcelMetrics& m = a.metrics[i];
-    t.rows.push_back({std::int64_t(i), std::int64_t(parcels[i].sourceFid), std::int64_t(parcels[i].part),
-                      std::int64_t(a.blockOf[i]), std::string(roles[static_cast<int>(a.rightOfWay[i])]),
-                      std::int64_t(parcels[i].stackCount), std::int64_t(parcels[i].repaired), m.area,
-                      m.perimeter, m.width, m.length, m.aspectRatio, m.elongation, m.rectangularity,
-                      m.pAngle, m.pArea, std::int64_t(m.neighbours), m.frontage,
-                      std::int64_t(m.streetAccess)});
+    std::vector<Value> row = {std::int64_t(i),
+                              std::int64_t(parcels[i].sourceFid),
+                              std::int64_t(parcels[i].part),
+                              std::int64_t(a.blockOf[i]),
+                              std::string(roles[static_cast<int>(a.rightOfWay[i])]),
+                              std::int64_t(parcels[i].stackCount),
+                              std::int64_t(parcels[i].repaired)};
+    for (Value& v : metricValues(a.metrics[i])) row.push_back(std::move(v));
+    t.rows.push_back(std::move(row));
   }
   return t;
 }

@@ -56,6 +56,7 @@ struct Feature {
   std::int64_t fid = -1;
   std::unique_ptr<OGRGeometry> geometry;
   int stackCount = 1;
+  std::vector<double> values;  // ReadOptions::numericFields
 };
 
 struct Envelope {
@@ -262,6 +263,11 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
     result.crs.overridden = true;
   }
 
+  std::vector<int> fieldIndex;
+  for (const auto& name : options.numericFields) {
+    fieldIndex.push_back(layer->GetLayerDefn()->GetFieldIndex(name.c_str()));
+  }
+
   // Pass 1: read features, collapse exact duplicate geometries, find the extent.
   const GIntBig total = layer->GetFeatureCount(FALSE);
   std::vector<Feature> features;
@@ -292,7 +298,13 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
     OGREnvelope e;
     g->getEnvelope(&e);
     env.merge(e);
-    features.push_back({feature->GetFID(), std::unique_ptr<OGRGeometry>(feature->StealGeometry()), 1});
+    std::vector<double> values;
+    for (int idx : fieldIndex) {
+      values.push_back(idx >= 0 && feature->IsFieldSetAndNotNull(idx) ? feature->GetFieldAsDouble(idx)
+                                                                    : std::numeric_limits<double>::quiet_NaN());
+    }
+    features.push_back(
+        {feature->GetFID(), std::unique_ptr<OGRGeometry>(feature->StealGeometry()), 1, std::move(values)});
   }
   if (CPLGetLastErrorType() == CE_Failure && report.features == 0) {
     throw inputError(path + ": reading layer " + result.layerName + " failed (" + lastGdalMessage() + ")");
@@ -321,7 +333,11 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
         reportProgress(progress, 0.6 + 0.4 * static_cast<double>(done) / static_cast<double>(features.size()),
                        "cleaning");
       });
-  for (Cleaned& c : cleaned) {
+  for (std::size_t k = 0; k < cleaned.size(); ++k) {
+    Cleaned& c = cleaned[k];
+    if (!options.numericFields.empty()) {
+      result.fields.insert(result.fields.end(), c.parcels.size(), features[k].values);
+    }
     report.nonPolygonal += c.nonPolygonal;
     report.degenerateSkipped += c.degenerate;
     if (c.repairFailed || (c.repaired && c.parcels.empty())) ++report.invalidSkipped;

@@ -17,6 +17,15 @@ namespace {
 
 using test::TempDir;
 
+ReadOptions options(std::string path, std::string layer = "", std::string where = "", std::string crs = "") {
+  ReadOptions o;
+  o.path = std::move(path);
+  o.layer = std::move(layer);
+  o.where = std::move(where);
+  o.crsOverride = std::move(crs);
+  return o;
+}
+
 double totalArea(const ParcelLayer& l) {
   double a = 0;
   for (const auto& p : l.parcels) a += area(p.shape);
@@ -63,7 +72,7 @@ std::string feetGeoJson() {
 TEST(ParcelReader, CleaningCountsEveryRepairSplitCollapseAndSkip) {
   TempDir dir;
   const auto path = dir.write("quirks.geojson", test::quirksGeoJson());
-  const ParcelLayer l = readParcels({path, "", "", ""});
+  const ParcelLayer l = readParcels(options(path, "", "", ""));
   const CleaningReport& r = l.report;
   EXPECT_EQ(r.features, 7);
   EXPECT_EQ(r.nullOrEmpty, 1);
@@ -90,7 +99,7 @@ TEST(ParcelReader, ProjectedAreaMatchesGeodesicArea) {
   const auto path = dir.write(
       "sq.geojson", test::collection(test::feature(
                         R"({"type":"Polygon","coordinates":[)" + test::squareRing(lon, lat, d) + "]}", 1)));
-  const ParcelLayer l = readParcels({path, "", "", ""});
+  const ParcelLayer l = readParcels(options(path, "", "", ""));
   GeographicLib::PolygonArea geodesic(GeographicLib::Geodesic::WGS84());
   for (auto [x, y] : {std::pair{lon, lat}, {lon + d, lat}, {lon + d, lat + d}, {lon, lat + d}}) {
     geodesic.AddPoint(y, x);
@@ -105,11 +114,11 @@ TEST(ParcelReader, ProjectedAreaMatchesGeodesicArea) {
 TEST(ParcelReader, ReadsEveryFormatWithTheSameParcels) {
   TempDir dir;
   const auto geojson = dir.write("quirks.geojson", test::quirksGeoJson());
-  const ParcelLayer reference = readParcels({geojson, "", "", ""});
+  const ParcelLayer reference = readParcels(options(geojson, "", "", ""));
   for (auto [format, name] : {std::pair{"GPKG", "q.gpkg"}, {"ESRI Shapefile", "q.shp"}, {"FlatGeobuf", "q.fgb"}}) {
     SCOPED_TRACE(format);
     const auto path = convert(geojson, dir.file(name), format);
-    const ParcelLayer l = readParcels({path, "", "", ""});
+    const ParcelLayer l = readParcels(options(path, "", "", ""));
     EXPECT_EQ(l.parcels.size(), reference.parcels.size());
     EXPECT_NEAR(totalArea(l), totalArea(reference), 1e-6 * totalArea(reference));
   }
@@ -119,7 +128,7 @@ TEST(ParcelReader, ReadsEveryFormatWithTheSameParcels) {
     "objects":{"parcels":{"type":"GeometryCollection","geometries":[
       {"type":"Polygon","arcs":[[0]],"properties":{"id":1}},
       {"type":"Polygon","arcs":[[1]],"properties":{"id":2}}]}}})");
-  const ParcelLayer t = readParcels({topo, "", "", ""});
+  const ParcelLayer t = readParcels(options(topo, "", "", ""));
   EXPECT_EQ(t.parcels.size(), 2u);
   EXPECT_TRUE(t.crs.assumedLonLat || t.crs.name.find("4326") != std::string::npos) << t.crs.name;
   EXPECT_NEAR(totalArea(t), 2 * 0.0001 * 111195.0 * 0.0001 * 111195.0 * std::cos(48.85 * M_PI / 180), 2.0);
@@ -128,30 +137,30 @@ TEST(ParcelReader, ReadsEveryFormatWithTheSameParcels) {
 TEST(ParcelReader, WhereFilterAndLayerSelection) {
   TempDir dir;
   const auto path = dir.write("quirks.geojson", test::quirksGeoJson());
-  const ParcelLayer l = readParcels({path, "quirks", "use = 'lot'", ""});
+  const ParcelLayer l = readParcels(options(path, "quirks", "use = 'lot'", ""));
   EXPECT_EQ(l.report.features, 6);  // every feature but the null one has use = 'lot' (odd pid)
-  expectError({path, "nope", "", ""}, Error::Kind::Input, {path, "nope", "quirks"});
-  expectError({path, "", "use ===", ""}, Error::Kind::Input, {path, "--where"});
+  expectError(options(path, "nope", "", ""), Error::Kind::Input, {path, "nope", "quirks"});
+  expectError(options(path, "", "use ===", ""), Error::Kind::Input, {path, "--where"});
 }
 
 TEST(ParcelReader, RefusesMissingUnreadableAndPolygonFreeInput) {
   TempDir dir;
-  expectError({dir.file("absent.geojson"), "", "", ""}, Error::Kind::Input, {"absent.geojson", "no such file"});
+  expectError(options(dir.file("absent.geojson"), "", "", ""), Error::Kind::Input, {"absent.geojson", "no such file"});
   const auto garbage = dir.write("garbage.geojson", "this is not { json");
-  expectError({garbage, "", "", ""}, Error::Kind::Input, {"garbage.geojson", "not a vector format"});
+  expectError(options(garbage, "", "", ""), Error::Kind::Input, {"garbage.geojson", "not a vector format"});
   const auto points = dir.write(
       "points.geojson", test::collection(test::feature(R"({"type":"Point","coordinates":[2.35,48.85]})", 1)));
-  expectError({points, "", "", ""}, Error::Kind::Input, {"points.geojson", "no usable polygon"});
+  expectError(options(points, "", "", ""), Error::Kind::Input, {"points.geojson", "no usable polygon"});
 }
 
 TEST(ParcelReader, RefusesLonLatClaimForCoordinatesThatCannotBeDegrees) {
   TempDir dir;
   const auto path = dir.write("feet.geojson", feetGeoJson());
-  expectError({path, "", "", ""}, Error::Kind::Input, {"feet.geojson", "cannot be degrees", "--crs"});
-  const ParcelLayer l = readParcels({path, "", "", "EPSG:2286"});
+  expectError(options(path, "", "", ""), Error::Kind::Input, {"feet.geojson", "cannot be degrees", "--crs"});
+  const ParcelLayer l = readParcels(options(path, "", "", "EPSG:2286"));
   EXPECT_TRUE(l.crs.overridden);
   EXPECT_NEAR(totalArea(l), 100 * 100 * 0.3048006096 * 0.3048006096, 1e-6);
-  expectError({path, "", "", "EPSG:99999999"}, Error::Kind::Usage, {"--crs", "EPSG:99999999"});
+  expectError(options(path, "", "", "EPSG:99999999"), Error::Kind::Usage, {"--crs", "EPSG:99999999"});
 }
 
 TEST(ParcelReader, RefusesProjectedCoordinatesWithoutCrs) {
@@ -160,7 +169,7 @@ TEST(ParcelReader, RefusesProjectedCoordinatesWithoutCrs) {
   // A shapefile without .prj declares no CRS at all.
   const auto shp = convert(geojson, dir.file("feet.shp"), "ESRI Shapefile");
   std::filesystem::remove(dir.file("feet.prj"));
-  expectError({shp, "", "", ""}, Error::Kind::Input, {"feet.shp", "declares no CRS", "--crs"});
+  expectError(options(shp, "", "", ""), Error::Kind::Input, {"feet.shp", "declares no CRS", "--crs"});
 }
 
 }  // namespace

@@ -81,6 +81,17 @@ struct ObservedAnalysis {
 ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const AnalysisOptions& options,
                                 const ProgressFn& progress = {});
 
+/// Metrics of parcels whose blocks are already known (generated parcels):
+/// shape metrics, neighbours (>= 1 m of shared boundary within `tolerance`) and
+/// frontage on the outline of their block. `blocks[b].parcels` index `shapes`.
+std::vector<ParcelMetrics> measureParcels(const std::vector<Polygon>& shapes, const std::vector<Block>& blocks,
+                                          double tolerance, double minFrontage);
+
+/// The metric columns shared by observed and generated parcel tables, and one
+/// parcel's values for them (same order).
+std::vector<Column> metricColumns();
+std::vector<Value> metricValues(const ParcelMetrics& m);
+
 /// One row per parcel: ids, block, role and every metric (the parcels.csv columns).
 Table parcelTable(const std::vector<Parcel>& parcels, const ObservedAnalysis& analysis);
 /// One row per block: statistics and derived parameters (the blocks.csv columns).

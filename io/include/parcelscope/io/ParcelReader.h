@@ -19,6 +19,9 @@ struct ReadOptions {
   std::string layer;        ///< layer name; empty = the first layer
   std::string where;        ///< OGR SQL attribute filter; empty = none
   std::string crsOverride;  ///< e.g. "EPSG:2286"; replaces a missing or wrong CRS
+  /// Numeric attributes to carry per parcel (ParcelLayer::fields); absent or
+  /// null values read as NaN.
+  std::vector<std::string> numericFields;
 };
 
 struct CleaningReport {
@@ -51,6 +54,8 @@ struct ParcelLayer {
   CrsInfo crs;
   CleaningReport report;
   Timings timings;  ///< "read" and "clean"
+  /// Per parcel, the values of ReadOptions::numericFields in that order.
+  std::vector<std::vector<double>> fields;
 };
 
 /// Reads, projects and cleans the polygons of one layer.

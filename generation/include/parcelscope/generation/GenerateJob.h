@@ -1,0 +1,56 @@
+#pragma once
+// The `generate` job: blocks in (a block layer, or observed parcels grouped into
+// blocks exactly as `stats` does), procedural parcels out, with the same
+// metrics as observed parcels. The command line and the GUI both call this.
+#include <cstdint>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "parcelscope/analysis/ObservedAnalysis.h"
+#include "parcelscope/core/Json.h"
+#include "parcelscope/generation/ObbSubdivision.h"
+#include "parcelscope/io/ParcelReader.h"
+
+namespace parcelscope::generation {
+
+struct GenerateRequest {
+  io::ReadOptions input;
+  /// The input holds observed parcels: build blocks and per-block A_min, A_max,
+  /// W_min, W_max from them (as `stats`). Otherwise it holds block polygons, and
+  /// numeric fields a_min, a_max, w_min, w_max (as in `stats`' blocks.gpkg) are
+  /// used per block when present.
+  bool fromParcels = false;
+  std::string style = "obb";
+  /// Values of analysis::analysisParameters() and obbParameterDescriptions().
+  ParameterValues parameters;
+  /// Names the user set explicitly: these override per-block values.
+  std::set<std::string> explicitParameters;
+};
+
+/// Parameters a block runs with: the request's values, with the per-block bounds
+/// (NaN when the block has none) where the user did not set them.
+ObbParameters blockParameters(const GenerateRequest& request, double aMin, double aMax, double wMin,
+                              double wMax);
+
+struct GeneratedParcels {
+  io::ParcelLayer source;                 ///< the input as read (frame, CRS, cleaning report)
+  std::vector<Block> blocks;              ///< block outlines; `parcels` index `parcels` below
+  std::vector<std::int64_t> blockIds;     ///< id of each entry of `blocks` (ids repeat for multipart blocks)
+  std::vector<Polygon> parcels;           ///< generated parcels, local metres
+  std::vector<analysis::ParcelMetrics> metrics;
+  std::int64_t failedBlocks = 0, oversize = 0, withoutAccess = 0;
+  std::vector<std::string> failures;      ///< one line per failed block
+  std::uint64_t seed = 0;
+};
+
+/// Reads the input and subdivides every block (in parallel). Throws Error on bad
+/// input or parameters (A_min > A_max, W_min > W_max, unknown style).
+GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& progress = {});
+
+/// Runs `generate` and writes DIR/parcels.gpkg (layer `parcels`, input CRS, field
+/// block_id and the metrics), DIR/parcels.csv and DIR/run.json, all at once when
+/// complete. Returns the run record.
+Json runGenerate(const GenerateRequest& request, const std::string& outDir, const ProgressFn& progress = {});
+
+}  // namespace parcelscope::generation

@@ -1,0 +1,173 @@
+#include "parcelscope/generation/GenerateJob.h"
+
+#include <cmath>
+
+#include "parcelscope/analysis/StatsJob.h"
+#include "parcelscope/core/Error.h"
+#include "parcelscope/core/Parallel.h"
+#include "parcelscope/io/OutputDirectory.h"
+#include "parcelscope/io/Writers.h"
+
+namespace parcelscope::generation {
+
+ObbParameters blockParameters(const GenerateRequest& request, double aMin, double aMax, double wMin,
+                              double wMax) {
+  ObbParameters p = obbParametersFrom(request.parameters);
+  auto pick = [&](const char* name, double perBlock, double& target) {
+    if (!request.explicitParameters.count(name) && std::isfinite(perBlock)) target = perBlock;
+  };
+  pick("a-min", aMin, p.aMin);
+  pick("a-max", aMax, p.aMax);
+  pick("w-min", wMin, p.wMin);
+  pick("w-max", wMax, p.wMax);
+  return p;
+}
+
+GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& progress) {
+  if (request.style != "obb") {
+    throw usageError("--style " + request.style + " is not available (styles: obb)");
+  }
+  const ObbParameters global = obbParametersFrom(request.parameters);
+  if (global.aMin > global.aMax) throw usageError("--a-min must not exceed --a-max");
+  if (global.wMin > global.wMax) throw usageError("--w-min must not exceed --w-max");
+  auto seedIt = request.parameters.find("seed");
+  GeneratedParcels out;
+  out.seed = seedIt == request.parameters.end() ? 1 : static_cast<std::uint64_t>(seedIt->second);
+
+  // Blocks and their own bounds (NaN where they have none).
+  struct Unit {
+    std::int64_t blockId;
+    Polygon shape;
+    ObbParameters p;
+    int part;
+  };
+  std::vector<Unit> units;
+  if (request.fromParcels) {
+    analysis::ObservedData observed =
+        analysis::loadObserved(request.input, request.parameters, scaledProgress(progress, 0.0, 0.4));
+    for (std::size_t b = 0; b < observed.analysis.blocks.size(); ++b) {
+      const auto& s = observed.analysis.statistics[b];
+      const ObbParameters p = blockParameters(request, s.aMin, s.aMax, s.wMin, s.wMax);
+      int part = 0;
+      for (const Polygon& shape : observed.analysis.blocks[b].parts) {
+        units.push_back({observed.analysis.blocks[b].id, shape, p, part++});
+      }
+    }
+    out.source = std::move(observed.layer);
+  } else {
+    io::ReadOptions in = request.input;
+    in.numericFields = {"block_id", "a_min", "a_max", "w_min", "w_max"};
+    out.source = io::readParcels(in, scaledProgress(progress, 0.0, 0.2));
+    for (std::size_t i = 0; i < out.source.parcels.size(); ++i) {
+      const auto& f = out.source.fields[i];
+      const std::int64_t id = std::isfinite(f[0]) ? static_cast<std::int64_t>(f[0]) : out.source.parcels[i].sourceFid;
+      units.push_back({id, out.source.parcels[i].shape, blockParameters(request, f[1], f[2], f[3], f[4]),
+                       out.source.parcels[i].part});
+    }
+  }
+  for (const Unit& u : units) {
+    if (u.p.aMin > u.p.aMax || u.p.wMin > u.p.wMax) {
+      throw usageError("block " + std::to_string(u.blockId) +
+                       ": its bounds conflict with the ones given (A_min > A_max or W_min > W_max)");
+    }
+  }
+
+  // Subdivide every block, in parallel; each block's seed depends only on its id.
+  std::vector<Subdivision> results(units.size());
+  const ProgressFn sub = scaledProgress(progress, request.fromParcels ? 0.4 : 0.2, 0.9);
+  parallelFor(
+      units.size(),
+      [&](std::size_t k) {
+        const Unit& u = units[k];
+        results[k] = subdivideObb(u.shape, u.p, blockSeed(out.seed, u.blockId * 64 + u.part));
+      },
+      [&](std::size_t done) {
+        reportProgress(sub, static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(1, units.size())),
+                       "subdividing");
+      });
+
+  for (std::size_t k = 0; k < units.size(); ++k) {
+    Block block;
+    block.id = static_cast<int>(out.blocks.size());
+    block.parts = {units[k].shape};
+    for (Polygon& parcel : results[k].parcels) {
+      block.parcels.push_back(static_cast<int>(out.parcels.size()));
+      out.parcels.push_back(std::move(parcel));
+    }
+    out.blocks.push_back(std::move(block));
+    out.blockIds.push_back(units[k].blockId);
+    out.oversize += results[k].oversize;
+    out.withoutAccess += results[k].withoutAccess;
+    if (results[k].failed) {
+      ++out.failedBlocks;
+      out.failures.push_back("block " + std::to_string(units[k].blockId) + ": " + results[k].failure);
+    }
+  }
+  reportProgress(progress, 0.9, "measuring");
+  const double minFrontage = global.minFrontage;
+  out.metrics = analysis::measureParcels(out.parcels, out.blocks, 0.05, minFrontage);
+  reportProgress(progress, 1.0, "measuring");
+  return out;
+}
+
+Json runGenerate(const GenerateRequest& request, const std::string& outDir, const ProgressFn& progress) {
+  io::OutputDirectory out(outDir, {request.input.path});
+  const GeneratedParcels g = generate(request, scaledProgress(progress, 0.0, 0.9));
+
+  reportProgress(progress, 0.9, "writing");
+  Table table;
+  table.columns = {{"parcel_id", Column::Type::Integer, ""}, {"block_id", Column::Type::Integer, ""}};
+  for (Column& c : analysis::metricColumns()) table.columns.push_back(std::move(c));
+  std::vector<std::vector<Polygon>> geometries;
+  for (std::size_t b = 0; b < g.blocks.size(); ++b) {
+    for (int i : g.blocks[b].parcels) {
+      std::vector<Value> row = {std::int64_t(i), g.blockIds[b]};
+      for (Value& v : analysis::metricValues(g.metrics[i])) row.push_back(std::move(v));
+      table.rows.push_back(std::move(row));
+      geometries.push_back({g.parcels[i]});
+    }
+  }
+  io::writePolygonLayer(out.stage("parcels.gpkg"), "parcels", geometries, table, g.source.frame, g.source.crs);
+  io::writeCsv(out.stage("parcels.csv"), table);
+
+  Json params = Json::object();
+  for (const auto& [name, value] : request.parameters) params.set(name, value);
+  Json perBlock = Json::array();
+  for (const char* name : {"a-min", "a-max", "w-min", "w-max"}) {
+    if (!request.explicitParameters.count(name)) perBlock.push(name);
+  }
+  std::int64_t withAccess = 0;
+  for (const auto& m : g.metrics) withAccess += m.streetAccess;
+  Json failures = Json::array();
+  for (const auto& f : g.failures) failures.push(f);
+  Json run = Json::object()
+                 .set("tool", "parcelscope")
+                 .set("version", analysis::version())
+                 .set("command", "generate")
+                 .set("style", request.style)
+                 .set("from_parcels", request.fromParcels)
+                 .set("seed", static_cast<std::int64_t>(g.seed))
+                 .set("gdal", io::gdalVersion())
+                 .set("parameters", params)
+                 .set("per_block_parameters_where_available", perBlock);
+  run.set("input", Json::object()
+                       .set("path", g.source.path)
+                       .set("layer", g.source.layerName)
+                       .set("crs", g.source.crs.name)
+                       .set("local_frame", g.source.frame.describe()));
+  run.set("counts", Json::object()
+                        .set("blocks", static_cast<std::int64_t>(g.blocks.size()))
+                        .set("blocks_failed", g.failedBlocks)
+                        .set("parcels", static_cast<std::int64_t>(g.parcels.size()))
+                        .set("parcels_oversize", g.oversize)
+                        .set("parcels_without_street_access", g.withoutAccess)
+                        .set("parcels_with_street_access_measured", withAccess));
+  run.set("failures", failures);
+  run.set("outputs", Json::array().push("parcels.gpkg").push("parcels.csv").push("run.json"));
+  io::writeJson(out.stage("run.json"), run);
+  out.commit();
+  reportProgress(progress, 1.0, "writing");
+  return run;
+}
+
+}  // namespace parcelscope::generation
