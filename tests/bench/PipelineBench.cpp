@@ -1,4 +1,4 @@
-// Benchmark: the stats pipeline (read + project + clean + metrics + blocks) on
+// Benchmarks. 1) The stats pipeline (read + project + clean + metrics + blocks) on
 // cambridge_ma against a plain GDAL read of the same file (every feature and its
 // geometry fetched). Target: the pipeline within 3x of the plain read.
 //   build/release/tests/bench/parcelscope_bench
@@ -10,6 +10,7 @@
 #include <filesystem>
 
 #include "parcelscope/analysis/StatsJob.h"
+#include "parcelscope/generation/GenerateJob.h"
 
 namespace {
 
@@ -59,6 +60,36 @@ void StatsPipeline(benchmark::State& state) {
       benchmark::Counter(static_cast<double>(parcels), benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(StatsPipeline)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
+
+// OBB subdivision of every cambridge_ma block with its own derived bounds
+// (Vanegas et al. 2012 report 1-10 ms per block after an edit). Single thread.
+void ObbSubdivisionPerBlock(benchmark::State& state) {
+  if (!haveData(state)) return;
+  parcelscope::io::ReadOptions in;
+  in.path = kCambridge;
+  const auto d = parcelscope::analysis::loadObserved(
+      in, parcelscope::defaultValues(parcelscope::analysis::analysisParameters()));
+  parcelscope::generation::GenerateRequest request;
+  request.parameters = parcelscope::defaultValues(parcelscope::generation::obbParameterDescriptions());
+  std::size_t blocks = 0, parcels = 0;
+  for (auto _ : state) {
+    blocks = parcels = 0;
+    for (std::size_t b = 0; b < d.analysis.blocks.size(); ++b) {
+      const auto& s = d.analysis.statistics[b];
+      const auto p = parcelscope::generation::blockParameters(request, s.aMin, s.aMax, s.wMin, s.wMax);
+      for (const auto& part : d.analysis.blocks[b].parts) {
+        parcels += parcelscope::generation::subdivideObb(part, p, b).parcels.size();
+        ++blocks;
+      }
+    }
+  }
+  state.counters["blocks"] = static_cast<double>(blocks);
+  state.counters["parcels"] = static_cast<double>(parcels);
+  state.counters["ms_per_block"] = benchmark::Counter(static_cast<double>(blocks) / 1000.0,
+                                                      benchmark::Counter::kIsIterationInvariantRate |
+                                                          benchmark::Counter::kInvert);
+}
+BENCHMARK(ObbSubdivisionPerBlock)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
 }  // namespace
 

@@ -109,6 +109,32 @@ TEST(ObbSubdivision, SplitSnapsToNearbyContourVertex) {
   EXPECT_NEAR(std::min(area(t.parcels[0]), area(t.parcels[1])), 100 * 40, 1e-6);
 }
 
+TEST(ObbSubdivision, LocalEditChangesOnlyNearbyParcels) {
+  // Moving a concave vertex of the street line leaves the OBB and the first
+  // splits as they were; only parcels near the edit change (Vanegas et al. 2012, 4.3).
+  auto block = [](double notch) {
+    Polygon p = poly({{0, 0}, {200, 0}, {200, 60}, {40, 60}, {30, 60 - notch}, {20, 60}, {0, 60}});
+    normalise(p);
+    return p;
+  };
+  const auto p = params(200, 700, 8, 35, 0.5);
+  const Subdivision before = subdivideObb(block(2.0), p, 11), after = subdivideObb(block(3.0), p, 11);
+  auto same = [](const Polygon& a, const Polygon& b) {
+    if (a.outer.size() != b.outer.size()) return false;
+    for (std::size_t k = 0; k < a.outer.size(); ++k) {
+      if (a.outer[k].x != b.outer[k].x || a.outer[k].y != b.outer[k].y) return false;
+    }
+    return true;
+  };
+  int unchanged = 0;
+  for (const Polygon& a : after.parcels) {
+    for (const Polygon& b : before.parcels) unchanged += same(a, b);
+  }
+  std::printf("%d of %zu parcels unchanged\n", unchanged, after.parcels.size());
+  EXPECT_GE(unchanged, static_cast<int>(after.parcels.size()) * 2 / 3);
+  EXPECT_LT(unchanged, static_cast<int>(after.parcels.size()));  // the parcel at the notch did change
+}
+
 // ---- Randomised shapes ------------------------------------------------------
 
 Polygon rotateShift(Polygon p, double angle, double dx, double dy) {

@@ -101,5 +101,49 @@ TEST(StatsCommand, RefusesToWriteOverTheInput) {
   EXPECT_EQ(fs::file_size(input), before);
 }
 
+std::string slurp(const std::string& path) {
+  std::stringstream s;
+  s << std::ifstream(path).rdbuf();
+  return s.str();
+}
+
+TEST(GenerateCommand, FromParcelsWritesParcelsAndIsReproducibleFromTheSeed) {
+  TempDir dir;
+  const std::string base = "generate '" + kSample + "' --where \"use <> 'ROW'\" --from-parcels --style obb --quiet";
+  const CliRun a = run(base + " --seed 7 --out '" + dir.file("a") + "'");
+  ASSERT_EQ(a.code, 0) << a.output;
+  for (const char* f : {"parcels.gpkg", "parcels.csv", "run.json"}) {
+    EXPECT_TRUE(fs::exists(dir.file("a") + "/" + f)) << f;
+  }
+  const std::string csv = slurp(dir.file("a") + "/parcels.csv");
+  EXPECT_EQ(csv.rfind("parcel_id,block_id,area,perimeter,width", 0), 0u) << csv.substr(0, 80);
+  EXPECT_GT(std::count(csv.begin(), csv.end(), '\n'), 100);
+  const std::string json = slurp(dir.file("a") + "/run.json");
+  EXPECT_NE(json.find("\"blocks_failed\": 0"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"seed\": 7"), std::string::npos) << json;
+
+  ASSERT_EQ(run(base + " --seed 7 --out '" + dir.file("b") + "'").code, 0);
+  EXPECT_EQ(slurp(dir.file("b") + "/parcels.csv"), csv);
+  ASSERT_EQ(run(base + " --seed 8 --out '" + dir.file("c") + "'").code, 0);
+  EXPECT_NE(slurp(dir.file("c") + "/parcels.csv"), csv);
+}
+
+TEST(GenerateCommand, SubdividesTheBlocksThatStatsWrote) {
+  TempDir dir;
+  ASSERT_EQ(run("stats '" + kSample + "' --where \"use <> 'ROW'\" --out '" + dir.file("s") + "' --quiet").code, 0);
+  const CliRun g = run("generate '" + dir.file("s") + "/blocks.gpkg' --out '" + dir.file("g") + "' --quiet");
+  ASSERT_EQ(g.code, 0) << g.output;
+  const std::string json = slurp(dir.file("g") + "/run.json");
+  EXPECT_NE(json.find("\"blocks\": 10"), std::string::npos) << json;
+}
+
+TEST(GenerateCommand, BadStyleAndConflictingBoundsAreUsageErrors) {
+  TempDir dir;
+  EXPECT_EQ(run("generate '" + kSample + "' --style voronoi --out '" + dir.file("x") + "' --quiet").code, 2);
+  const CliRun r = run("generate '" + kSample + "' --a-min 900 --a-max 100 --out '" + dir.file("x") + "' --quiet");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_FALSE(fs::exists(dir.file("x")));
+}
+
 }  // namespace
 }  // namespace parcelscope

@@ -1,0 +1,93 @@
+// OBB subdivision of every block of the shared real datasets, with the bounds
+// derived from each block's own observed parcels (Vanegas et al. 2012, section 6).
+#include <gtest/gtest.h>
+
+#include "TestUtil.h"
+#include "generation/TilingCheck.h"
+#include "parcelscope/analysis/StatsJob.h"
+#include "parcelscope/core/Parallel.h"
+#include "parcelscope/generation/GenerateJob.h"
+
+namespace parcelscope::generation {
+namespace {
+
+struct Dataset {
+  const char* file;
+  const char* crs;
+};
+
+void PrintTo(const Dataset& d, std::ostream* os) { *os << d.file; }
+
+class RealBlocks : public ::testing::TestWithParam<Dataset> {};
+
+TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
+  PARCELSCOPE_REQUIRE_SHARED_DATASETS();
+  io::ReadOptions in;
+  in.path = test::sharedDataset(GetParam().file);
+  in.crsOverride = GetParam().crs;
+  const auto observed = analysis::loadObserved(in, defaultValues(analysis::analysisParameters()));
+  GenerateRequest request;
+  request.parameters = defaultValues(obbParameterDescriptions());  // xi = 1
+
+  struct Unit {
+    const Polygon* shape;
+    ObbParameters p;
+    int id;
+  };
+  std::vector<Unit> units;
+  for (std::size_t b = 0; b < observed.analysis.blocks.size(); ++b) {
+    const auto& s = observed.analysis.statistics[b];
+    for (const Polygon& part : observed.analysis.blocks[b].parts) {
+      units.push_back({&part, blockParameters(request, s.aMin, s.aMax, s.wMin, s.wMax), static_cast<int>(b)});
+    }
+  }
+  std::vector<Subdivision> results(units.size());
+  std::vector<test::TilingReport> reports(units.size());
+  parallelFor(units.size(), [&](std::size_t k) {
+    results[k] = subdivideObb(*units[k].shape, units[k].p, blockSeed(1, units[k].id));
+    reports[k] = test::checkTiling(*units[k].shape, results[k].parcels);
+  });
+  int parcels = 0, withoutAccess = 0, failed = 0, oversize = 0;
+  for (std::size_t k = 0; k < units.size(); ++k) {
+    const std::string what = std::string(GetParam().file) + " block " + std::to_string(units[k].id);
+    EXPECT_FALSE(results[k].failed) << what << ": " << results[k].failure;
+    EXPECT_LE(reports[k].areaError, 1e-6) << what;
+    EXPECT_LE(reports[k].maxOverlap, 1e-6) << what;
+    EXPECT_EQ(reports[k].invalid, 0) << what;
+    EXPECT_EQ(reports[k].outside, 0) << what;
+    parcels += static_cast<int>(results[k].parcels.size());
+    withoutAccess += results[k].withoutAccess;
+    failed += results[k].failed;
+    oversize += results[k].oversize;
+  }
+  std::printf("%s: %zu blocks, %d parcels, %d oversize, %d without street access at xi = 1, %d failed\n",
+              GetParam().file, units.size(), parcels, oversize, withoutAccess, failed);
+  EXPECT_EQ(withoutAccess, 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Datasets, RealBlocks,
+                         ::testing::Values(Dataset{"cambridge_ma/ASSESSING_ParcelsFY2014.topojson", ""},
+                                           Dataset{"paris_18e/cadastre-75118-parcelles.json", ""},
+                                           Dataset{"malibu_ca/parcels.geojson", ""},
+                                           Dataset{"eatonville_wa/parcels.geojson", "EPSG:2286"},
+                                           Dataset{"seoul_jamsil/parcels.geojson", ""},
+                                           Dataset{"rhone_69114/parcelles.json", ""}),
+                         [](const ::testing::TestParamInfo<Dataset>& param) {
+                           const std::string n = param.param.file;
+                           return n.substr(0, n.find('/'));
+                         });
+
+TEST(BlockParameters, UserValuesOverridePerBlockValuesWhichOverrideDefaults) {
+  GenerateRequest r;
+  r.parameters = defaultValues(obbParameterDescriptions());
+  r.parameters["a-max"] = 555;
+  r.explicitParameters = {"a-max"};
+  const ObbParameters p = blockParameters(r, 100, 900, 4, std::nan(""));
+  EXPECT_DOUBLE_EQ(p.aMin, 100);   // per block
+  EXPECT_DOUBLE_EQ(p.aMax, 555);   // given by the user
+  EXPECT_DOUBLE_EQ(p.wMin, 4);     // per block
+  EXPECT_DOUBLE_EQ(p.wMax, 30);    // no per-block value: default
+}
+
+}  // namespace
+}  // namespace parcelscope::generation
