@@ -1,5 +1,7 @@
 #include "Contacts.h"
 
+#include "parcelscope/core/Parallel.h"
+
 #include <CGAL/box_intersection_d.h>
 
 #include <algorithm>
@@ -114,18 +116,46 @@ std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons, doubl
   for (std::size_t i = 0; i < polygons.size(); ++i) {
     addEdges(*polygons[i], static_cast<int>(i), 0.5 * tolerance, edges, boxes);
   }
-  std::vector<Cover> covers;
-  std::vector<std::pair<int, int>> closePairs;
-  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const EdgeBox& x, const EdgeBox& y) {
-    const EdgeInfo& e = edges[x.info()];
-    const EdgeInfo& f = edges[y.info()];
-    if (e.polygon == f.polygon) return;
-    if (segmentDistance(*e.p, *e.q, *f.p, *f.q) > tolerance) return;
-    closePairs.emplace_back(std::min(e.polygon, f.polygon), std::max(e.polygon, f.polygon));
-    double lo = 0, hi = 0;
-    if (coveredInterval(*e.p, *e.q, *f.p, *f.q, tolerance, lo, hi)) covers.push_back({x.info(), f.polygon, lo, hi});
-    if (coveredInterval(*f.p, *f.q, *e.p, *e.q, tolerance, lo, hi)) covers.push_back({y.info(), e.polygon, lo, hi});
+  // Two halves split at the median x, searched in parallel. A box crossing the
+  // split goes to both halves; a pair is kept only in the half that holds the
+  // larger of the two boxes' minimum x, so no pair is found twice.
+  std::vector<double> xs;
+  xs.reserve(boxes.size());
+  for (const EdgeBox& b : boxes) xs.push_back(0.5 * (b.min_coord(0) + b.max_coord(0)));
+  double split = 0;
+  if (!xs.empty()) {
+    std::nth_element(xs.begin(), xs.begin() + static_cast<long>(xs.size() / 2), xs.end());
+    split = xs[xs.size() / 2];
+  }
+  struct Half {
+    std::vector<EdgeBox> boxes;
+    std::vector<Cover> covers;
+    std::vector<std::pair<int, int>> closePairs;
+  };
+  Half halves[2];
+  for (const EdgeBox& b : boxes) {
+    if (b.min_coord(0) < split) halves[0].boxes.push_back(b);
+    if (b.max_coord(0) >= split) halves[1].boxes.push_back(b);
+  }
+  parallelFor(2, [&](std::size_t h) {
+    Half& half = halves[h];
+    CGAL::box_self_intersection_d(half.boxes.begin(), half.boxes.end(), [&](const EdgeBox& x, const EdgeBox& y) {
+      const bool upper = std::max(x.min_coord(0), y.min_coord(0)) >= split;
+      if (upper != (h == 1)) return;
+      const EdgeInfo& e = edges[x.info()];
+      const EdgeInfo& f = edges[y.info()];
+      if (e.polygon == f.polygon) return;
+      if (segmentDistance(*e.p, *e.q, *f.p, *f.q) > tolerance) return;
+      half.closePairs.emplace_back(std::min(e.polygon, f.polygon), std::max(e.polygon, f.polygon));
+      double lo = 0, hi = 0;
+      if (coveredInterval(*e.p, *e.q, *f.p, *f.q, tolerance, lo, hi)) half.covers.push_back({x.info(), f.polygon, lo, hi});
+      if (coveredInterval(*f.p, *f.q, *e.p, *e.q, tolerance, lo, hi)) half.covers.push_back({y.info(), e.polygon, lo, hi});
+    });
   });
+  std::vector<Cover> covers = std::move(halves[0].covers);
+  covers.insert(covers.end(), halves[1].covers.begin(), halves[1].covers.end());
+  std::vector<std::pair<int, int>> closePairs = std::move(halves[0].closePairs);
+  closePairs.insert(closePairs.end(), halves[1].closePairs.begin(), halves[1].closePairs.end());
   std::sort(closePairs.begin(), closePairs.end());
   closePairs.erase(std::unique(closePairs.begin(), closePairs.end()), closePairs.end());
   std::vector<Contact> out(closePairs.size());

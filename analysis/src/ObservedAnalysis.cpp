@@ -202,9 +202,16 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
   // 5. Block outlines, frontage and statistics.
   const double frontTol = std::max(tol, 0.05);
   out.timings.start("block_outlines");
+  // Largest blocks first, so that one big block does not finish last alone.
+  std::vector<std::size_t> bySize(out.blocks.size());
+  std::iota(bySize.begin(), bySize.end(), 0);
+  std::stable_sort(bySize.begin(), bySize.end(), [&](std::size_t x, std::size_t y) {
+    return out.blocks[x].parcels.size() > out.blocks[y].parcels.size();
+  });
   parallelFor(
       out.blocks.size(),
-      [&](std::size_t b) {
+      [&](std::size_t k) {
+        const std::size_t b = bySize[k];
         std::vector<const Polygon*> members;
         for (int i : out.blocks[b].parcels) members.push_back(&parcels[i].shape);
         out.blocks[b].parts = io::unionAndClose(members, tol);

@@ -180,7 +180,8 @@ Cleaned cleanFeature(const Feature& f, const LocalFrame& frame) {
   }
   polygons.clear();
   if (!whole->IsValid()) {
-    std::unique_ptr<OGRGeometry> fixed(whole->MakeValid());
+    const char* const makeValidOptions[] = {"METHOD=STRUCTURE", nullptr};
+    std::unique_ptr<OGRGeometry> fixed(whole->MakeValid(makeValidOptions));
     if (!fixed || fixed->IsEmpty()) {
       c.repairFailed = true;
       return c;

@@ -85,9 +85,8 @@ void ObbSubdivisionPerBlock(benchmark::State& state) {
   }
   state.counters["blocks"] = static_cast<double>(blocks);
   state.counters["parcels"] = static_cast<double>(parcels);
-  state.counters["ms_per_block"] = benchmark::Counter(static_cast<double>(blocks) / 1000.0,
-                                                      benchmark::Counter::kIsIterationInvariantRate |
-                                                          benchmark::Counter::kInvert);
+  state.counters["blocks_per_s"] = benchmark::Counter(static_cast<double>(blocks),
+                                                      benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(ObbSubdivisionPerBlock)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
