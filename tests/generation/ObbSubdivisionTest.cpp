@@ -249,5 +249,33 @@ TEST(ObbSubdivision, RandomShapesAreTiledValidlyAndReproducibly) {
   EXPECT_EQ(accessExceptions, 0);
 }
 
+TEST(ObbSubdivision, ArbitraryPointRingsNeverThrowAndTileWhenValid) {
+  // Random rings of 3 to 12 points: mostly self-intersecting, some with repeated
+  // or collinear points. Invalid ones come back whole and flagged.
+  const std::uint64_t seed = 99;
+  std::printf("garbage rings seed %llu\n", static_cast<unsigned long long>(seed));
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int> count(3, 12), grid(0, 20);
+  int failed = 0, tiled = 0;
+  for (int i = 0; i < 600; ++i) {
+    Polygon p;
+    const int n = count(rng);
+    for (int k = 0; k < n; ++k) p.outer.push_back({10.0 * grid(rng), 10.0 * grid(rng)});
+    if (!normalise(p)) continue;
+    Subdivision s;
+    ASSERT_NO_THROW(s = subdivideObb(p, params(100, 800, 4, 30, 0.5, 0.5), static_cast<std::uint64_t>(i)));
+    if (s.failed) {
+      ++failed;
+      EXPECT_EQ(s.parcels.size(), 1u);
+      continue;
+    }
+    ++tiled;
+    EXPECT_TILES(p, s.parcels, "ring " + std::to_string(i));
+  }
+  std::printf("%d rings subdivided, %d refused as invalid\n", tiled, failed);
+  EXPECT_GT(failed, 0);
+  EXPECT_GT(tiled, 0);
+}
+
 }  // namespace
 }  // namespace parcelscope::generation
