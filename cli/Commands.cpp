@@ -72,8 +72,8 @@ int statsCommand(const std::vector<std::string>& args) {
   input.where = a.value("where").value_or("");
   input.crsOverride = a.value("crs").value_or("");
   const bool quiet = a.has("quiet");
-  const Json run = analysis::runStats(input, a.parameters(), *a.value("out"), terminalProgress(quiet));
-  if (!quiet) std::fprintf(stderr, "%s\nwritten to %s\n", run.dump().c_str(), a.value("out")->c_str());
+  const auto outcome = analysis::runStats(input, a.parameters(), *a.value("out"), terminalProgress(quiet));
+  if (!quiet) std::fprintf(stderr, "%s\nwritten to %s\n", outcome.summary.c_str(), a.value("out")->c_str());
   return 0;
 }
 
@@ -116,8 +116,8 @@ int generateCommand(const std::vector<std::string>& args) {
     if (a.given(p.name)) request.explicitParameters.insert(p.name);
   }
   const bool quiet = a.has("quiet");
-  const Json run = generation::runGenerate(request, *a.value("out"), terminalProgress(quiet));
-  if (!quiet) std::fprintf(stderr, "%s\nwritten to %s\n", run.dump().c_str(), a.value("out")->c_str());
+  const auto outcome = generation::runGenerate(request, *a.value("out"), terminalProgress(quiet));
+  if (!quiet) std::fprintf(stderr, "%s\nwritten to %s\n", outcome.summary.c_str(), a.value("out")->c_str());
   return 0;
 }
 

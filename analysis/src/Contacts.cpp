@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <tuple>
 
 namespace parcelscope::analysis::detail {
@@ -120,10 +121,12 @@ std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons, doubl
   // split goes to both halves; a pair is kept only in the half that holds the
   // larger of the two boxes' minimum x, so no pair is found twice.
   std::vector<double> xs;
-  xs.reserve(boxes.size());
-  for (const EdgeBox& b : boxes) xs.push_back(0.5 * (b.min_coord(0) + b.max_coord(0)));
-  double split = 0;
-  if (!xs.empty()) {
+  // Small inputs (one block, one parcel pair) stay on the calling thread.
+  const bool parallel = boxes.size() >= 20000;
+  double split = std::numeric_limits<double>::infinity();
+  if (parallel) {
+    xs.reserve(boxes.size());
+    for (const EdgeBox& b : boxes) xs.push_back(0.5 * (b.min_coord(0) + b.max_coord(0)));
     std::nth_element(xs.begin(), xs.begin() + static_cast<long>(xs.size() / 2), xs.end());
     split = xs[xs.size() / 2];
   }
@@ -137,7 +140,7 @@ std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons, doubl
     if (b.min_coord(0) < split) halves[0].boxes.push_back(b);
     if (b.max_coord(0) >= split) halves[1].boxes.push_back(b);
   }
-  parallelFor(2, [&](std::size_t h) {
+  auto search = [&](std::size_t h) {
     Half& half = halves[h];
     CGAL::box_self_intersection_d(half.boxes.begin(), half.boxes.end(), [&](const EdgeBox& x, const EdgeBox& y) {
       const bool upper = std::max(x.min_coord(0), y.min_coord(0)) >= split;
@@ -151,7 +154,12 @@ std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons, doubl
       if (coveredInterval(*e.p, *e.q, *f.p, *f.q, tolerance, lo, hi)) half.covers.push_back({x.info(), f.polygon, lo, hi});
       if (coveredInterval(*f.p, *f.q, *e.p, *e.q, tolerance, lo, hi)) half.covers.push_back({y.info(), e.polygon, lo, hi});
     });
-  });
+  };
+  if (parallel) {
+    parallelFor(2, search);
+  } else {
+    search(0);
+  }
   std::vector<Cover> covers = std::move(halves[0].covers);
   covers.insert(covers.end(), halves[1].covers.begin(), halves[1].covers.end());
   std::vector<std::pair<int, int>> closePairs = std::move(halves[0].closePairs);

@@ -1,5 +1,7 @@
 #include "parcelscope/analysis/StatsJob.h"
 
+#include <sstream>
+
 #include "parcelscope/io/OutputDirectory.h"
 #include "parcelscope/io/Writers.h"
 
@@ -62,8 +64,24 @@ void addObservedRecord(Json& record, const ObservedData& data) {
   record.set("input", input).set("counts", counts).set("seconds", seconds);
 }
 
-Json runStats(const io::ReadOptions& input, const ParameterValues& parameters, const std::string& outDir,
-              const ProgressFn& progress) {
+std::string summarize(const ObservedData& data) {
+  const io::CleaningReport& r = data.layer.report;
+  const ObservedAnalysis& a = data.analysis;
+  std::ostringstream s;
+  s << "read " << r.features << " features of " << data.layer.path << " (" << data.layer.crs.name << ")\n"
+    << "  " << r.parcels << " parcels: " << r.invalidRepaired << " repaired, " << r.multipartFeatures
+    << " multipart features split into " << r.partsFromMultipart << " parcels, " << r.duplicatesCollapsed
+    << " duplicates collapsed into " << r.duplicateStacks << " stacks\n"
+    << "  skipped: " << r.nullOrEmpty << " null or empty, " << r.nonPolygonal << " not polygons, "
+    << r.invalidSkipped << " beyond repair, " << r.degenerateSkipped << " degenerate parts\n"
+    << "  " << a.rightOfWayCount << " right-of-way parcels kept out of blocks\n"
+    << "  " << a.blocks.size() << " blocks (" << a.clampedAMin << " with A_min clamped, " << a.clampedWMin
+    << " with W_min clamped)";
+  return s.str();
+}
+
+JobOutcome runStats(const io::ReadOptions& input, const ParameterValues& parameters, const std::string& outDir,
+                    const ProgressFn& progress) {
   io::OutputDirectory out(outDir, {input.path});
   ObservedData data = loadObserved(input, parameters, scaledProgress(progress, 0.0, 0.9));
 
@@ -89,7 +107,7 @@ Json runStats(const io::ReadOptions& input, const ParameterValues& parameters, c
   io::writeJson(out.stage("run.json"), run);
   out.commit();
   reportProgress(progress, 1.0, "writing");
-  return run;
+  return {run, summarize(data)};
 }
 
 }  // namespace parcelscope::analysis

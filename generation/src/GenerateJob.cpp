@@ -110,7 +110,8 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
   return out;
 }
 
-Json runGenerate(const GenerateRequest& request, const std::string& outDir, const ProgressFn& progress) {
+analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::string& outDir,
+                                 const ProgressFn& progress) {
   io::OutputDirectory out(outDir, {request.input.path});
   const GeneratedParcels g = generate(request, scaledProgress(progress, 0.0, 0.9));
 
@@ -167,7 +168,13 @@ Json runGenerate(const GenerateRequest& request, const std::string& outDir, cons
   io::writeJson(out.stage("run.json"), run);
   out.commit();
   reportProgress(progress, 1.0, "writing");
-  return run;
+  std::string summary = std::to_string(g.blocks.size()) + " blocks of " + g.source.path + " subdivided (" +
+                        request.style + ", seed " + std::to_string(g.seed) + ") into " +
+                        std::to_string(g.parcels.size()) + " parcels\n  " + std::to_string(g.oversize) +
+                        " oversize (no admissible split), " + std::to_string(g.withoutAccess) +
+                        " without street access, " + std::to_string(g.failedBlocks) + " blocks refused";
+  for (const auto& f : g.failures) summary += "\n  " + f;
+  return {run, summary};
 }
 
 }  // namespace parcelscope::generation

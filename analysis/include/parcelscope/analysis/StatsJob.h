@@ -21,12 +21,22 @@ ObservedData loadObserved(const io::ReadOptions& input, const ParameterValues& p
 /// Adds the run record's "input" and "counts" sections for observed data to `record`.
 void addObservedRecord(Json& record, const ObservedData& data);
 
+/// A finished job: its run record (as written to run.json) and a few lines of
+/// summary for people.
+struct JobOutcome {
+  Json record;
+  std::string summary;
+};
+
+/// One-paragraph summary of what was read, repaired, skipped and grouped.
+std::string summarize(const ObservedData& data);
+
 /// Runs `stats` and writes, all at once when complete, into `outDir`:
 /// parcels.csv, blocks.csv, blocks.gpkg (layer `blocks`, input CRS) and run.json.
-/// Returns the run record. Throws Error on bad input or failed output; the
-/// output directory is then left as it was.
-Json runStats(const io::ReadOptions& input, const ParameterValues& parameters, const std::string& outDir,
-              const ProgressFn& progress = {});
+/// Throws Error on bad input or failed output; the output directory is then
+/// left as it was.
+JobOutcome runStats(const io::ReadOptions& input, const ParameterValues& parameters, const std::string& outDir,
+                    const ProgressFn& progress = {});
 
 /// "0.1.0": the project version written into run records.
 std::string version();

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "parcelscope/analysis/ObservedAnalysis.h"
+#include "parcelscope/analysis/StatsJob.h"
 #include "parcelscope/core/Json.h"
 #include "parcelscope/generation/ObbSubdivision.h"
 #include "parcelscope/io/ParcelReader.h"
@@ -50,7 +51,8 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
 
 /// Runs `generate` and writes DIR/parcels.gpkg (layer `parcels`, input CRS, field
 /// block_id and the metrics), DIR/parcels.csv and DIR/run.json, all at once when
-/// complete. Returns the run record.
-Json runGenerate(const GenerateRequest& request, const std::string& outDir, const ProgressFn& progress = {});
+/// complete.
+analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::string& outDir,
+                                 const ProgressFn& progress = {});
 
 }  // namespace parcelscope::generation
