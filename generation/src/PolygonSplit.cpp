@@ -44,8 +44,11 @@ Ring fromCgal(const P2& p) {
 }
 
 std::vector<Polygon> clip(const PWH& polygon, const P2& halfPlane) {
+  // With explicit segment traits: the default for Epeck polygons converts to
+  // polylines, a path that leaks in CGAL 5.5.
   std::vector<PWH> parts;
-  CGAL::intersection(polygon, halfPlane, std::back_inserter(parts));
+  Traits traits;
+  CGAL::intersection(polygon, halfPlane, std::back_inserter(parts), traits);
   std::vector<Polygon> out;
   for (const PWH& part : parts) {
     Polygon p;
