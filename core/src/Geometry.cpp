@@ -187,46 +187,6 @@ double segmentDistance(const Point& a, const Point& b, const Point& c, const Poi
                   std::min(pointSegmentDistance(c, a, b), pointSegmentDistance(d, a, b)));
 }
 
-namespace {
-template <typename F>
-void forEachEdge(const Polygon& p, F&& f) {
-  auto ring = [&](const Ring& r) {
-    for (std::size_t i = 0, n = r.size(); i < n; ++i) f(r[i], r[(i + 1) % n]);
-  };
-  ring(p.outer);
-  for (const auto& h : p.holes) ring(h);
-}
-}  // namespace
-
-double boundaryDistance(const Polygon& a, const Polygon& b) {
-  double best = std::numeric_limits<double>::max();
-  forEachEdge(a, [&](const Point& p, const Point& q) {
-    if (best == 0.0) return;
-    forEachEdge(b, [&](const Point& r, const Point& s) {
-      if (best == 0.0) return;
-      best = std::min(best, segmentDistance(p, q, r, s));
-    });
-  });
-  return best;
-}
-
-bool withinDistance(const Polygon& a, const Polygon& b, double distance) {
-  if (!bounds(a).expanded(distance).intersects(bounds(b))) return false;
-  bool close = false;
-  forEachEdge(a, [&](const Point& p, const Point& q) {
-    if (close) return;
-    const Box ea = Box{std::min(p.x, q.x), std::min(p.y, q.y), std::max(p.x, q.x), std::max(p.y, q.y)}
-                       .expanded(distance);
-    forEachEdge(b, [&](const Point& r, const Point& s) {
-      if (close) return;
-      const Box eb{std::min(r.x, s.x), std::min(r.y, s.y), std::max(r.x, s.x), std::max(r.y, s.y)};
-      if (ea.intersects(eb) && segmentDistance(p, q, r, s) <= distance) close = true;
-    });
-  });
-  if (close) return true;
-  return pointInPolygon(b.outer[0], a) || pointInPolygon(a.outer[0], b);
-}
-
 bool isClearlySimple(const Ring& r) {
   const std::size_t n = r.size();
   if (n < 3 || n > 64) return false;
@@ -275,55 +235,59 @@ Ring convexHull(std::vector<Point> pts) {
   return hull;
 }
 
-OrientedBox minimumAreaBox(const Ring& ring) {
+OrientedBox smallestBoxAlongEdges(const Ring& hull, const Ring& edges) {
   OrientedBox best;
-  const Ring hull = convexHull(ring);
-  if (hull.size() < 3) {
-    if (hull.size() == 2) {
-      const double dx = hull[1].x - hull[0].x, dy = hull[1].y - hull[0].y;
-      const double l = norm(dx, dy);
-      best.center = {0.5 * (hull[0].x + hull[1].x), 0.5 * (hull[0].y + hull[1].y)};
-      if (l > 0) best.u = {dx / l, dy / l};
-      best.length = l;
-    } else if (hull.size() == 1) {
-      best.center = hull[0];
-    }
-    return best;
-  }
+  if (hull.empty()) return best;
+  best.center = hull[0];
+  const Point o = hull[0];  // projections relative to a hull point keep precision
   double bestArea = std::numeric_limits<double>::max();
-  const std::size_t n = hull.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Point& a = hull[i];
-    const Point& b = hull[(i + 1) % n];
+  for (std::size_t i = 0, n = edges.size(); i < n; ++i) {
+    const Point& a = edges[i];
+    const Point& b = edges[(i + 1) % n];
     const double l = norm(b.x - a.x, b.y - a.y);
     if (l == 0) continue;
     const Point e{(b.x - a.x) / l, (b.y - a.y) / l};
-    const Point nrm{-e.y, e.x};
     double minE = std::numeric_limits<double>::max(), maxE = std::numeric_limits<double>::lowest();
     double minN = minE, maxN = maxE;
     for (const Point& p : hull) {
-      const double pe = (p.x - a.x) * e.x + (p.y - a.y) * e.y;
-      const double pn = (p.x - a.x) * nrm.x + (p.y - a.y) * nrm.y;
+      const double pe = (p.x - o.x) * e.x + (p.y - o.y) * e.y;
+      const double pn = -(p.x - o.x) * e.y + (p.y - o.y) * e.x;
       minE = std::min(minE, pe);
       maxE = std::max(maxE, pe);
       minN = std::min(minN, pn);
       maxN = std::max(maxN, pn);
     }
     const double w = maxE - minE, h = maxN - minN;
-    if (w * h < bestArea * (1 - 1e-12)) {
+    if (w * h < bestArea * (1 - 1e-9)) {
       bestArea = w * h;
       const double ce = 0.5 * (minE + maxE), cn = 0.5 * (minN + maxN);
-      best.center = {a.x + ce * e.x + cn * nrm.x, a.y + ce * e.y + cn * nrm.y};
+      best.center = {o.x + ce * e.x - cn * e.y, o.y + ce * e.y + cn * e.x};
       if (w >= h) {
         best.u = e;
         best.length = w;
         best.width = h;
       } else {
-        best.u = nrm;
+        best.u = {-e.y, e.x};
         best.length = h;
         best.width = w;
       }
     }
+  }
+  return best;
+}
+
+OrientedBox minimumAreaBox(const Ring& ring) {
+  const Ring hull = convexHull(ring);
+  if (hull.size() >= 3) return smallestBoxAlongEdges(hull, hull);
+  OrientedBox best;  // degenerate: a segment or a point
+  if (hull.size() == 2) {
+    const double dx = hull[1].x - hull[0].x, dy = hull[1].y - hull[0].y;
+    const double l = norm(dx, dy);
+    best.center = {0.5 * (hull[0].x + hull[1].x), 0.5 * (hull[0].y + hull[1].y)};
+    if (l > 0) best.u = {dx / l, dy / l};
+    best.length = l;
+  } else if (hull.size() == 1) {
+    best.center = hull[0];
   }
   return best;
 }

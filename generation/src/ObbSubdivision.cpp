@@ -65,44 +65,7 @@ struct Rng {
 
 // The OBB of Vanegas et al.: the smallest box with a side along one of the
 // ring's own edges (edge-aligned, so small edits elsewhere do not turn it).
-OrientedBox edgeAlignedBox(const Ring& ring) {
-  const Ring hull = convexHull(ring);
-  OrientedBox best;
-  double bestArea = std::numeric_limits<double>::max();
-  for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
-    const Point& a = ring[i];
-    const Point& b = ring[(i + 1) % n];
-    const double l = norm(b.x - a.x, b.y - a.y);
-    if (l <= 0) continue;
-    const Point e{(b.x - a.x) / l, (b.y - a.y) / l};
-    double minE = std::numeric_limits<double>::max(), maxE = std::numeric_limits<double>::lowest();
-    double minN = minE, maxN = maxE;
-    for (const Point& p : hull) {
-      const double pe = p.x * e.x + p.y * e.y;
-      const double pn = -p.x * e.y + p.y * e.x;
-      minE = std::min(minE, pe);
-      maxE = std::max(maxE, pe);
-      minN = std::min(minN, pn);
-      maxN = std::max(maxN, pn);
-    }
-    const double w = maxE - minE, h = maxN - minN;
-    if (w * h < bestArea * (1 - 1e-9)) {
-      bestArea = w * h;
-      const double ce = 0.5 * (minE + maxE), cn = 0.5 * (minN + maxN);
-      best.center = {ce * e.x - cn * e.y, ce * e.y + cn * e.x};
-      if (w >= h) {
-        best.u = e;
-        best.length = w;
-        best.width = h;
-      } else {
-        best.u = {-e.y, e.x};
-        best.length = h;
-        best.width = w;
-      }
-    }
-  }
-  return best;
-}
+OrientedBox edgeAlignedBox(const Ring& ring) { return smallestBoxAlongEdges(convexHull(ring), ring); }
 
 class Subdivider {
 public:

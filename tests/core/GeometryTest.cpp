@@ -81,12 +81,10 @@ TEST(Geometry, InteriorPointOfConcaveShapeIsInside) {
   EXPECT_TRUE(pointInPolygon(interiorPoint(u), u));
 }
 
-TEST(Geometry, WithinDistanceDetectsGapsAndContainment) {
-  const Polygon a = rect(0, 0, 10, 10);
-  EXPECT_TRUE(withinDistance(a, rect(10.5, 0, 20, 10), 1.0));
-  EXPECT_FALSE(withinDistance(a, rect(11.5, 0, 20, 10), 1.0));
-  EXPECT_TRUE(withinDistance(a, rect(3, 3, 4, 4), 0.1));  // inside
-  EXPECT_NEAR(boundaryDistance(a, rect(12, 0, 20, 10)), 2.0, 1e-12);
+TEST(Geometry, SegmentDistanceIsZeroForCrossingSegments) {
+  EXPECT_DOUBLE_EQ(segmentDistance({0, 0}, {10, 10}, {0, 10}, {10, 0}), 0.0);
+  EXPECT_DOUBLE_EQ(segmentDistance({0, 0}, {10, 0}, {0, 2}, {10, 2}), 2.0);
+  EXPECT_DOUBLE_EQ(segmentDistance({0, 0}, {10, 0}, {13, 4}, {20, 4}), 5.0);  // end to end
 }
 
 TEST(Geometry, ConvexHullDropsInteriorAndCollinearPoints) {

@@ -66,12 +66,6 @@ Point interiorPoint(const Polygon& polygon);
 double pointSegmentDistance(const Point& p, const Point& a, const Point& b);
 /// Distance in m between segments [a, b] and [c, d] (0 when they cross).
 double segmentDistance(const Point& a, const Point& b, const Point& c, const Point& d);
-/// Smallest distance in m between the boundaries of two polygons (0 if they cross).
-double boundaryDistance(const Polygon& a, const Polygon& b);
-
-/// True when the boundaries of `a` and `b` come within `distance` m of each
-/// other, or one polygon lies inside the other. Stops at the first close pair.
-bool withinDistance(const Polygon& a, const Polygon& b, double distance);
 
 /// A fast, conservative validity test for one ring: true only when the ring
 /// clearly is simple (no edge comes within 1e-9 of the ring's size of a
@@ -90,6 +84,13 @@ struct OrientedBox {
   double width = 0;    ///< short side (m)
   double area() const { return length * width; }
 };
+
+/// The smallest rectangle enclosing the convex ring `hull` that has a side
+/// parallel to one of the edges of `edges` (closed ring, any orientation).
+/// Ties go to the first such edge. With edges = hull this is the minimum-area
+/// rectangle; with edges = a polygon's own ring it is the edge-aligned box of
+/// Vanegas et al. 2012, 4.3.
+OrientedBox smallestBoxAlongEdges(const Ring& hull, const Ring& edges);
 
 /// Minimum-area enclosing rectangle of a ring (rotating calipers over the convex
 /// hull: the optimum has a side on a hull edge). Ties are broken towards the

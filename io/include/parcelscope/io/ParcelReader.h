@@ -66,7 +66,4 @@ struct ParcelLayer {
 /// `crsOverride` is not a CRS GDAL knows.
 ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress = {});
 
-/// Names of the layers of a vector dataset (for `--layer` help and the GUI).
-std::vector<std::string> listLayers(const std::string& path);
-
 }  // namespace parcelscope::io
