@@ -161,6 +161,8 @@ TEST(ParcelReader, RefusesLonLatClaimForCoordinatesThatCannotBeDegrees) {
   EXPECT_TRUE(l.crs.overridden);
   EXPECT_NEAR(totalArea(l), 100 * 100 * 0.3048006096 * 0.3048006096, 1e-6);
   expectError(options(path, "", "", "EPSG:99999999"), Error::Kind::Usage, {"--crs", "EPSG:99999999"});
+  // A CRS that exists but has no plane to measure in (geocentric).
+  expectError(options(path, "", "", "EPSG:4978"), Error::Kind::Input, {"feet.geojson", "neither geographic nor projected"});
 }
 
 TEST(ParcelReader, RefusesProjectedCoordinatesWithoutCrs) {
