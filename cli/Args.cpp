@@ -59,6 +59,7 @@ std::optional<std::string> Args::value(const std::string& flag) const {
 std::string usageText(const std::string& synopsis, const std::vector<FlagSpec>& flags,
                       const std::vector<ParameterDescription>& parameters) {
   std::ostringstream s;
+  s.precision(12);
   s << "usage: " << synopsis << "\n\noptions:\n";
   for (const auto& f : flags) {
     s << "  --" << f.name << (f.takesValue ? " VALUE" : "") << "\n      " << f.help << "\n";
