@@ -78,7 +78,9 @@ bool coveredInterval(const Point& p, const Point& q, const Point& r, const Point
   // Offsets of r and s from the line of [p, q] and their positions along it.
   const double dr = (r.x - p.x) * -uy + (r.y - p.y) * ux;
   const double ds = (s.x - p.x) * -uy + (s.y - p.y) * ux;
-  if (std::fabs(dr) > tolerance && std::fabs(ds) > tolerance) return false;
+  // Both ends beyond the tolerance on the same side: no part is close. (Ends on
+  // opposite sides cross the band, and the clipping below keeps the middle.)
+  if ((dr > tolerance && ds > tolerance) || (dr < -tolerance && ds < -tolerance)) return false;
   const double tr = (r.x - p.x) * ux + (r.y - p.y) * uy;
   const double ts = (s.x - p.x) * ux + (s.y - p.y) * uy;
   double a = std::min(tr, ts), b = std::max(tr, ts);
@@ -111,7 +113,9 @@ double unionLength(std::vector<std::pair<double, double>>& intervals) {
   return total + (hi - lo);
 }
 
-std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons, double tolerance) {
+std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons, double tolerance,
+                              double sharedTolerance) {
+  if (sharedTolerance < 0 || sharedTolerance > tolerance) sharedTolerance = tolerance;
   std::vector<EdgeInfo> edges;
   std::vector<EdgeBox> boxes;
   for (std::size_t i = 0; i < polygons.size(); ++i) {
@@ -151,8 +155,12 @@ std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons, doubl
       if (segmentDistance(*e.p, *e.q, *f.p, *f.q) > tolerance) return;
       half.closePairs.emplace_back(std::min(e.polygon, f.polygon), std::max(e.polygon, f.polygon));
       double lo = 0, hi = 0;
-      if (coveredInterval(*e.p, *e.q, *f.p, *f.q, tolerance, lo, hi)) half.covers.push_back({x.info(), f.polygon, lo, hi});
-      if (coveredInterval(*f.p, *f.q, *e.p, *e.q, tolerance, lo, hi)) half.covers.push_back({y.info(), e.polygon, lo, hi});
+      if (coveredInterval(*e.p, *e.q, *f.p, *f.q, sharedTolerance, lo, hi)) {
+        half.covers.push_back({x.info(), f.polygon, lo, hi});
+      }
+      if (coveredInterval(*f.p, *f.q, *e.p, *e.q, sharedTolerance, lo, hi)) {
+        half.covers.push_back({y.info(), e.polygon, lo, hi});
+      }
     });
   };
   if (parallel) {

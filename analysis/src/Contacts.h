@@ -16,8 +16,10 @@ struct Contact {
 };
 
 /// Contacts between every pair of `polygons` whose boundaries come within
-/// `tolerance` m, sorted by (a, b).
-std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons, double tolerance);
+/// `closeTolerance` m, sorted by (a, b). Shared lengths count edges within
+/// `sharedTolerance` (<= closeTolerance; negative means the same).
+std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons, double closeTolerance,
+                              double sharedTolerance = -1);
 
 /// For each polygon, the length in m of its boundary running along `rings`
 /// (within `tolerance`, parallel within 10 degrees).

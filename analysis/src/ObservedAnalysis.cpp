@@ -72,6 +72,16 @@ struct DisjointSets {
 
 // Minimum shared boundary (m) for two parcels to count as neighbours.
 constexpr double kMinSharedBoundary = 1.0;
+
+// Shared boundaries match edges within the block tolerance, but never farther
+// than 1 m: a large tolerance joins blocks, it must not make lots across an
+// alley into neighbours.
+double sharedTolerance(double blockTolerance) { return std::clamp(blockTolerance, 1e-6, 1.0); }
+
+// The block outline lies on its parcels' street edges except where the closing
+// bridged a gap (at most half the tolerance away); frontage matches within that,
+// between 5 cm and 0.5 m, so rear edges near the street do not count.
+double frontageTolerance(double blockTolerance) { return std::clamp(0.5 * blockTolerance, 0.05, 0.5); }
 // Right-of-way: an MBR width at least kNetworkWidthRatio times the strip width
 // 2A/P (a rectangular lot of any proportions stays below 2), and either holes
 // holding other parcels or at least kNetworkMinNeighbours neighbours.
@@ -129,7 +139,7 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
   // 2. Shared boundaries (neighbours) and closeness, edge by edge.
   std::vector<const Polygon*> shapes(n);
   for (std::size_t i = 0; i < n; ++i) shapes[i] = &parcels[i].shape;
-  const auto touching = detail::contacts(shapes, std::max(tol, 1e-6));
+  const auto touching = detail::contacts(shapes, std::max(tol, 1e-6), sharedTolerance(tol));
   for (const auto& c : touching) {
     if (c.shared >= kMinSharedBoundary) {
       ++out.metrics[c.a].neighbours;
@@ -200,7 +210,7 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
   }
 
   // 5. Block outlines, frontage and statistics.
-  const double frontTol = std::max(tol, 0.05);
+  const double frontTol = frontageTolerance(tol);
   out.timings.start("block_outlines");
   // Largest blocks first, so that one big block does not finish last alone.
   std::vector<std::size_t> bySize(out.blocks.size());
@@ -262,7 +272,7 @@ std::vector<ParcelMetrics> measureParcels(const std::vector<Polygon>& shapes, co
   });
   std::vector<const Polygon*> all;
   for (const Polygon& s : shapes) all.push_back(&s);
-  for (const auto& c : detail::contacts(all, std::max(tolerance, 1e-6))) {
+  for (const auto& c : detail::contacts(all, std::max(tolerance, 1e-6), sharedTolerance(tolerance))) {
     if (c.shared >= kMinSharedBoundary) {
       ++metrics[c.a].neighbours;
       ++metrics[c.b].neighbours;
@@ -273,7 +283,7 @@ std::vector<ParcelMetrics> measureParcels(const std::vector<Polygon>& shapes, co
     for (int i : block.parcels) members.push_back(&shapes[i]);
     std::vector<Ring> outline;
     for (const Polygon& part : block.parts) outline.push_back(part.outer);
-    const auto frontage = detail::lengthAlong(members, outline, std::max(tolerance, 0.05));
+    const auto frontage = detail::lengthAlong(members, outline, frontageTolerance(tolerance));
     for (std::size_t k = 0; k < block.parcels.size(); ++k) {
       ParcelMetrics& m = metrics[block.parcels[k]];
       m.frontage = frontage[k];

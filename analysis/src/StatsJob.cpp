@@ -41,6 +41,8 @@ void addObservedRecord(Json& record, const ObservedData& data) {
                     .set("features", r.features)
                     .set("null_or_empty_skipped", r.nullOrEmpty)
                     .set("non_polygonal_skipped", r.nonPolygonal)
+                    .set("non_polygonal_parts_dropped", r.nonPolygonalParts)
+                    .set("non_finite_skipped", r.nonFiniteSkipped)
                     .set("multipart_features_split", r.multipartFeatures)
                     .set("parcels_from_multipart", r.partsFromMultipart)
                     .set("parcels_with_holes", r.withHoles)
@@ -73,6 +75,7 @@ std::string summarize(const ObservedData& data) {
     << " multipart features split into " << r.partsFromMultipart << " parcels, " << r.duplicatesCollapsed
     << " duplicates collapsed into " << r.duplicateStacks << " stacks\n"
     << "  skipped: " << r.nullOrEmpty << " null or empty, " << r.nonPolygonal << " not polygons, "
+    << r.nonFiniteSkipped << " with non-finite coordinates, "
     << r.invalidSkipped << " beyond repair, " << r.degenerateSkipped << " degenerate parts\n"
     << "  " << a.rightOfWayCount << " right-of-way parcels kept out of blocks\n"
     << "  " << a.blocks.size() << " blocks (" << a.clampedAMin << " with A_min clamped, " << a.clampedWMin

@@ -1,6 +1,7 @@
 #include "parcelscope/generation/GenerateJob.h"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "parcelscope/analysis/StatsJob.h"
 #include "parcelscope/core/Error.h"
@@ -23,6 +24,18 @@ ObbParameters blockParameters(const GenerateRequest& request, double aMin, doubl
   return p;
 }
 
+namespace {
+// A block's seed key: its centroid in the input CRS, rounded to about 0.1 m, so
+// that adding, removing or renumbering other blocks does not reseed it.
+std::int64_t positionKey(const Polygon& shape, const io::LocalFrame& frame) {
+  const Point c = frame.toSource(centroid(shape));
+  const double q = frame.isGeographic() ? 1e-6 : 0.1;
+  const auto qx = static_cast<std::uint64_t>(std::llround(c.x / q));
+  const auto qy = static_cast<std::uint64_t>(std::llround(c.y / q));
+  return static_cast<std::int64_t>(qx * 0x9E3779B97F4A7C15ull ^ qy);
+}
+}  // namespace
+
 GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& progress) {
   if (request.style != "obb") {
     throw usageError("--style " + request.style + " is not available (styles: obb)");
@@ -39,7 +52,6 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
     std::int64_t blockId;
     Polygon shape;
     ObbParameters p;
-    int part;
   };
   std::vector<Unit> units;
   if (request.fromParcels) {
@@ -48,9 +60,8 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
     for (std::size_t b = 0; b < observed.analysis.blocks.size(); ++b) {
       const auto& s = observed.analysis.statistics[b];
       const ObbParameters p = blockParameters(request, s.aMin, s.aMax, s.wMin, s.wMax);
-      int part = 0;
       for (const Polygon& shape : observed.analysis.blocks[b].parts) {
-        units.push_back({observed.analysis.blocks[b].id, shape, p, part++});
+        units.push_back({observed.analysis.blocks[b].id, shape, p});
       }
     }
     out.source = std::move(observed.layer);
@@ -61,11 +72,25 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
     for (std::size_t i = 0; i < out.source.parcels.size(); ++i) {
       const auto& f = out.source.fields[i];
       const std::int64_t id = std::isfinite(f[0]) ? static_cast<std::int64_t>(f[0]) : out.source.parcels[i].sourceFid;
-      units.push_back({id, out.source.parcels[i].shape, blockParameters(request, f[1], f[2], f[3], f[4]),
-                       out.source.parcels[i].part});
+      units.push_back({id, out.source.parcels[i].shape, blockParameters(request, f[1], f[2], f[3], f[4])});
     }
   }
+  const auto& descriptions = obbParameterDescriptions();
+  auto describe = [&](const char* name) -> const ParameterDescription& {
+    for (const auto& d : descriptions) {
+      if (d.name == name) return d;
+    }
+    throw std::logic_error(name);
+  };
   for (const Unit& u : units) {
+    try {
+      checkValue(describe("a-min"), u.p.aMin);
+      checkValue(describe("a-max"), u.p.aMax);
+      checkValue(describe("w-min"), u.p.wMin);
+      checkValue(describe("w-max"), u.p.wMax);
+    } catch (const Error& e) {
+      throw inputError(request.input.path + ": block " + std::to_string(u.blockId) + ": " + e.what());
+    }
     if (u.p.aMin > u.p.aMax || u.p.wMin > u.p.wMax) {
       throw usageError("block " + std::to_string(u.blockId) +
                        ": its bounds conflict with the ones given (A_min > A_max or W_min > W_max)");
@@ -79,7 +104,7 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
       units.size(),
       [&](std::size_t k) {
         const Unit& u = units[k];
-        results[k] = subdivideObb(u.shape, u.p, blockSeed(out.seed, u.blockId * 64 + u.part));
+        results[k] = subdivideObb(u.shape, u.p, blockSeed(out.seed, positionKey(u.shape, out.source.frame)));
       },
       [&](std::size_t done) {
         reportProgress(sub, static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(1, units.size())),

@@ -13,9 +13,9 @@ namespace parcelscope::generation {
 const std::vector<ParameterDescription>& obbParameterDescriptions() {
   static const std::vector<ParameterDescription> d = {
       {"a-min", "Smallest parcel area a split may create", "m2", 0.0, 1e8, 200.0},
-      {"a-max", "Parcels larger than this are split", "m2", 0.0, 1e8, 800.0},
+      {"a-max", "Parcels larger than this are split", "m2", 1.0, 1e8, 800.0},
       {"w-min", "Smallest parcel width (OBB short side) a split may create", "m", 0.0, 1e5, 8.0},
-      {"w-max", "Parcels wider than this are split", "m", 0.0, 1e5, 30.0},
+      {"w-max", "Parcels wider than this are split", "m", 0.1, 1e5, 30.0},
       {"omega", "Split irregularity: the split line moves up to omega x 1/4 of the parcel's length off centre",
        "", 0.0, 1.0, 0.3},
       {"xi", "Street-access preference: probability that a split leaving a parcel without street access is "
@@ -66,6 +66,8 @@ struct Rng {
 // The OBB of Vanegas et al.: the smallest box with a side along one of the
 // ring's own edges (edge-aligned, so small edits elsewhere do not turn it).
 OrientedBox edgeAlignedBox(const Ring& ring) { return smallestBoxAlongEdges(convexHull(ring), ring); }
+
+constexpr std::size_t kMaxParcelsPerBlock = 200000;
 
 class Subdivider {
 public:
@@ -168,7 +170,9 @@ private:
     const double a = area(piece);
     const OrientedBox measured = minimumAreaBox(piece.outer);
     const bool fits = a <= p_.aMax && measured.width <= p_.wMax;
-    if (fits || depth > 60) {
+    // Safety nets against pathological bounds: recursion depth and a budget of
+    // parcels per block.
+    if (fits || depth > 60 || out_.parcels.size() >= kMaxParcelsPerBlock) {
       emit(piece, access, !fits);
       return;
     }
@@ -258,17 +262,9 @@ Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, 
   ObbParameters p = parameters;
   p.aMax = std::max(p.aMax, p.aMin);
   p.wMax = std::max(p.wMax, p.wMin);
-  // Work near the origin: the exact kernel is faster, and areas are accurate.
-  const Box b = bounds(block);
-  const Point o{0.5 * (b.minX + b.maxX), 0.5 * (b.minY + b.maxY)};
-  auto shift = [](const Polygon& in, double dx, double dy) {
-    Polygon r = in;
-    for (Point& q : r.outer) q = {q.x + dx, q.y + dy};
-    for (Ring& h : r.holes)
-      for (Point& q : h) q = {q.x + dx, q.y + dy};
-    return r;
-  };
-  Polygon local = shift(block, -o.x, -o.y);
+  // No shift to the origin: io/ already works near it, and a shift and its
+  // inverse would round vertices that the validity checks have passed.
+  Polygon local = block;
   try {
     if (!normalise(local) || !detail::isValidForSplit(local)) {
       out.failed = true;
@@ -285,7 +281,6 @@ Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, 
     out.parcels = {block};
     return out;
   }
-  for (Polygon& parcel : out.parcels) parcel = shift(parcel, o.x, o.y);
   return out;
 }
 

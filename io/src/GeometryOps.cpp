@@ -87,9 +87,12 @@ std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, 
   if (!result) throw geometryError("union of " + std::to_string(polygons.size()) + " parcels failed");
   // Parts smaller than half a tolerance square are artefacts of the closing.
   const double minArea = closeDistance > 0 ? 0.5 * closeDistance * closeDistance : 1e-6;
-  std::vector<Polygon> parts;
-  for (auto& p : polygonsOf(*result)) {
-    if (area(p) >= minArea) parts.push_back(std::move(p));
+  std::vector<Polygon> all = polygonsOf(*result), parts;
+  double largest = 0;
+  for (const Polygon& p : all) largest = std::max(largest, area(p));
+  for (auto& p : all) {
+    const double a = area(p);
+    if (a >= minArea || a == largest) parts.push_back(std::move(p));  // never drop the whole block
   }
   return parts;
 }

@@ -7,8 +7,9 @@ namespace parcelscope::io {
 
 LocalFrame::LocalFrame() = default;
 
-LocalFrame LocalFrame::geographic(double lon0, double lat0, double a, double f) {
+LocalFrame LocalFrame::geographic(double lon0, double lat0, double a, double f, double degreesPerUnit) {
   LocalFrame frame;
+  frame.unit_ = degreesPerUnit;
   frame.tm_ = std::make_shared<GeographicLib::TransverseMercator>(a, f, 1.0);
   frame.lon0_ = lon0;
   frame.lat0_ = lat0;
@@ -30,7 +31,7 @@ LocalFrame LocalFrame::projected(double metresPerUnit, double x0, double y0) {
 Point LocalFrame::toLocal(double x, double y) const {
   if (tm_) {
     double e = 0, n = 0;
-    tm_->Forward(lon0_, y, x, e, n);
+    tm_->Forward(lon0_, y * unit_, x * unit_, e, n);
     return {e - x0_, n - y0_};
   }
   return {(x - x0_) * unit_, (y - y0_) * unit_};
@@ -40,7 +41,7 @@ Point LocalFrame::toSource(const Point& p) const {
   if (tm_) {
     double lat = 0, lon = 0;
     tm_->Reverse(lon0_, p.x + x0_, p.y + y0_, lat, lon);
-    return {lon, lat};
+    return {lon / unit_, lat / unit_};
   }
   return {p.x / unit_ + x0_, p.y / unit_ + y0_};
 }

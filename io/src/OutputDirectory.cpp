@@ -1,6 +1,9 @@
 #include "parcelscope/io/OutputDirectory.h"
 
+#include <signal.h>
 #include <unistd.h>
+
+#include <cerrno>
 
 #include <filesystem>
 
@@ -34,7 +37,16 @@ OutputDirectory::OutputDirectory(std::string target, const std::vector<std::stri
     fs::create_directories(parent, ec);
     if (ec) throw ioError(target_ + ": cannot create parent directory (" + ec.message() + ")");
   }
-  staging_ = (parent / ("." + t.filename().string() + ".partial-" + std::to_string(::getpid()))).string();
+  const std::string prefix = "." + t.filename().string() + ".partial-";
+  // Staging folders of runs that were killed (their process is gone) are removed.
+  for (const auto& entry : fs::directory_iterator(parent, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::string pid = name.substr(prefix.size());
+    if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    if (::kill(static_cast<pid_t>(std::stol(pid)), 0) != 0 && errno == ESRCH) fs::remove_all(entry.path(), ec);
+  }
+  staging_ = (parent / (prefix + std::to_string(::getpid()))).string();
   fs::remove_all(staging_, ec);
   if (!fs::create_directory(staging_, ec)) {
     throw ioError(target_ + ": cannot create staging directory " + staging_ + " (" + ec.message() + ")");

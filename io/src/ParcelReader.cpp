@@ -62,14 +62,27 @@ struct Feature {
 struct Envelope {
   double minX = std::numeric_limits<double>::max(), minY = minX;
   double maxX = std::numeric_limits<double>::lowest(), maxY = maxX;
+  std::vector<double> centresX, centresY;
   void merge(const OGREnvelope& e) {
     minX = std::min(minX, e.MinX);
     minY = std::min(minY, e.MinY);
     maxX = std::max(maxX, e.MaxX);
     maxY = std::max(maxY, e.MaxY);
+    centresX.push_back(0.5 * (e.MinX + e.MaxX));
+    centresY.push_back(0.5 * (e.MinY + e.MaxY));
   }
-  bool looksLikeDegrees() const {
-    return minX >= -180.0 && maxX <= 180.0 && minY >= -90.0 && maxY <= 90.0;
+  // `unit`: degrees per coordinate unit of a geographic CRS.
+  bool looksLikeDegrees(double unit = 1.0) const {
+    return minX * unit >= -180.0 && maxX * unit <= 180.0 && minY * unit >= -90.0 && maxY * unit <= 90.0;
+  }
+  // The median of the features' centres: one stray feature far away (a record
+  // at 0, 0, say) does not move the local frame off the data.
+  Point centre() {
+    auto median = [](std::vector<double>& v) {
+      std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+      return v[v.size() / 2];
+    };
+    return {median(centresX), median(centresY)};
   }
 };
 
@@ -81,10 +94,10 @@ std::string fmt(double v) {
 }
 
 // Chooses the local frame and records the CRS, or throws when the CRS cannot be used.
-LocalFrame chooseFrame(const std::string& path, const OGRSpatialReference* srs,
-                       const Envelope& env, CrsInfo& crs) {
-  const double cx = 0.5 * (env.minX + env.maxX);
-  const double cy = 0.5 * (env.minY + env.maxY);
+LocalFrame chooseFrame(const std::string& path, const OGRSpatialReference* srs, Envelope& env,
+                       CrsInfo& crs) {
+  const Point c = env.centre();
+  const double cx = c.x, cy = c.y;
   const std::string hint = "; give the real CRS with --crs EPSG:N";
   if (!srs) {
     if (!env.looksLikeDegrees()) {
@@ -103,7 +116,9 @@ LocalFrame chooseFrame(const std::string& path, const OGRSpatialReference* srs,
     crs.name += std::string(" (") + (auth ? auth : "") + ":" + code + ")";
   }
   if (srs->IsGeographic()) {
-    if (!env.looksLikeDegrees()) {
+    const double degreesPerUnit = srs->GetAngularUnits() * 180.0 / M_PI;  // 0.9 for grads
+    if (!(degreesPerUnit > 0)) throw inputError(path + ": CRS " + crs.name + " has no usable angular unit");
+    if (!env.looksLikeDegrees(degreesPerUnit)) {
       throw inputError(path + ": the layer claims lon/lat (" + crs.name + ") but its coordinates (x " +
                        fmt(env.minX) + " to " + fmt(env.maxX) + ", y " + fmt(env.minY) + " to " +
                        fmt(env.maxY) + ") cannot be degrees" + hint);
@@ -111,7 +126,8 @@ LocalFrame chooseFrame(const std::string& path, const OGRSpatialReference* srs,
     OGRErr err = OGRERR_NONE;
     const double a = srs->GetSemiMajor(&err);
     const double invf = srs->GetInvFlattening(&err);
-    return LocalFrame::geographic(cx, cy, a, invf > 0 ? 1.0 / invf : 0.0);
+    return LocalFrame::geographic(cx * degreesPerUnit, cy * degreesPerUnit, a, invf > 0 ? 1.0 / invf : 0.0,
+                                  degreesPerUnit);
   }
   if (srs->IsProjected()) {
     const double unit = srs->GetLinearUnits();
@@ -141,6 +157,8 @@ void projectInPlace(OGRGeometry& g, const LocalFrame& frame) {
 struct Cleaned {
   std::vector<Parcel> parcels;
   bool nonPolygonal = false, repaired = false, repairFailed = false;
+  bool mixed = false;  // points or lines dropped beside polygons
+  int inputParts = 0;  // polygon parts of the input geometry
   int degenerate = 0;
 };
 
@@ -148,10 +166,13 @@ Cleaned cleanFeature(const Feature& f, const LocalFrame& frame) {
   QuietErrors quiet;  // error handlers are per thread
   Cleaned c;
   std::vector<std::unique_ptr<OGRPolygon>> polygons;
-  if (!detail::collectPolygons(*f.geometry, polygons) && polygons.empty()) {
+  const bool onlyPolygons = detail::collectPolygons(*f.geometry, polygons);
+  if (polygons.empty()) {
     c.nonPolygonal = true;
     return c;
   }
+  c.mixed = !onlyPolygons;
+  c.inputParts = static_cast<int>(polygons.size());
   for (auto& p : polygons) projectInPlace(*p, frame);
   // Fast path: a single ring that is clearly simple needs no GEOS check.
   if (polygons.size() == 1 && polygons[0]->getNumInteriorRings() == 0) {
@@ -291,6 +312,12 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
     }
     OGREnvelope e;
     g->getEnvelope(&e);
+    if (!std::isfinite(e.MinX) || !std::isfinite(e.MinY) || !std::isfinite(e.MaxX) || !std::isfinite(e.MaxY) ||
+        std::fabs(e.MinX) > 1e12 || std::fabs(e.MaxX) > 1e12 || std::fabs(e.MinY) > 1e12 ||
+        std::fabs(e.MaxY) > 1e12) {
+      ++report.nonFiniteSkipped;  // NaN, infinite or absurd coordinates
+      continue;
+    }
     env.merge(e);
     std::vector<double> values;
     for (int idx : fieldIndex) {
@@ -336,7 +363,8 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
     report.degenerateSkipped += c.degenerate;
     if (c.repairFailed || (c.repaired && c.parcels.empty())) ++report.invalidSkipped;
     if (c.repaired && !c.parcels.empty()) ++report.invalidRepaired;
-    if (c.parcels.size() > 1) {
+    report.nonPolygonalParts += c.mixed;
+    if (c.inputParts > 1) {
       ++report.multipartFeatures;
       report.partsFromMultipart += static_cast<std::int64_t>(c.parcels.size());
     }

@@ -70,6 +70,26 @@ TEST(ObservedAnalysis, TouchingAndNearlyTouchingLotsFormBlocks) {
   EXPECT_EQ(analyseParcels(parcels, o).blocks.size(), 3u);
 }
 
+TEST(ObservedAnalysis, LargeToleranceKeepsALoneBlockAndDoesNotInventFrontage) {
+  // A lone lot: its block is the lot itself whatever the tolerance.
+  AnalysisOptions wide;
+  wide.blockTolerance = 30;
+  const ObservedAnalysis lone = analyseParcels(parcelsOf({rect(0, 0, 20, 20)}), wide);
+  ASSERT_EQ(lone.blocks.size(), 1u);
+  ASSERT_EQ(lone.blocks[0].parts.size(), 1u);
+  EXPECT_NEAR(lone.statistics[0].blockArea, 400, 1e-6);
+  EXPECT_TRUE(lone.metrics[0].streetAccess);
+  // 3 rows of 8 m deep lots: the middle row has no frontage, even with a 10 m tolerance.
+  std::vector<Polygon> shapes;
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 4; ++col) shapes.push_back(rect(col * 20, row * 8, col * 20 + 20, row * 8 + 8));
+  wide.blockTolerance = 10;
+  const ObservedAnalysis grid = analyseParcels(parcelsOf(shapes), wide);
+  EXPECT_NEAR(grid.metrics[5].frontage, 0, 1e-9);
+  EXPECT_NEAR(grid.metrics[6].frontage, 0, 1e-9);
+  EXPECT_FALSE(grid.metrics[5].streetAccess);
+}
+
 TEST(ObservedAnalysis, InnerLotHasNoStreetAccess) {
   // 3 x 3 grid: the middle lot touches no street.
   std::vector<Polygon> shapes;

@@ -142,6 +142,7 @@ TEST(GenerateCommand, BadStyleAndConflictingBoundsAreUsageErrors) {
   EXPECT_EQ(run("generate '" + kSample + "' --style voronoi --out '" + dir.file("x") + "' --quiet").code, 2);
   const CliRun r = run("generate '" + kSample + "' --a-min 900 --a-max 100 --out '" + dir.file("x") + "' --quiet");
   EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_EQ(run("generate '" + kSample + "' --a-max 0 --out '" + dir.file("x") + "' --quiet").code, 2);
   EXPECT_FALSE(fs::exists(dir.file("x")));
 }
 

@@ -44,6 +44,18 @@ TEST(OutputDirectory, FilesAppearOnlyOnCommit) {
   EXPECT_TRUE(fs::exists(target + "/b.csv"));
 }
 
+TEST(OutputDirectory, StagingOfAKilledRunIsRemovedByTheNext) {
+  TempDir dir;
+  const fs::path stale = dir.path() / ".out.partial-999999999";  // no such process
+  fs::create_directories(stale);
+  std::ofstream((stale / "parcels.csv").string()) << "x\n";
+  {
+    OutputDirectory out(dir.file("out"), {});
+    out.commit();
+  }
+  EXPECT_FALSE(fs::exists(stale));
+}
+
 TEST(OutputDirectory, NeverOverwritesAnInput) {
   TempDir dir;
   const auto input = dir.write("parcels.csv", "x\n");

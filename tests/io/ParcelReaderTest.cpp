@@ -80,8 +80,8 @@ TEST(ParcelReader, CleaningCountsEveryRepairSplitCollapseAndSkip) {
   EXPECT_EQ(r.duplicatesCollapsed, 1);
   EXPECT_EQ(r.duplicateStacks, 1);
   EXPECT_EQ(r.invalidRepaired, 1);  // the bow-tie, made valid as two triangles
-  EXPECT_EQ(r.multipartFeatures, 2);
-  EXPECT_EQ(r.partsFromMultipart, 4);
+  EXPECT_EQ(r.multipartFeatures, 1);  // the MultiPolygon; the repaired bow-tie is not one
+  EXPECT_EQ(r.partsFromMultipart, 2);
   EXPECT_EQ(r.withHoles, 1);
   EXPECT_EQ(r.parcels, 6);
   ASSERT_EQ(l.parcels.size(), 6u);
@@ -91,6 +91,36 @@ TEST(ParcelReader, CleaningCountsEveryRepairSplitCollapseAndSkip) {
     EXPECT_GT(signedArea(p.shape.outer), 0);
     for (const auto& h : p.shape.holes) EXPECT_LT(signedArea(h), 0);
   }
+}
+
+TEST(ParcelReader, StrayAndNonFiniteFeaturesDoNotMoveTheFrame) {
+  TempDir dir;
+  const double lon = 127.08, lat = 37.51, d = 0.0002;
+  const std::string square = R"({"type":"Polygon","coordinates":[)" + test::squareRing(lon, lat, d) + "]}";
+  const auto alone = dir.write("alone.geojson", test::collection(test::feature(square, 1)));
+  // The same square, plus a stray record at 0, 0 and one with an absurd coordinate.
+  const auto stray = dir.write(
+      "stray.geojson",
+      test::collection(test::feature(square, 1) + "," +
+                       test::feature(R"({"type":"Polygon","coordinates":[)" + test::squareRing(0, 0, d) + "]}", 5) +
+                       "," +
+                       test::feature(R"({"type":"Polygon","coordinates":[[[1e300,0],[1e300,1],[0,1],[1e300,0]]]})", 7)));
+  const double a = area(readParcels(options(alone)).parcels[0].shape);
+  const ParcelLayer l = readParcels(options(stray));
+  EXPECT_EQ(l.report.nonFiniteSkipped, 1);
+  EXPECT_NEAR(area(l.parcels[0].shape), a, 1e-6 * a);
+}
+
+TEST(ParcelReader, GeographicCrsInGradsIsConverted) {
+  TempDir dir;
+  // 0.001 grad squares near Paris, read as NTF (Paris) in grads and as the same square in degrees.
+  const std::string g = R"({"type":"Polygon","coordinates":[)" + test::squareRing(0.0, 54.27, 0.001) + "]}";
+  const std::string deg = R"({"type":"Polygon","coordinates":[)" + test::squareRing(0.0, 54.27 * 0.9, 0.0009) + "]}";
+  const auto grads = dir.write("grads.geojson", test::collection(test::feature(g, 1)));
+  const auto degrees = dir.write("degrees.geojson", test::collection(test::feature(deg, 1)));
+  const double inGrads = area(readParcels(options(grads, "", "", "EPSG:4807")).parcels[0].shape);
+  const double inDegrees = area(readParcels(options(degrees)).parcels[0].shape);
+  EXPECT_NEAR(inGrads / inDegrees, 1.0, 1e-3);  // same square; ellipsoids differ slightly
 }
 
 TEST(ParcelReader, ProjectedAreaMatchesGeodesicArea) {

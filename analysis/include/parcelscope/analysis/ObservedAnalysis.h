@@ -31,8 +31,8 @@ const std::vector<ParameterDescription>& analysisParameters();
 AnalysisOptions analysisOptionsFrom(const ParameterValues& values);
 
 struct ParcelMetrics : ShapeMetrics {
-  int neighbours = 0;        ///< parcels sharing >= 1 m of boundary (within the block tolerance)
-  double frontage = 0;       ///< m of boundary on the block's outer contour (facing a street)
+  int neighbours = 0;        ///< parcels sharing >= 1 m of boundary (edges within min(block tolerance, 1 m))
+  double frontage = 0;       ///< m of boundary on the block's outer contour (within tolerance/2, 5 cm..0.5 m)
   bool streetAccess = false; ///< frontage >= minFrontage
 };
 

@@ -52,8 +52,9 @@ struct Subdivision {
 /// whole with failed = true.
 Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, std::uint64_t seed);
 
-/// Seed of block `blockId` in a run with seed `runSeed` (splitmix64 mix), so a
-/// block's parcels do not depend on the other blocks.
-std::uint64_t blockSeed(std::uint64_t runSeed, std::int64_t blockId);
+/// Seed of the block with key `blockKey` (generate uses the block's position)
+/// in a run with seed `runSeed` (splitmix64 mix), so a block's parcels do not
+/// depend on the other blocks.
+std::uint64_t blockSeed(std::uint64_t runSeed, std::int64_t blockKey);
 
 }  // namespace parcelscope::generation

@@ -2,7 +2,8 @@
 // An output directory that is never left half-written. Files are written into a
 // hidden staging folder beside the target; commit() moves them into the target
 // (each move an atomic rename) and removes the staging folder. Without commit(),
-// the destructor removes the staging folder and the target is untouched.
+// the destructor removes the staging folder and the target is untouched. The
+// staging folder of a run that was killed is removed by the next run.
 #include <string>
 #include <vector>
 

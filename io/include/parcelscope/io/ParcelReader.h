@@ -28,8 +28,10 @@ struct CleaningReport {
   std::int64_t features = 0;            ///< features read (after --where)
   std::int64_t nullOrEmpty = 0;         ///< skipped: null or empty geometry
   std::int64_t nonPolygonal = 0;        ///< skipped: points or lines only
-  std::int64_t multipartFeatures = 0;   ///< features with more than one polygon part
-  std::int64_t partsFromMultipart = 0;  ///< parcels those features were split into
+  std::int64_t nonPolygonalParts = 0;   ///< point or line members dropped from mixed collections
+  std::int64_t nonFiniteSkipped = 0;    ///< skipped: NaN, infinite or beyond 1e12 coordinates
+  std::int64_t multipartFeatures = 0;   ///< multipolygon features with more than one part
+  std::int64_t partsFromMultipart = 0;  ///< parcels those features were split into (after repair)
   std::int64_t withHoles = 0;           ///< parcels that keep one or more holes
   std::int64_t invalidRepaired = 0;     ///< invalid polygons repaired by make-valid
   std::int64_t invalidSkipped = 0;      ///< invalid polygons make-valid could not save
