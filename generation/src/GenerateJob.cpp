@@ -1,5 +1,6 @@
 #include "parcelscope/generation/GenerateJob.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -75,25 +76,33 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
       units.push_back({id, out.source.parcels[i].shape, blockParameters(request, f[1], f[2], f[3], f[4])});
     }
   }
+  // Per-block bounds (derived from observed parcels or read from the input) are
+  // clamped into the parameters' ranges: a block of tiny slivers can derive an
+  // A_max below the 1 m2 minimum, and a zero would make splitting endless.
   const auto& descriptions = obbParameterDescriptions();
-  auto describe = [&](const char* name) -> const ParameterDescription& {
+  auto clampTo = [&](const char* name, double& value) {
     for (const auto& d : descriptions) {
-      if (d.name == name) return d;
+      if (d.name == name && (value < d.minimum || value > d.maximum)) {
+        value = std::clamp(value, d.minimum, d.maximum);
+        ++out.clampedBounds;
+      }
     }
-    throw std::logic_error(name);
   };
-  for (const Unit& u : units) {
-    try {
-      checkValue(describe("a-min"), u.p.aMin);
-      checkValue(describe("a-max"), u.p.aMax);
-      checkValue(describe("w-min"), u.p.wMin);
-      checkValue(describe("w-max"), u.p.wMax);
-    } catch (const Error& e) {
-      throw inputError(request.input.path + ": block " + std::to_string(u.blockId) + ": " + e.what());
+  for (Unit& u : units) {
+    clampTo("a-min", u.p.aMin);
+    clampTo("a-max", u.p.aMax);
+    clampTo("w-min", u.p.wMin);
+    clampTo("w-max", u.p.wMax);
+    // A bound the user gave wins over a conflicting per-block one.
+    if (request.explicitParameters.count("a-min")) {
+      u.p.aMax = std::max(u.p.aMax, u.p.aMin);
+    } else {
+      u.p.aMin = std::min(u.p.aMin, u.p.aMax);
     }
-    if (u.p.aMin > u.p.aMax || u.p.wMin > u.p.wMax) {
-      throw usageError("block " + std::to_string(u.blockId) +
-                       ": its bounds conflict with the ones given (A_min > A_max or W_min > W_max)");
+    if (request.explicitParameters.count("w-min")) {
+      u.p.wMax = std::max(u.p.wMax, u.p.wMin);
+    } else {
+      u.p.wMin = std::min(u.p.wMin, u.p.wMax);
     }
   }
 
@@ -187,6 +196,7 @@ analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::stri
                         .set("parcels", static_cast<std::int64_t>(g.parcels.size()))
                         .set("parcels_oversize", g.oversize)
                         .set("parcels_without_street_access", g.withoutAccess)
+                        .set("per_block_bounds_clamped", g.clampedBounds)
                         .set("parcels_with_street_access_measured", withAccess));
   run.set("failures", failures);
   run.set("outputs", Json::array().push("parcels.gpkg").push("parcels.csv").push("run.json"));

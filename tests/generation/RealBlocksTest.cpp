@@ -77,6 +77,21 @@ INSTANTIATE_TEST_SUITE_P(Datasets, RealBlocks,
                            return n.substr(0, n.find('/'));
                          });
 
+TEST(GenerateJob, DerivedBoundsBelowTheRangesAreClampedNotRefused) {
+  // eatonville_wa has a block of slivers whose derived A_max is under 1 m2.
+  PARCELSCOPE_REQUIRE_SHARED_DATASETS();
+  GenerateRequest request;
+  request.input.path = test::sharedDataset("eatonville_wa/parcels.geojson");
+  request.input.crsOverride = "EPSG:2286";
+  request.fromParcels = true;
+  request.parameters = defaultValues(obbParameterDescriptions());
+  for (const auto& d : analysis::analysisParameters()) request.parameters[d.name] = d.defaultValue;
+  const GeneratedParcels g = generate(request);
+  EXPECT_GT(g.clampedBounds, 0);
+  EXPECT_EQ(g.failedBlocks, 0);
+  EXPECT_GT(g.parcels.size(), 500u);
+}
+
 TEST(BlockParameters, UserValuesOverridePerBlockValuesWhichOverrideDefaults) {
   GenerateRequest r;
   r.parameters = defaultValues(obbParameterDescriptions());

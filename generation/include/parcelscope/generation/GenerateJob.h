@@ -41,6 +41,7 @@ struct GeneratedParcels {
   std::vector<Polygon> parcels;           ///< generated parcels, local metres
   std::vector<analysis::ParcelMetrics> metrics;
   std::int64_t failedBlocks = 0, oversize = 0, withoutAccess = 0;
+  std::int64_t clampedBounds = 0;         ///< per-block bounds moved into the parameter ranges
   std::vector<std::string> failures;      ///< one line per failed block
   std::uint64_t seed = 0;
 };
