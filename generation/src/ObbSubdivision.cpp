@@ -262,9 +262,25 @@ Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, 
   ObbParameters p = parameters;
   p.aMax = std::max(p.aMax, p.aMin);
   p.wMax = std::max(p.wMax, p.wMin);
-  // No shift to the origin: io/ already works near it, and a shift and its
-  // inverse would round vertices that the validity checks have passed.
-  Polygon local = block;
+  // Blocks far from the origin are moved next to it (the exact kernel is much
+  // faster there), but only by a shift that is exact both ways: by Sterbenz's
+  // lemma x - o is exact when o/2 <= x <= 2o, and then (x - o) + o == x. Blocks
+  // already near the origin (io/ centres its frame on the data) stay put.
+  const Box b = bounds(block);
+  Point o{0.5 * (b.minX + b.maxX), 0.5 * (b.minY + b.maxY)};
+  auto exactShift = [](double lo, double hi, double c) {
+    return (c > 0 && lo >= 0.5 * c && hi <= 2 * c) || (c < 0 && hi <= 0.5 * c && lo >= 2 * c);
+  };
+  if (!exactShift(b.minX, b.maxX, o.x)) o.x = 0;
+  if (!exactShift(b.minY, b.maxY, o.y)) o.y = 0;
+  auto shift = [](const Polygon& in, double dx, double dy) {
+    Polygon r = in;
+    for (Point& q : r.outer) q = {q.x + dx, q.y + dy};
+    for (Ring& h : r.holes)
+      for (Point& q : h) q = {q.x + dx, q.y + dy};
+    return r;
+  };
+  Polygon local = shift(block, -o.x, -o.y);
   try {
     if (!normalise(local) || !detail::isValidForSplit(local)) {
       out.failed = true;
@@ -280,6 +296,9 @@ Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, 
   if (out.failed) {
     out.parcels = {block};
     return out;
+  }
+  if (o.x != 0 || o.y != 0) {
+    for (Polygon& parcel : out.parcels) parcel = shift(parcel, o.x, o.y);
   }
   return out;
 }
