@@ -12,7 +12,6 @@
 namespace parcelscope::analysis::detail {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 struct EdgeInfo {
   int polygon;

@@ -8,7 +8,6 @@
 namespace parcelscope::analysis {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = 180.0 / kPi;
 }  // namespace
 

@@ -82,6 +82,35 @@ double sharedTolerance(double blockTolerance) { return std::clamp(blockTolerance
 // bridged a gap (at most half the tolerance away); frontage matches within that,
 // between 5 cm and 0.5 m, so rear edges near the street do not count.
 double frontageTolerance(double blockTolerance) { return std::clamp(0.5 * blockTolerance, 0.05, 0.5); }
+
+// Counts, for every parcel, the others it shares at least kMinSharedBoundary with.
+void countNeighbours(const std::vector<detail::Contact>& contacts, std::vector<ParcelMetrics>& metrics) {
+  for (const auto& c : contacts) {
+    if (c.shared >= kMinSharedBoundary) {
+      ++metrics[c.a].neighbours;
+      ++metrics[c.b].neighbours;
+    }
+  }
+}
+
+// Frontage and street access of a block's parcels, measured on its outline.
+// Returns how many have street access.
+int measureFrontage(const Block& block, const std::vector<const Polygon*>& shapes, double tolerance,
+                    double minFrontage, std::vector<ParcelMetrics>& metrics) {
+  std::vector<const Polygon*> members;
+  for (int i : block.parcels) members.push_back(shapes[i]);
+  std::vector<Ring> outline;
+  for (const Polygon& part : block.parts) outline.push_back(part.outer);
+  const auto frontage = detail::lengthAlong(members, outline, frontageTolerance(tolerance));
+  int withAccess = 0;
+  for (std::size_t k = 0; k < block.parcels.size(); ++k) {
+    ParcelMetrics& m = metrics[block.parcels[k]];
+    m.frontage = frontage[k];
+    m.streetAccess = m.frontage >= minFrontage;
+    withAccess += m.streetAccess;
+  }
+  return withAccess;
+}
 // Right-of-way: an MBR width at least kNetworkWidthRatio times the strip width
 // 2A/P (a rectangular lot of any proportions stays below 2), and either holes
 // holding other parcels or at least kNetworkMinNeighbours neighbours.
@@ -140,12 +169,7 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
   std::vector<const Polygon*> shapes(n);
   for (std::size_t i = 0; i < n; ++i) shapes[i] = &parcels[i].shape;
   const auto touching = detail::contacts(shapes, std::max(tol, 1e-6), sharedTolerance(tol));
-  for (const auto& c : touching) {
-    if (c.shared >= kMinSharedBoundary) {
-      ++out.metrics[c.a].neighbours;
-      ++out.metrics[c.b].neighbours;
-    }
-  }
+  countNeighbours(touching, out.metrics);
   reportProgress(progress, 0.3, "neighbours");
   // Overlapping boxes find parcels lying inside others without touching them.
   const auto pairs = detail::intersectingPairs(boxes);
@@ -210,7 +234,6 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
   }
 
   // 5. Block outlines, frontage and statistics.
-  const double frontTol = frontageTolerance(tol);
   out.timings.start("block_outlines");
   // Largest blocks first, so that one big block does not finish last alone.
   std::vector<std::size_t> bySize(out.blocks.size());
@@ -223,7 +246,7 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
       [&](std::size_t k) {
         const std::size_t b = bySize[k];
         std::vector<const Polygon*> members;
-        for (int i : out.blocks[b].parcels) members.push_back(&parcels[i].shape);
+        for (int i : out.blocks[b].parcels) members.push_back(shapes[i]);
         out.blocks[b].parts = io::unionAndClose(members, tol);
       },
       [&](std::size_t done) {
@@ -232,24 +255,13 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
       });
   out.timings.start("frontage_and_statistics");
   for (std::size_t b = 0; b < out.blocks.size(); ++b) {
-    Block& block = out.blocks[b];
-    std::vector<const Polygon*> members;
-    for (int i : block.parcels) members.push_back(&parcels[i].shape);
+    const Block& block = out.blocks[b];
     if (block.parts.size() > 1) ++out.multipartBlocks;
-
-    std::vector<Ring> outline;
-    for (const Polygon& part : block.parts) outline.push_back(part.outer);
-    const auto frontage = detail::lengthAlong(members, outline, frontTol);
+    const int withAccess = measureFrontage(block, shapes, tol, options.minFrontage, out.metrics);
     std::vector<double> areas, widths;
-    int withAccess = 0;
-    for (std::size_t k = 0; k < block.parcels.size(); ++k) {
-      const int i = block.parcels[k];
-      ParcelMetrics& m = out.metrics[i];
-      m.frontage = frontage[k];
-      m.streetAccess = m.frontage >= options.minFrontage;
-      withAccess += m.streetAccess;
-      areas.push_back(m.area);
-      widths.push_back(m.width);
+    for (int i : block.parcels) {
+      areas.push_back(out.metrics[i].area);
+      widths.push_back(out.metrics[i].width);
     }
     BlockStatistics s = blockStatistics(areas, widths, options.k);
     s.blockId = block.id;
@@ -272,24 +284,8 @@ std::vector<ParcelMetrics> measureParcels(const std::vector<Polygon>& shapes, co
   });
   std::vector<const Polygon*> all;
   for (const Polygon& s : shapes) all.push_back(&s);
-  for (const auto& c : detail::contacts(all, std::max(tolerance, 1e-6), sharedTolerance(tolerance))) {
-    if (c.shared >= kMinSharedBoundary) {
-      ++metrics[c.a].neighbours;
-      ++metrics[c.b].neighbours;
-    }
-  }
-  for (const Block& block : blocks) {
-    std::vector<const Polygon*> members;
-    for (int i : block.parcels) members.push_back(&shapes[i]);
-    std::vector<Ring> outline;
-    for (const Polygon& part : block.parts) outline.push_back(part.outer);
-    const auto frontage = detail::lengthAlong(members, outline, frontageTolerance(tolerance));
-    for (std::size_t k = 0; k < block.parcels.size(); ++k) {
-      ParcelMetrics& m = metrics[block.parcels[k]];
-      m.frontage = frontage[k];
-      m.streetAccess = m.frontage >= minFrontage;
-    }
-  }
+  countNeighbours(detail::contacts(all, std::max(tolerance, 1e-6), sharedTolerance(tolerance)), metrics);
+  for (const Block& block : blocks) measureFrontage(block, all, tolerance, minFrontage, metrics);
   return metrics;
 }
 

@@ -6,6 +6,8 @@
 
 namespace parcelscope {
 
+constexpr double kPi = 3.14159265358979323846;
+
 struct Point {
   double x = 0;
   double y = 0;

@@ -24,9 +24,6 @@ public:
     current_.clear();
   }
   const std::vector<std::pair<std::string, double>>& stages() const { return stages_; }
-  void append(const Timings& other) {
-    stages_.insert(stages_.end(), other.stages_.begin(), other.stages_.end());
-  }
 
 private:
   std::string current_;
