@@ -64,7 +64,11 @@ std::string OutputDirectory::stage(const std::string& name) {
     if (sameFile(final, in)) throw usageError(final.string() + ": output would overwrite an input");
   }
   names_.push_back(name);
-  return (fs::path(staging_) / name).string();
+  const fs::path staged = fs::path(staging_) / name;
+  std::error_code ec;
+  fs::create_directories(staged.parent_path(), ec);  // names may hold folders, e.g. figures/map.png
+  if (ec) throw ioError(staged.parent_path().string() + ": cannot create staging folder (" + ec.message() + ")");
+  return staged.string();
 }
 
 void OutputDirectory::commit() {
@@ -81,6 +85,7 @@ void OutputDirectory::commit() {
   for (const auto& name : names_) {
     const fs::path from = fs::path(staging_) / name;
     if (!fs::exists(from, ec)) continue;
+    fs::create_directories((fs::path(target_) / name).parent_path(), ec);
     fs::rename(from, fs::path(target_) / name, ec);
     if (ec) throw ioError((fs::path(target_) / name).string() + ": cannot move into place (" + ec.message() + ")");
   }

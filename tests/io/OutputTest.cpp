@@ -44,6 +44,18 @@ TEST(OutputDirectory, FilesAppearOnlyOnCommit) {
   EXPECT_TRUE(fs::exists(target + "/b.csv"));
 }
 
+TEST(OutputDirectory, FilesInSubfoldersMoveIntoNewAndExistingTargets) {
+  TempDir dir;
+  const std::string target = dir.file("out");
+  for (const char* name : {"figures/a.png", "figures/b.png"}) {
+    OutputDirectory out(target, {});  // first run: the folder is renamed; second: files move one by one
+    std::ofstream(out.stage(name)) << name;
+    out.commit();
+  }
+  EXPECT_TRUE(fs::exists(target + "/figures/a.png"));
+  EXPECT_TRUE(fs::exists(target + "/figures/b.png"));
+}
+
 TEST(OutputDirectory, StagingOfAKilledRunIsRemovedByTheNext) {
   TempDir dir;
   const fs::path stale = dir.path() / ".out.partial-999999999";  // no such process

@@ -19,7 +19,8 @@ public:
   OutputDirectory(const OutputDirectory&) = delete;
   OutputDirectory& operator=(const OutputDirectory&) = delete;
 
-  /// Where to write the output file `name` before commit().
+  /// Where to write the output file `name` before commit(). `name` may name a
+  /// file in a subfolder ("figures/map.png"); the folder is created.
   std::string stage(const std::string& name);
   /// Moves every staged file into the target. Throws Error(IO) on failure.
   void commit();
