@@ -1,12 +1,14 @@
 #include "Commands.h"
 
 #include <cstdio>
+#include <set>
 
 #include "Args.h"
 #include "TermProgress.h"
 #include "parcelscope/analysis/StatsJob.h"
-#include "parcelscope/generation/GenerateJob.h"
 #include "parcelscope/core/Error.h"
+#include "parcelscope/generation/GenerateJob.h"
+#include "parcelscope/viz/CompareJob.h"
 
 namespace parcelscope::cli {
 
@@ -20,6 +22,8 @@ const char* kOverview =
     "  stats     read observed parcels, build blocks, write per-parcel metrics,\n"
     "            per-block statistics and generator parameters\n"
     "  generate  subdivide blocks into procedural parcels (OBB style)\n"
+    "  compare   generate parcels in the blocks of observed ones and compare the two sets:\n"
+    "            per-block and city-wide tables, distances, layers and figures\n"
     "  version   print the version\n"
     "\n"
     "'parcelscope COMMAND --help' describes a command's options.\n";
@@ -36,6 +40,33 @@ bool wantsHelp(const std::vector<std::string>& args) {
   }
   return false;
 }
+
+// Names of the parameters the user gave (as opposed to their defaults).
+std::set<std::string> givenParameters(const Args& a, const std::vector<ParameterDescription>& params) {
+  std::set<std::string> given;
+  for (const auto& p : params) {
+    if (a.given(p.name)) given.insert(p.name);
+  }
+  return given;
+}
+
+// Prints a finished job's summary (unless --quiet) and returns the exit code.
+int reportOutcome(const analysis::JobOutcome& outcome, const Args& a) {
+  if (!a.has("quiet")) std::fprintf(stderr, "%s\nwritten to %s\n", outcome.summary.c_str(), a.value("out")->c_str());
+  return 0;
+}
+
+// The one INPUT and the input flags of inputFlags(); --out is required.
+io::ReadOptions readOptions(const Args& a) {
+  if (a.positional().size() != 1) throw usageError("expected exactly one INPUT file");
+  if (!a.value("out")) throw usageError("--out DIR is required");
+  io::ReadOptions input;
+  input.path = a.positional()[0];
+  input.layer = a.value("layer").value_or("");
+  input.where = a.value("where").value_or("");
+  input.crsOverride = a.value("crs").value_or("");
+  return input;
+}
 }  // namespace
 
 int dispatch(const std::vector<std::string>& args) {
@@ -50,7 +81,8 @@ int dispatch(const std::vector<std::string>& args) {
   }
   if (args[0] == "stats") return statsCommand(rest);
   if (args[0] == "generate") return generateCommand(rest);
-  throw usageError("unknown command '" + args[0] + "' (commands: stats, generate, version)");
+  if (args[0] == "compare") return compareCommand(rest);
+  throw usageError("unknown command '" + args[0] + "' (commands: stats, generate, compare, version)");
 }
 
 int statsCommand(const std::vector<std::string>& args) {
@@ -64,17 +96,8 @@ int statsCommand(const std::vector<std::string>& args) {
     return 0;
   }
   const Args a(args, flags, params);
-  if (a.positional().size() != 1) throw usageError("expected exactly one INPUT file");
-  if (!a.value("out")) throw usageError("--out DIR is required");
-  io::ReadOptions input;
-  input.path = a.positional()[0];
-  input.layer = a.value("layer").value_or("");
-  input.where = a.value("where").value_or("");
-  input.crsOverride = a.value("crs").value_or("");
-  const bool quiet = a.has("quiet");
-  const auto outcome = analysis::runStats(input, a.parameters(), *a.value("out"), terminalProgress(quiet));
-  if (!quiet) std::fprintf(stderr, "%s\nwritten to %s\n", outcome.summary.c_str(), a.value("out")->c_str());
-  return 0;
+  return reportOutcome(
+      analysis::runStats(readOptions(a), a.parameters(), *a.value("out"), terminalProgress(a.has("quiet"))), a);
 }
 
 int generateCommand(const std::vector<std::string>& args) {
@@ -102,23 +125,43 @@ int generateCommand(const std::vector<std::string>& args) {
     return 0;
   }
   const Args a(args, flags, params);
-  if (a.positional().size() != 1) throw usageError("expected exactly one INPUT file");
-  if (!a.value("out")) throw usageError("--out DIR is required");
   generation::GenerateRequest request;
-  request.input.path = a.positional()[0];
-  request.input.layer = a.value("layer").value_or("");
-  request.input.where = a.value("where").value_or("");
-  request.input.crsOverride = a.value("crs").value_or("");
+  request.input = readOptions(a);
   request.fromParcels = a.has("from-parcels");
   request.style = a.value("style").value_or("obb");
   request.parameters = a.parameters();
-  for (const auto& p : params) {
-    if (a.given(p.name)) request.explicitParameters.insert(p.name);
+  request.explicitParameters = givenParameters(a, params);
+  return reportOutcome(generation::runGenerate(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
+}
+
+int compareCommand(const std::vector<std::string>& args) {
+  auto flags = inputFlags();
+  flags.push_back({"style", "subdivision style passed to generation, as for 'generate' (default obb; skeleton, "
+                            "offset and auto once generation offers them)"});
+  flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
+  flags.push_back({"quiet", "no progress or summary on stderr", false});
+  const auto params = viz::compareParameters();
+  if (wantsHelp(args)) {
+    std::fputs(usageText("parcelscope compare INPUT [--style obb] [--k 2] [--seed N] [options] --out DIR", flags,
+                         params)
+                   .c_str(),
+               stdout);
+    std::fputs("\nINPUT holds observed parcels. They are grouped into blocks and measured as 'stats' does; every\n"
+               "block is subdivided with its own bounds (A-bar -/+ k s_A, W-bar -/+ k s_W) unless --a-min etc.\n"
+               "are given; both sets are measured alike and compared. Writes DIR/parcels.gpkg, blocks.gpkg,\n"
+               "observed_parcels.csv, generated_parcels.csv, blocks.csv, summary.csv, distances.csv,\n"
+               "summary.json, run.json and DIR/figures/*.png and *.svg (figures need an X server: use\n"
+               "'xvfb-run -a' without a screen, or --figures 0).\n",
+               stdout);
+    return 0;
   }
-  const bool quiet = a.has("quiet");
-  const auto outcome = generation::runGenerate(request, *a.value("out"), terminalProgress(quiet));
-  if (!quiet) std::fprintf(stderr, "%s\nwritten to %s\n", outcome.summary.c_str(), a.value("out")->c_str());
-  return 0;
+  const Args a(args, flags, params);
+  viz::CompareRequest request;
+  request.input = readOptions(a);
+  request.style = a.value("style").value_or("obb");
+  request.parameters = a.parameters();
+  request.explicitParameters = givenParameters(a, params);
+  return reportOutcome(viz::runCompare(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
 }
 
 }  // namespace parcelscope::cli

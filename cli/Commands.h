@@ -9,5 +9,6 @@ int dispatch(const std::vector<std::string>& args);
 
 int statsCommand(const std::vector<std::string>& args);
 int generateCommand(const std::vector<std::string>& args);
+int compareCommand(const std::vector<std::string>& args);
 
 }  // namespace parcelscope::cli

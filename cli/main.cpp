@@ -1,20 +1,26 @@
 // parcelscope: the batch command line. Each subcommand is a thin shell around a
-// library function; errors map to exit codes 1 (failure) and 2 (usage).
+// library function; errors map to exit codes 1 (failure), 2 (usage) and 130
+// (stopped by Ctrl-C; nothing written).
 #include <cstdio>
 #include <exception>
 #include <string>
 #include <vector>
 
 #include "Commands.h"
+#include "TermProgress.h"
 #include "parcelscope/core/Error.h"
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   const std::string command = args.empty() ? "" : args.front();
+  parcelscope::cli::installInterruptHandler();
   try {
     return parcelscope::cli::dispatch(args);
   } catch (const parcelscope::Error& e) {
-    std::fprintf(stderr, "parcelscope%s: %s\n", command.empty() ? "" : (" " + command).c_str(), e.what());
+    const bool cancelled = e.kind() == parcelscope::Error::Kind::Cancelled;
+    std::fprintf(stderr, "parcelscope%s: %s%s\n", command.empty() ? "" : (" " + command).c_str(), e.what(),
+                 cancelled ? "; nothing was written" : "");
+    if (cancelled) return 130;
     if (e.kind() == parcelscope::Error::Kind::Usage) {
       std::fprintf(stderr, "run 'parcelscope %s --help' for usage\n", command.c_str());
       return 2;

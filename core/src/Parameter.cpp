@@ -13,6 +13,14 @@ ParameterValues defaultValues(const std::vector<ParameterDescription>& descripti
   return values;
 }
 
+void appendParameters(std::vector<ParameterDescription>& to, const std::vector<ParameterDescription>& more) {
+  for (const auto& d : more) {
+    bool seen = false;
+    for (const auto& t : to) seen = seen || t.name == d.name;
+    if (!seen) to.push_back(d);
+  }
+}
+
 void checkValue(const ParameterDescription& d, double value) {
   std::ostringstream m;
   if (!std::isfinite(value) || value < d.minimum || value > d.maximum) {

@@ -56,8 +56,11 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
   };
   std::vector<Unit> units;
   if (request.fromParcels) {
-    analysis::ObservedData observed =
-        analysis::loadObserved(request.input, request.parameters, scaledProgress(progress, 0.0, 0.4));
+    analysis::ObservedData loaded;
+    if (!request.observed) {
+      loaded = analysis::loadObserved(request.input, request.parameters, scaledProgress(progress, 0.0, 0.4));
+    }
+    const analysis::ObservedData& observed = request.observed ? *request.observed : loaded;
     for (std::size_t b = 0; b < observed.analysis.blocks.size(); ++b) {
       const auto& s = observed.analysis.statistics[b];
       const ObbParameters p = blockParameters(request, s.aMin, s.aMax, s.wMin, s.wMax);
@@ -65,7 +68,11 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
         units.push_back({observed.analysis.blocks[b].id, shape, p});
       }
     }
-    out.source = std::move(observed.layer);
+    if (request.observed) {
+      out.source = request.observed->layer;
+    } else {
+      out.source = std::move(loaded.layer);
+    }
   } else {
     io::ReadOptions in = request.input;
     in.numericFields = {"block_id", "a_min", "a_max", "w_min", "w_max"};
@@ -107,6 +114,7 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
   }
 
   // Subdivide every block, in parallel; each block's seed depends only on its id.
+  out.timings.start("subdivide");
   std::vector<Subdivision> results(units.size());
   const ProgressFn sub = scaledProgress(progress, request.fromParcels ? 0.4 : 0.2, 0.9);
   parallelFor(
@@ -138,10 +146,27 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
     }
   }
   reportProgress(progress, 0.9, "measuring");
+  out.timings.start("measure");
   const double minFrontage = global.minFrontage;
   out.metrics = analysis::measureParcels(out.parcels, out.blocks, 0.05, minFrontage);
+  out.timings.stop();
   reportProgress(progress, 1.0, "measuring");
   return out;
+}
+
+Table generatedParcelTable(const GeneratedParcels& g, std::vector<std::vector<Polygon>>* geometries) {
+  Table table;
+  table.columns = {{"parcel_id", Column::Type::Integer, ""}, {"block_id", Column::Type::Integer, ""}};
+  for (Column& c : analysis::metricColumns()) table.columns.push_back(std::move(c));
+  for (std::size_t b = 0; b < g.blocks.size(); ++b) {
+    for (int i : g.blocks[b].parcels) {
+      std::vector<Value> row = {std::int64_t(i), g.blockIds[b]};
+      for (Value& v : analysis::metricValues(g.metrics[i])) row.push_back(std::move(v));
+      table.rows.push_back(std::move(row));
+      if (geometries) geometries->push_back({g.parcels[i]});
+    }
+  }
+  return table;
 }
 
 analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::string& outDir,
@@ -150,18 +175,8 @@ analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::stri
   const GeneratedParcels g = generate(request, scaledProgress(progress, 0.0, 0.9));
 
   reportProgress(progress, 0.9, "writing");
-  Table table;
-  table.columns = {{"parcel_id", Column::Type::Integer, ""}, {"block_id", Column::Type::Integer, ""}};
-  for (Column& c : analysis::metricColumns()) table.columns.push_back(std::move(c));
   std::vector<std::vector<Polygon>> geometries;
-  for (std::size_t b = 0; b < g.blocks.size(); ++b) {
-    for (int i : g.blocks[b].parcels) {
-      std::vector<Value> row = {std::int64_t(i), g.blockIds[b]};
-      for (Value& v : analysis::metricValues(g.metrics[i])) row.push_back(std::move(v));
-      table.rows.push_back(std::move(row));
-      geometries.push_back({g.parcels[i]});
-    }
-  }
+  const Table table = generatedParcelTable(g, &geometries);
   io::writePolygonLayer(out.stage("parcels.gpkg"), "parcels", geometries, table, g.source.frame, g.source.crs);
   io::writeCsv(out.stage("parcels.csv"), table);
 

@@ -1,7 +1,6 @@
 // The command line as a user runs it: exit codes, one-line errors, and outputs
 // that appear whole or not at all.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -9,6 +8,7 @@
 #include <sstream>
 
 #include "TestUtil.h"
+#include "cli/CliRun.h"
 
 namespace parcelscope {
 namespace {
@@ -16,22 +16,10 @@ namespace {
 namespace fs = std::filesystem;
 using test::TempDir;
 
-struct CliRun {
-  int code;
-  std::string output;  // stdout and stderr
-};
+using test::CliRun;
+using test::slurp;
 
-CliRun run(const std::string& args) {
-  const std::string cmd = std::string("'") + PARCELSCOPE_CLI + "' " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  CliRun r{-1, ""};
-  if (!pipe) return r;
-  char buf[4096];
-  while (std::size_t n = fread(buf, 1, sizeof buf, pipe)) r.output.append(buf, n);
-  const int status = pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+CliRun run(const std::string& args) { return test::runCli(args); }
 
 const std::string kSample = std::string(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_town.geojson";
 
@@ -99,12 +87,6 @@ TEST(StatsCommand, RefusesToWriteOverTheInput) {
   const CliRun r = run("stats '" + input + "' --out '" + dir.path().string() + "' --quiet");
   EXPECT_NE(r.code, 0) << r.output;
   EXPECT_EQ(fs::file_size(input), before);
-}
-
-std::string slurp(const std::string& path) {
-  std::stringstream s;
-  s << std::ifstream(path).rdbuf();
-  return s.str();
 }
 
 TEST(GenerateCommand, FromParcelsWritesParcelsAndIsReproducibleFromTheSeed) {

@@ -24,6 +24,10 @@ using ParameterValues = std::map<std::string, double>;
 /// Defaults of every description in `descriptions`.
 ParameterValues defaultValues(const std::vector<ParameterDescription>& descriptions);
 
+/// Appends to `to` the descriptions of `more` whose name `to` does not hold yet,
+/// so that a parameter shared by two algorithms (e.g. min-frontage) is listed once.
+void appendParameters(std::vector<ParameterDescription>& to, const std::vector<ParameterDescription>& more);
+
 /// Throws Error(Usage) naming the parameter when `value` is outside its range or
 /// not an integer where one is required.
 void checkValue(const ParameterDescription& description, double value);

@@ -27,6 +27,9 @@ struct GenerateRequest {
   ParameterValues parameters;
   /// Names the user set explicitly: these override per-block values.
   std::set<std::string> explicitParameters;
+  /// With fromParcels: the input already read and analysed with `parameters`
+  /// (as `compare` does before generating); used instead of reading it again.
+  const analysis::ObservedData* observed = nullptr;
 };
 
 /// Parameters a block runs with: the request's values, with the per-block bounds
@@ -44,11 +47,17 @@ struct GeneratedParcels {
   std::int64_t clampedBounds = 0;         ///< per-block bounds moved into the parameter ranges
   std::vector<std::string> failures;      ///< one line per failed block
   std::uint64_t seed = 0;
+  Timings timings;                        ///< "subdivide" and "measure"
 };
 
 /// Reads the input and subdivides every block (in parallel). Throws Error on bad
 /// input or parameters (A_min > A_max, W_min > W_max, unknown style).
 GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& progress = {});
+
+/// The generated parcels as parcels.gpkg and parcels.csv hold them: one row per
+/// parcel in block order (parcel_id, block_id and every metric) and, when
+/// `geometries` is given, each row's geometry.
+Table generatedParcelTable(const GeneratedParcels& g, std::vector<std::vector<Polygon>>* geometries = nullptr);
 
 /// Runs `generate` and writes DIR/parcels.gpkg (layer `parcels`, input CRS, field
 /// block_id and the metrics), DIR/parcels.csv and DIR/run.json, all at once when

@@ -1,0 +1,311 @@
+// `parcelscope compare` as a user runs it, end to end: every output exists and
+// parses, generated parcels tile their blocks, the distances lie in their
+// ranges, the figures have the requested size and ink, one figure matches its
+// baseline image; no display, a bad style and Ctrl-C leave nothing behind.
+// Runs under xvfb-run (tests/xvfb-run-test.sh).
+#include <cpl_json.h>
+#include <gdal_priv.h>
+#include <gtest/gtest.h>
+#include <ogrsf_frmts.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <fcntl.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <thread>
+
+#include "TestUtil.h"
+#include "cli/CliRun.h"
+#include "parcelscope/io/FileHash.h"
+#include "viz/ImageCheck.h"
+
+extern char** environ;
+
+namespace parcelscope {
+namespace {
+
+namespace fs = std::filesystem;
+using test::CliRun;
+using test::runCli;
+using test::TempDir;
+
+const std::string kSample = std::string(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_town.geojson";
+const std::string kSampleArgs = "'" + kSample + "' --where \"use <> 'ROW'\"";
+
+// A CSV file as rows of fields (our outputs quote nothing that holds a comma).
+std::vector<std::vector<std::string>> readCsv(const std::string& path) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(test::slurp(path));
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> fields;
+    std::stringstream s(line);
+    for (std::string f; std::getline(s, f, ',');) fields.push_back(f);
+    rows.push_back(fields);
+  }
+  return rows;
+}
+
+std::size_t columnOf(const std::vector<std::string>& header, const std::string& name) {
+  for (std::size_t i = 0; i < header.size(); ++i) {
+    if (header[i] == name) return i;
+  }
+  ADD_FAILURE() << "no column " << name;
+  return 0;
+}
+
+GDALDatasetUniquePtr openVector(const std::string& path) {
+  GDALAllRegister();
+  return GDALDatasetUniquePtr(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
+}
+
+// Generated parcels tile their block: parcel areas sum to the block's area (no
+// gap), to the area of their union (no overlap), and the union lies in the block.
+void expectTiling(const std::string& out) {
+  auto parcels = openVector(out + "/parcels.gpkg");
+  auto blocks = openVector(out + "/blocks.gpkg");
+  ASSERT_TRUE(parcels && blocks);
+  std::map<std::int64_t, std::unique_ptr<OGRMultiPolygon>> members;
+  std::map<std::int64_t, double> sums;
+  for (auto& f : *parcels->GetLayerByName("parcels")) {
+    const std::int64_t id = f->GetFieldAsInteger64("block_id");
+    auto& m = members[id];
+    if (!m) m = std::make_unique<OGRMultiPolygon>();
+    const auto* g = f->GetGeometryRef()->toMultiPolygon();
+    for (const auto* part : *g) m->addGeometry(part);
+    sums[id] += g->get_Area();
+  }
+  int checked = 0;
+  for (auto& f : *blocks->GetLayerByName("blocks")) {
+    const std::int64_t id = f->GetFieldAsInteger64("block_id");
+    const OGRGeometry* block = f->GetGeometryRef();
+    const double blockArea = block->toMultiPolygon()->get_Area();
+    ASSERT_TRUE(members.count(id)) << "block " << id << " has no generated parcel";
+    EXPECT_NEAR(sums[id] / blockArea, 1.0, 1e-6) << "block " << id << ": parcels do not cover it";
+    std::unique_ptr<OGRGeometry> together(members[id]->UnionCascaded());
+    ASSERT_TRUE(together) << "block " << id;
+    const double unionArea = together->toSurface() ? together->toSurface()->get_Area()
+                                                   : together->toMultiPolygon()->get_Area();
+    EXPECT_NEAR(unionArea / sums[id], 1.0, 1e-6) << "block " << id << ": parcels overlap";
+    std::unique_ptr<OGRGeometry> inside(together->Intersection(block));
+    ASSERT_TRUE(inside) << "block " << id;
+    const double insideArea = inside->toSurface() ? inside->toSurface()->get_Area()
+                                                  : inside->toGeometryCollection()->get_Area();
+    EXPECT_NEAR(insideArea / unionArea, 1.0, 1e-6) << "block " << id << ": parcels leave the block";
+    ++checked;
+  }
+  EXPECT_EQ(checked, static_cast<int>(sums.size()));
+}
+
+struct Expected {
+  std::string input;
+  int epsg;    ///< CRS given with --crs, which the outputs must carry; 0: the input's CRS
+  int width, height;
+};
+
+// Every file of a compare run exists and parses, and holds consistent numbers.
+void expectCompareOutputs(const std::string& out, const Expected& e) {
+  for (const char* f : {"parcels.gpkg", "blocks.gpkg", "observed_parcels.csv", "generated_parcels.csv", "blocks.csv",
+                        "summary.csv", "distances.csv", "summary.json", "run.json"}) {
+    ASSERT_TRUE(fs::exists(out + "/" + f)) << f;
+  }
+  CPLJSONDocument summaryDoc, runDoc;
+  ASSERT_TRUE(summaryDoc.Load(out + "/summary.json"));
+  ASSERT_TRUE(runDoc.Load(out + "/run.json"));
+  const CPLJSONObject summary = summaryDoc.GetRoot(), run = runDoc.GetRoot();
+  const auto blocks = summary.GetLong("blocks", -1);
+  const auto observed = summary.GetLong("observed/parcels", -1);
+  const auto generated = summary.GetLong("generated/parcels", -1);
+  EXPECT_GT(blocks, 0);
+  EXPECT_GT(observed, 0);
+  EXPECT_GT(generated, 0);
+  for (const char* m : {"area", "width", "aspect_ratio"}) {
+    const double ks = summary.GetDouble(std::string("ks/") + m, -1);
+    EXPECT_GE(ks, 0.0) << m;
+    EXPECT_LE(ks, 1.0) << m;
+    EXPECT_GE(summary.GetDouble(std::string("wasserstein/") + m, -1), 0.0) << m;
+    const double hi = summary.GetDouble(std::string("histogram_intersection/") + m, -1);
+    EXPECT_GE(hi, 0.0) << m;
+    EXPECT_LE(hi, 1.0) << m;
+  }
+  EXPECT_GT(summary.GetDouble("timing_s/generate", -1), 0.0);
+  EXPECT_GE(summary.GetDouble("timing_s/total", -1), summary.GetDouble("timing_s/generate", 0));
+  EXPECT_EQ(run.GetString("command"), "compare");
+  EXPECT_EQ(run.GetString("input_file/sha256"), io::sha256File(e.input));
+  EXPECT_EQ(run.GetDouble("parameters/k", -1), 2.0);
+  EXPECT_FALSE(run.GetString("version").empty());
+
+  // Tables: rectangular, and their counts agree with summary.json.
+  for (const char* f : {"observed_parcels.csv", "generated_parcels.csv", "blocks.csv", "summary.csv",
+                        "distances.csv"}) {
+    const auto rows = readCsv(out + "/" + f);
+    ASSERT_GE(rows.size(), 2u) << f;
+    for (const auto& row : rows) ASSERT_EQ(row.size(), rows[0].size()) << f;
+  }
+  const auto blockRows = readCsv(out + "/blocks.csv");
+  EXPECT_EQ(static_cast<long>(blockRows.size()) - 1, blocks);
+  EXPECT_EQ(static_cast<long>(readCsv(out + "/generated_parcels.csv").size()) - 1, generated);
+  std::int64_t observedInBlocks = 0, generatedInBlocks = 0;
+  for (std::size_t r = 1; r < blockRows.size(); ++r) {
+    observedInBlocks += std::stoll(blockRows[r][columnOf(blockRows[0], "observed_parcels")]);
+    generatedInBlocks += std::stoll(blockRows[r][columnOf(blockRows[0], "generated_parcels")]);
+    for (const char* m : {"ks_area", "ks_width", "ks_aspect_ratio"}) {
+      const double ks = std::stod(blockRows[r][columnOf(blockRows[0], m)]);
+      EXPECT_TRUE(ks >= 0 && ks <= 1) << m << " = " << ks << " in block row " << r;
+    }
+  }
+  EXPECT_EQ(observedInBlocks, observed);
+  EXPECT_EQ(generatedInBlocks, generated);
+
+  // The generated layer: its name, field, count and the input's CRS.
+  auto gpkg = openVector(out + "/parcels.gpkg");
+  ASSERT_TRUE(gpkg);
+  OGRLayer* layer = gpkg->GetLayerByName("parcels");
+  ASSERT_NE(layer, nullptr);
+  EXPECT_GE(layer->GetLayerDefn()->GetFieldIndex("block_id"), 0);
+  EXPECT_GE(layer->GetLayerDefn()->GetFieldIndex("aspect_ratio"), 0);
+  EXPECT_EQ(layer->GetFeatureCount(), generated);
+  ASSERT_NE(layer->GetSpatialRef(), nullptr);
+  // The input's own CRS, or the one given with --crs.
+  OGRSpatialReference expected;
+  if (e.epsg > 0) {
+    expected.importFromEPSG(e.epsg);
+  } else {
+    auto input = openVector(e.input);
+    ASSERT_TRUE(input && input->GetLayer(0)->GetSpatialRef());
+    expected = *input->GetLayer(0)->GetSpatialRef();
+  }
+  EXPECT_TRUE(layer->GetSpatialRef()->IsSame(&expected)) << layer->GetSpatialRef()->GetName();
+  expectTiling(out);
+
+  // Figures: requested size, not blank; the charts also as SVG.
+  for (const char* name : {"map_aspect_ratio", "hist_area", "hist_width", "hist_aspect_ratio", "map_blocks"}) {
+    const std::string png = out + "/figures/" + name + ".png";
+    const test::Image image = test::readPng(png);
+    ASSERT_EQ(image.width, e.width) << png;
+    ASSERT_EQ(image.height, e.height) << png;
+    const test::Ink ink = test::ink(image);
+    EXPECT_GT(ink.share, 0.03) << png << " looks blank";
+    EXPECT_GT(ink.colours, 16u) << png << " has hardly any colour";
+  }
+  for (const char* name : {"hist_area", "hist_width", "hist_aspect_ratio"}) {
+    EXPECT_NE(test::slurp(out + "/figures/" + name + ".svg").find("<svg"), std::string::npos) << name;
+  }
+}
+
+// Runs compare on the bundled sample with `options`, writing to `out`.
+CliRun compareSample(const std::string& out, const std::string& options) {
+  return runCli("compare " + kSampleArgs + " " + options + " --out '" + out + "' --quiet");
+}
+
+TEST(CompareCommand, BundledSampleEndToEnd) {
+  TempDir dir;
+  const std::string out = dir.file("out");
+  const CliRun r = compareSample(out, "--seed 3 --figure-width 1000 --figure-height 520");
+  ASSERT_EQ(r.code, 0) << r.output;
+  expectCompareOutputs(out, {kSample, 0, 1000, 520});
+  // The sample's ten blocks (datasets/README.md), and its parcels, are all compared.
+  CPLJSONDocument summary;
+  ASSERT_TRUE(summary.Load(out + "/summary.json"));
+  EXPECT_EQ(summary.GetRoot().GetLong("blocks"), 10);
+  EXPECT_EQ(summary.GetRoot().GetLong("seed"), 3);
+}
+
+TEST(CompareCommand, SharedDatasetEndToEnd) {
+  PARCELSCOPE_REQUIRE_SHARED_DATASETS();
+  TempDir dir;
+  const std::string input = test::sharedDataset("eatonville_wa/parcels.geojson");
+  const std::string out = dir.file("out");
+  const CliRun r = runCli("compare '" + input + "' --crs EPSG:2286 --figure-width 1200 --figure-height 600 --out '" +
+                          out + "' --quiet");
+  ASSERT_EQ(r.code, 0) << r.output;
+  expectCompareOutputs(out, {input, 2286, 1200, 600});
+}
+
+// Figures of a fixed run compared with baseline images within a tolerance. On
+// a mismatch the rendered image is kept in the build tree; with
+// PARCELSCOPE_UPDATE_BASELINES=1 the rendered images become the baselines.
+TEST(CompareCommand, FiguresMatchTheirBaselines) {
+  TempDir dir;
+  const std::string out = dir.file("out");
+  const CliRun r = compareSample(out, "--seed 1 --figure-width 900 --figure-height 450");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const bool update = std::getenv("PARCELSCOPE_UPDATE_BASELINES") != nullptr;
+  for (const char* name : {"map_aspect_ratio", "hist_area"}) {
+    const std::string rendered = out + "/figures/" + name + ".png";
+    const std::string baseline = std::string(PARCELSCOPE_SOURCE_DIR) + "/tests/data/baseline/" + name + "_sample.png";
+    if (update) {
+      fs::create_directories(fs::path(baseline).parent_path());
+      fs::copy_file(rendered, baseline, fs::copy_options::overwrite_existing);
+      continue;
+    }
+    ASSERT_TRUE(fs::exists(baseline)) << baseline << " is missing (PARCELSCOPE_UPDATE_BASELINES=1 writes it)";
+    const double share = test::differingShare(test::readPng(rendered), test::readPng(baseline));
+    if (share > 0.01) {
+      const fs::path kept = fs::path(PARCELSCOPE_RENDER_FAILURES) / (std::string(name) + "_sample.png");
+      fs::create_directories(kept.parent_path());
+      fs::copy_file(rendered, kept, fs::copy_options::overwrite_existing);
+      ADD_FAILURE() << name << ": " << 100 * share << " % of the pixels differ from " << baseline
+                    << "; the rendered image is kept at " << kept;
+    }
+  }
+  if (update) GTEST_SKIP() << "baselines written to tests/data/baseline";
+}
+
+TEST(CompareCommand, WithoutDisplayFiguresFailCleanlyAndFiguresZeroSkipsThem) {
+  TempDir dir;
+  const CliRun r = runCli("compare " + kSampleArgs + " --out '" + dir.file("a") + "' --quiet", "env -u DISPLAY");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("xvfb-run"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir.file("a")));
+  const CliRun tablesOnly =
+      runCli("compare " + kSampleArgs + " --figures 0 --out '" + dir.file("b") + "' --quiet", "env -u DISPLAY");
+  ASSERT_EQ(tablesOnly.code, 0) << tablesOnly.output;
+  EXPECT_TRUE(fs::exists(dir.file("b") + "/summary.json"));
+  EXPECT_FALSE(fs::exists(dir.file("b") + "/figures"));
+}
+
+TEST(CompareCommand, UnknownStyleIsAUsageErrorAndWritesNothing) {
+  TempDir dir;
+  const CliRun r = runCli("compare " + kSampleArgs + " --style voronoi --out '" + dir.file("x") + "' --quiet");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("voronoi"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir.file("x")));
+  EXPECT_EQ(runCli("compare " + kSampleArgs + " --bins 1 --out '" + dir.file("x") + "'").code, 2);
+  EXPECT_EQ(runCli("compare --help").code, 0);
+}
+
+TEST(CompareCommand, CtrlCLeavesNoOutputAndNoStagingFolder) {
+  PARCELSCOPE_REQUIRE_SHARED_DATASETS();
+  TempDir dir;
+  const std::string input = test::sharedDataset("cambridge_ma/ASSESSING_ParcelsFY2014.topojson");
+  const std::string out = dir.file("out");
+  std::vector<std::string> args = {PARCELSCOPE_CLI, "compare", input, "--where", "ML <> 'ROAD'", "--figures", "0",
+                                   "--out", out};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  posix_spawn_file_actions_addopen(&files, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, PARCELSCOPE_CLI, &files, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&files);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // cambridge_ma takes several seconds
+  ASSERT_EQ(::kill(pid, SIGINT), 0);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by a signal instead of stopping";
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 0)
+      << "a staging folder was left behind";
+}
+
+}  // namespace
+}  // namespace parcelscope

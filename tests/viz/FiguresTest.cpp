@@ -1,0 +1,132 @@
+// Off-screen figures read back pixel by pixel: the requested size, ink where
+// the shapes are, the colour scale's ends, holes left open, panels drawn at the
+// same extent and scale, and charts with their text in the SVG copy.
+// Runs under xvfb-run (tests/xvfb-run-test.sh).
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "TestUtil.h"
+#include "parcelscope/core/Error.h"
+#include "parcelscope/viz/Figures.h"
+#include "viz/ImageCheck.h"
+
+namespace parcelscope::viz {
+namespace {
+
+using test::rect;
+using test::TempDir;
+
+int red(std::uint32_t c) { return static_cast<int>(c >> 16); }
+int green(std::uint32_t c) { return static_cast<int>((c >> 8) & 0xff); }
+int blue(std::uint32_t c) { return static_cast<int>(c & 0xff); }
+
+FigureOutput output(const TempDir& dir, const std::string& name, int width, int height) {
+  FigureOutput o;
+  o.png = dir.file(name + ".png");
+  o.width = width;
+  o.height = height;
+  return o;
+}
+
+TEST(RenderMaps, PanelsShareExtentAndScaleAndTheColourScaleRunsRedToGreen) {
+  TempDir dir;
+  // A 1:1 square (red) and a 5:1 strip (green) far apart: the extent is their union.
+  const Polygon square = rect(0, 0, 40, 40), strip = rect(200, 0, 400, 40);
+  MapPanel left{"left", {&square, &strip}, {1.0, 5.0}};
+  MapPanel right = left;
+  right.title = "right";
+  ColourScale scale;
+  scale.minimum = 1;
+  scale.maximum = 5;
+  scale.title = "aspect ratio";
+  const FigureOutput out = output(dir, "maps", 800, 400);
+  renderMaps("two panels", {left, right}, scale, out);
+  const test::Image image = test::readPng(out.png);
+  ASSERT_EQ(image.width, 800);
+  ASSERT_EQ(image.height, 400);
+  // The map band (between the title and the colour bar) of the left half equals the right half.
+  struct {
+    int differing = 0, inked = 0;
+  } h;
+  for (int y = static_cast<int>(0.15 * 400); y < static_cast<int>(0.85 * 400); ++y) {
+    for (int x = 0; x < 400; ++x) {
+      h.differing += image.rgb(x, y) != image.rgb(x + 400, y);
+      h.inked += image.rgb(x, y) != 0xffffff;
+    }
+  }
+  EXPECT_GT(h.inked, 2000);
+  EXPECT_LT(h.differing, h.inked / 100) << "the two panels differ: not the same extent and scale";
+  // Somewhere in the left band: a clearly red pixel (the square) and a clearly green one (the strip).
+  bool sawRed = false, sawGreen = false;
+  for (int y = 60; y < 340; ++y) {
+    for (int x = 0; x < 400; ++x) {
+      const std::uint32_t c = image.rgb(x, y);
+      sawRed = sawRed || (red(c) > 180 && green(c) < 80 && blue(c) < 80);
+      sawGreen = sawGreen || (green(c) > 140 && red(c) < 80 && blue(c) < 80);
+    }
+  }
+  EXPECT_TRUE(sawRed);
+  EXPECT_TRUE(sawGreen);
+}
+
+TEST(RenderMaps, HolesStayOpen) {
+  TempDir dir;
+  Polygon ring = rect(0, 0, 100, 100);
+  ring.holes.push_back({{30, 30}, {30, 70}, {70, 70}, {70, 30}});  // clockwise hole
+  MapPanel panel{"ring", {&ring}, {1.0}};
+  ColourScale scale;
+  scale.title = "value";
+  const FigureOutput out = output(dir, "ring", 600, 600);
+  renderMaps("a ring", {panel}, scale, out);
+  const test::Image image = test::readPng(out.png);
+  ASSERT_EQ(image.width, 600);
+  // The map band runs from 13 % to 85 % of the height (from the top); its centre is the hole's.
+  const int cy = static_cast<int>(600 * (1 - 0.5 * (0.15 + 0.87)));
+  EXPECT_EQ(image.rgb(300, cy), 0xffffffu) << "the hole is filled";
+  EXPECT_NE(image.rgb(300 - 120, cy), 0xffffffu) << "the ring is not drawn";
+}
+
+TEST(RenderMaps, RefusesMismatchedValuesAndEmptyMaps) {
+  TempDir dir;
+  const Polygon square = rect(0, 0, 1, 1);
+  ColourScale scale;
+  EXPECT_THROW(renderMaps("x", {MapPanel{"p", {&square}, {}}}, scale, output(dir, "a", 400, 300)), Error);
+  EXPECT_THROW(renderMaps("x", {MapPanel{"p", {}, {}}}, scale, output(dir, "b", 400, 300)), Error);
+  EXPECT_THROW(renderMaps("x", {MapPanel{"p", {&square}, {1}}}, scale, output(dir, "c", 50, 50)), Error);
+}
+
+TEST(RenderHistogram, OverlaidSeriesInTheirColoursWithTextInTheSvg) {
+  TempDir dir;
+  FigureOutput out = output(dir, "hist", 900, 500);
+  out.vector = dir.file("hist.svg");
+  renderHistogram("Parcel area", "area (m\xc2\xb2)", "parcels (count)", {0, 100, 200, 300},
+                  {{"observed", {5, 10, 2}, {0.84, 0.15, 0.16}}, {"procedural", {3, 12, 4}, {0.12, 0.38, 0.75}}},
+                  out);
+  const test::Image image = test::readPng(out.png);
+  ASSERT_EQ(image.width, 900);
+  ASSERT_EQ(image.height, 500);
+  const test::Ink ink = test::ink(image);
+  EXPECT_GT(ink.share, 0.05);
+  EXPECT_GT(ink.colours, 20u);
+  bool sawRed = false, sawBlue = false;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const std::uint32_t c = image.rgb(x, y);
+      sawRed = sawRed || (red(c) > 180 && green(c) < 90 && blue(c) < 90);
+      sawBlue = sawBlue || (blue(c) > 150 && red(c) < 80 && green(c) < 130);
+    }
+  }
+  EXPECT_TRUE(sawRed);
+  EXPECT_TRUE(sawBlue);
+  std::stringstream svg;
+  svg << std::ifstream(out.vector).rdbuf();
+  for (const char* text : {"Parcel area", "parcels (count)", "observed", "procedural"}) {
+    EXPECT_NE(svg.str().find(text), std::string::npos) << text;
+  }
+  EXPECT_THROW(renderHistogram("x", "x", "y", {0, 1, 2}, {{"bad", {1}, {}}}, out), Error);
+}
+
+}  // namespace
+}  // namespace parcelscope::viz

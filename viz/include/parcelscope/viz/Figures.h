@@ -1,0 +1,78 @@
+#pragma once
+// Figures rendered off screen with VTK (PNG, plus a vector copy): parcel maps
+// coloured by a value, and overlaid frequency histograms. Plain ParcelScope
+// types in, files out; no VTK type appears here, so callers do not depend on
+// VTK's headers.
+//
+// Rendering needs an X server (VTK on Debian renders through GLX, off screen
+// in a hidden window). Without one, every function throws Error(IO) naming the
+// display instead of crashing; run under `xvfb-run -a` on a machine without a
+// screen.
+#include <string>
+#include <vector>
+
+#include "parcelscope/core/Geometry.h"
+
+namespace parcelscope::viz {
+
+struct Rgb {
+  double r = 0, g = 0, b = 0;  ///< each in [0, 1]
+};
+
+/// Where and how large a figure is written.
+struct FigureOutput {
+  std::string png;     ///< PNG path (written exactly `width` x `height` pixels)
+  std::string vector;  ///< optional vector copy: a path ending in .svg or .pdf; empty = none
+  int width = 1800;    ///< pixels
+  int height = 900;    ///< pixels
+};
+
+/// Throws Error(IO) unless an X server answers on $DISPLAY.
+void requireDisplay();
+
+/// A colour scale for map values. Values below `minimum` or above `maximum` take
+/// the end colours; NaN values are drawn light grey.
+struct ColourScale {
+  enum class Kind {
+    RedToGreen,  ///< red at minimum to green at maximum (Vanegas et al. 2012, Figure 1)
+    Sequential   ///< pale yellow at minimum to dark purple at maximum
+  };
+  Kind kind = Kind::RedToGreen;
+  double minimum = 0, maximum = 1;
+  std::string title;  ///< colour bar title, with unit
+};
+
+/// One map of a side-by-side figure.
+struct MapPanel {
+  std::string title;
+  std::vector<const Polygon*> shapes;  ///< local metres; holes are left unfilled
+  std::vector<double> values;          ///< one per shape
+};
+
+/// Renders `panels` side by side with the same extent (the union of every
+/// panel's shapes) and the same scale, each with its title and a scale bar in
+/// metres, one shared colour bar below and `title` above. Throws Error(Usage)
+/// when a panel's values do not match its shapes or no panel has a shape,
+/// Error(IO) when there is no display or a file cannot be written.
+void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, const ColourScale& scale,
+                const FigureOutput& output);
+
+/// One series of an overlaid histogram.
+struct HistogramSeries {
+  std::string label;        ///< legend entry
+  std::vector<int> counts;  ///< one per bin (frequencies, not normalised)
+  Rgb colour;
+};
+
+/// Renders overlaid frequency histograms on shared bins `edges` (bins + 1
+/// increasing values): each series as a translucent filled step outline, with
+/// axis titles, a legend and `title`. Throws Error(Usage) when a series does not
+/// have one count per bin, Error(IO) as renderMaps.
+void renderHistogram(const std::string& title, const std::string& xTitle, const std::string& yTitle,
+                     const std::vector<double>& edges, const std::vector<HistogramSeries>& series,
+                     const FigureOutput& output);
+
+/// "VTK 9.1.0", for run records.
+std::string vtkVersionString();
+
+}  // namespace parcelscope::viz

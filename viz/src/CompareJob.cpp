@@ -1,0 +1,387 @@
+#include "parcelscope/viz/CompareJob.h"
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <numeric>
+
+#include "parcelscope/core/Error.h"
+#include "parcelscope/core/Parallel.h"
+#include "parcelscope/io/FileHash.h"
+#include "parcelscope/io/OutputDirectory.h"
+#include "parcelscope/io/Writers.h"
+#include "parcelscope/viz/Figures.h"
+
+namespace parcelscope::viz {
+
+using analysis::ComparedMetric;
+using analysis::ParcelMetrics;
+
+const std::vector<ParameterDescription>& comparisonParameters() {
+  static const std::vector<ParameterDescription> d = {
+      {"bins", "Shared bins of the histograms, in the figures and in the histogram intersection", "", 2, 500, 30,
+       true},
+      {"histogram-quantile",
+       "The bins run from the smallest value to this quantile of both sets pooled; larger values count in the "
+       "last bin",
+       "", 0.5, 1.0, 0.99},
+      {"map-aspect-ratio-max", "Aspect ratio drawn fully green in map_aspect_ratio (1:1 is red)", "", 1.5, 100, 5},
+      {"figures", "1: render the figures (needs an X server); 0: tables and layers only", "", 0, 1, 1, true},
+      {"figure-width", "Width of every figure", "px", 200, 10000, 1800, true},
+      {"figure-height", "Height of every figure", "px", 150, 10000, 900, true},
+  };
+  return d;
+}
+
+std::vector<ParameterDescription> compareParameters() {
+  std::vector<ParameterDescription> all = analysis::analysisParameters();
+  appendParameters(all, generation::obbParameterDescriptions());
+  appendParameters(all, comparisonParameters());
+  return all;
+}
+
+namespace {
+
+double value(const CompareRequest& request, const std::string& name) {
+  const auto it = request.parameters.find(name);
+  if (it != request.parameters.end()) return it->second;
+  for (const auto& d : compareParameters()) {
+    if (d.name == name) return d.defaultValue;
+  }
+  throw std::logic_error("compare: no parameter named " + name);
+}
+
+double secondsIn(const Timings& t) {
+  double s = 0;
+  for (const auto& stage : t.stages()) s += stage.second;
+  return s;
+}
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::vector<ParcelMetrics> pick(const std::vector<ParcelMetrics>& all, const std::vector<int>& indices) {
+  std::vector<ParcelMetrics> out;
+  out.reserve(indices.size());
+  for (int i : indices) out.push_back(all[i]);
+  return out;
+}
+
+}  // namespace
+
+CompareResult compare(const CompareRequest& request, const ProgressFn& progress) {
+  for (const auto& d : compareParameters()) {
+    const auto it = request.parameters.find(d.name);
+    if (it != request.parameters.end()) checkValue(d, it->second);
+  }
+  CompareResult r;
+  r.observed = analysis::loadObserved(request.input, request.parameters, scaledProgress(progress, 0.0, 0.45));
+  const analysis::ObservedAnalysis& a = r.observed.analysis;
+
+  generation::GenerateRequest g;
+  g.input = request.input;
+  g.fromParcels = true;
+  g.style = request.style;
+  g.parameters = request.parameters;
+  g.explicitParameters = request.explicitParameters;
+  g.observed = &r.observed;
+  r.generated = generation::generate(g, scaledProgress(progress, 0.45, 0.9));
+
+  // Both sets measured with the same metrics; compared block by block, in parallel.
+  reportProgress(progress, 0.9, "comparing");
+  const auto compareStart = std::chrono::steady_clock::now();
+  const int bins = static_cast<int>(value(request, "bins"));
+  const double quantile = value(request, "histogram-quantile");
+  std::vector<int> lots;
+  for (std::size_t i = 0; i < a.blockOf.size(); ++i) {
+    if (a.blockOf[i] >= 0) lots.push_back(static_cast<int>(i));
+  }
+  r.observedLots = pick(a.metrics, lots);
+  std::vector<std::vector<int>> generatedIn(a.blocks.size());
+  for (std::size_t k = 0; k < r.generated.blocks.size(); ++k) {
+    const std::int64_t id = r.generated.blockIds[k];
+    if (id < 0 || id >= static_cast<std::int64_t>(a.blocks.size())) {
+      throw std::logic_error("compare: generated block id " + std::to_string(id) + " is not an observed block");
+    }
+    for (int i : r.generated.blocks[k].parcels) generatedIn[id].push_back(i);
+  }
+  r.blocks.resize(a.blocks.size());
+  parallelFor(a.blocks.size(), [&](std::size_t b) {
+    analysis::BlockComparison& c = r.blocks[b];
+    c.blockId = a.blocks[b].id;
+    c.blockArea = a.statistics[b].blockArea;
+    c.comparison = analysis::compareSets(pick(a.metrics, a.blocks[b].parcels),
+                                         pick(r.generated.metrics, generatedIn[b]), bins, quantile);
+  });
+  r.city = analysis::compareSets(r.observedLots, r.generated.metrics, bins, quantile);
+  for (ComparedMetric m : analysis::kComparedMetrics) {
+    r.histograms.push_back(analysis::sharedHistogram(analysis::metricSample(r.observedLots, m),
+                                                     analysis::metricSample(r.generated.metrics, m), bins,
+                                                     quantile));
+  }
+  const double measure = r.generated.timings.stages().empty() ? 0.0 : r.generated.timings.stages().back().second;
+  r.seconds = {{"read", secondsIn(r.observed.layer.timings)},
+               {"blocks", secondsIn(a.timings)},
+               {"generate", secondsIn(r.generated.timings) - measure},
+               {"metrics", measure + secondsSince(compareStart)}};
+  reportProgress(progress, 1.0, "comparing");
+  return r;
+}
+
+namespace {
+
+// Appends the Yang et al. 2013 `undesirable` flag to a parcel table whose
+// parcel_id column indexes `metrics`.
+void addUndesirable(Table& table, const std::vector<ParcelMetrics>& metrics) {
+  const std::size_t id = table.column("parcel_id");
+  table.columns.push_back({"undesirable", Column::Type::Integer, ""});
+  for (auto& row : table.rows) {
+    row.emplace_back(std::int64_t(analysis::isUndesirable(metrics[std::get<std::int64_t>(row[id])])));
+  }
+}
+
+Json summaryJson(const analysis::SetSummary& s) {
+  return Json::object()
+      .set("parcels", s.parcels)
+      .set("mean_area", s.meanArea)
+      .set("sd_area", s.sdArea)
+      .set("mean_width", s.meanWidth)
+      .set("sd_width", s.sdWidth)
+      .set("mean_aspect_ratio", s.meanAspectRatio)
+      .set("street_access_share", s.streetAccessShare)
+      .set("mean_p_angle", s.meanPAngle)
+      .set("mean_p_area", s.meanPArea)
+      .set("undesirable_share", s.undesirableShare);
+}
+
+struct FigureSet {
+  const CompareRequest& request;
+  const CompareResult& r;
+  io::OutputDirectory& out;
+  std::vector<std::string> written;
+
+  FigureOutput output(const std::string& name) {
+    // Charts also go to SVG. Maps are PNG only: VTK 9.1's GL2PS export
+    // rasterises 3D props, Debian's GL2PS cannot embed images in SVG, and a PDF
+    // would hold an uncompressed bitmap of the PNG (about 5 MB) and nothing more.
+    FigureOutput o;
+    written.push_back("figures/" + name + ".png");
+    o.png = out.stage(written.back());
+    if (name.rfind("map_", 0) != 0) {
+      written.push_back("figures/" + name + ".svg");
+      o.vector = out.stage(written.back());
+    }
+    o.width = static_cast<int>(value(request, "figure-width"));
+    o.height = static_cast<int>(value(request, "figure-height"));
+    return o;
+  }
+
+  std::string generatedName() const {
+    return "procedural (" + request.style + ", seed " + std::to_string(r.generated.seed) + ")";
+  }
+  std::string inputName() const { return std::filesystem::path(request.input.path).filename().string(); }
+
+  void aspectRatioMap() {
+    MapPanel observed, generated;
+    const auto& parcels = r.observed.layer.parcels;
+    for (std::size_t i = 0; i < parcels.size(); ++i) {
+      if (r.observed.analysis.blockOf[i] < 0) continue;
+      observed.shapes.push_back(&parcels[i].shape);
+      observed.values.push_back(r.observed.analysis.metrics[i].aspectRatio);
+    }
+    for (std::size_t i = 0; i < r.generated.parcels.size(); ++i) {
+      generated.shapes.push_back(&r.generated.parcels[i]);
+      generated.values.push_back(r.generated.metrics[i].aspectRatio);
+    }
+    observed.title = "Observed: " + std::to_string(observed.shapes.size()) + " parcels";
+    generated.title = "Procedural (" + request.style + "): " + std::to_string(generated.shapes.size()) + " parcels";
+    ColourScale scale;
+    scale.kind = ColourScale::Kind::RedToGreen;
+    scale.minimum = 1;
+    scale.maximum = value(request, "map-aspect-ratio-max");
+    char title[128];
+    std::snprintf(title, sizeof title, "Aspect ratio (length / width; %g and above drawn green)", scale.maximum);
+    scale.title = title;
+    renderMaps("Parcel aspect ratio, observed and " + generatedName() + ": " + inputName(), {observed, generated},
+               scale, output("map_aspect_ratio"));
+  }
+
+  void histogram(ComparedMetric m, std::size_t index) {
+    static const char* titles[] = {"Parcel area", "Parcel width", "Parcel aspect ratio"};
+    static const char* axes[] = {"area (m\xc2\xb2)", "width, short side of the minimum bounding rectangle (m)",
+                                 "aspect ratio (length / width)"};
+    const analysis::SharedHistogram& h = r.histograms[index];
+    if (h.edges.empty()) return;  // nothing to draw: no finite value on either side
+    std::string xTitle = axes[index];
+    if (h.aOverflow + h.bOverflow > 0) {
+      char note[96];
+      std::snprintf(note, sizeof note, "; the last bin holds every value above %.4g", h.edges.back());
+      xTitle += note;
+    }
+    auto counts = [](const std::vector<int>& c) { return std::accumulate(c.begin(), c.end(), 0); };
+    HistogramSeries observed{"observed (n = " + std::to_string(counts(h.a)) + ")", h.a, {0.84, 0.15, 0.16}};
+    HistogramSeries generated{"procedural, " + request.style + " (n = " + std::to_string(counts(h.b)) + ")", h.b,
+                              {0.12, 0.38, 0.75}};
+    renderHistogram(std::string(titles[index]) + ": observed and " + generatedName() + ", " + inputName(), xTitle,
+                    "parcels (count)", h.edges, {observed, generated},
+                    output(std::string("hist_") + analysis::metricName(m)));
+  }
+
+  void blocksMap() {
+    MapPanel blocks;
+    int withValue = 0;
+    for (std::size_t b = 0; b < r.observed.analysis.blocks.size(); ++b) {
+      const double ks = r.blocks[b].comparison.area.ks;
+      withValue += !std::isnan(ks);
+      for (const Polygon& part : r.observed.analysis.blocks[b].parts) {
+        blocks.shapes.push_back(&part);
+        blocks.values.push_back(ks);
+      }
+    }
+    blocks.title = std::to_string(r.observed.analysis.blocks.size()) + " blocks (" + std::to_string(withValue) +
+                   " with parcels on both sides)";
+    ColourScale scale;
+    scale.kind = ColourScale::Kind::Sequential;
+    scale.minimum = 0;
+    scale.maximum = 1;
+    scale.title = "KS statistic of parcel area (0: same distribution, 1: disjoint)";
+    renderMaps("Per-block difference in parcel area, observed and " + generatedName() + ": " + inputName(), {blocks},
+               scale, output("map_blocks"));
+  }
+};
+
+}  // namespace
+
+analysis::JobOutcome runCompare(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress) {
+  const auto started = std::chrono::steady_clock::now();
+  const bool figures = value(request, "figures") != 0;
+  if (figures) requireDisplay();  // before the long work, not after it
+  io::OutputDirectory out(outDir, {request.input.path});
+  const CompareResult r = compare(request, scaledProgress(progress, 0.0, 0.8));
+  const analysis::ObservedAnalysis& a = r.observed.analysis;
+
+  reportProgress(progress, 0.8, "writing");
+  const auto writeStart = std::chrono::steady_clock::now();
+  Table observedTable = analysis::parcelTable(r.observed.layer.parcels, a);
+  addUndesirable(observedTable, a.metrics);
+  io::writeCsv(out.stage("observed_parcels.csv"), observedTable);
+  std::vector<std::vector<Polygon>> geometries;
+  Table generatedTable = generation::generatedParcelTable(r.generated, &geometries);
+  addUndesirable(generatedTable, r.generated.metrics);
+  io::writeCsv(out.stage("generated_parcels.csv"), generatedTable);
+  io::writePolygonLayer(out.stage("parcels.gpkg"), "parcels", geometries, generatedTable,
+                        r.observed.layer.frame, r.observed.layer.crs);
+  const Table blocks = analysis::blockComparisonTable(r.blocks);
+  io::writeCsv(out.stage("blocks.csv"), blocks);
+  std::vector<std::vector<Polygon>> outlines;
+  for (const Block& b : a.blocks) outlines.push_back(b.parts);
+  io::writePolygonLayer(out.stage("blocks.gpkg"), "blocks", outlines, blocks, r.observed.layer.frame,
+                        r.observed.layer.crs);
+  io::writeCsv(out.stage("summary.csv"), analysis::summaryTable(r.city));
+  io::writeCsv(out.stage("distances.csv"), analysis::distanceTable(r.city));
+  const double writeSeconds = secondsSince(writeStart);
+
+  std::vector<std::string> outputs = {"parcels.gpkg", "blocks.gpkg", "observed_parcels.csv",
+                                      "generated_parcels.csv", "blocks.csv", "summary.csv", "distances.csv"};
+  double figureSeconds = 0;
+  if (figures) {
+    reportProgress(progress, 0.85, "figures");
+    const auto figureStart = std::chrono::steady_clock::now();
+    FigureSet f{request, r, out, {}};
+    f.aspectRatioMap();
+    reportProgress(progress, 0.9, "figures");
+    std::size_t index = 0;
+    for (ComparedMetric m : analysis::kComparedMetrics) f.histogram(m, index++);
+    reportProgress(progress, 0.93, "figures");
+    f.blocksMap();
+    outputs.insert(outputs.end(), f.written.begin(), f.written.end());
+    figureSeconds = secondsSince(figureStart);
+  }
+  outputs.push_back("summary.json");
+  outputs.push_back("run.json");
+
+  Json timing = Json::object();
+  for (const auto& [stage, s] : r.seconds) timing.set(stage, s);
+  timing.set("write", writeSeconds).set("figures", figureSeconds).set("total", secondsSince(started));
+  Json ks = Json::object(), wasserstein = Json::object(), intersection = Json::object();
+  for (ComparedMetric m : analysis::kComparedMetrics) {
+    ks.set(analysis::metricName(m), r.city.distances(m).ks);
+    wasserstein.set(analysis::metricName(m), r.city.distances(m).wasserstein);
+    intersection.set(analysis::metricName(m), r.city.distances(m).intersection);
+  }
+  Json generatedSummary = summaryJson(r.city.generated);
+  generatedSummary.set("oversize", r.generated.oversize).set("blocks_failed", r.generated.failedBlocks);
+  const Json summary = Json::object()
+                           .set("blocks", static_cast<std::int64_t>(a.blocks.size()))
+                           .set("style", request.style)
+                           .set("seed", static_cast<std::int64_t>(r.generated.seed))
+                           .set("observed", summaryJson(r.city.observed))
+                           .set("generated", generatedSummary)
+                           .set("ks", ks)
+                           .set("wasserstein", wasserstein)
+                           .set("histogram_intersection", intersection)
+                           .set("timing_s", timing);
+  io::writeJson(out.stage("summary.json"), summary);
+
+  Json params = Json::object();
+  for (const auto& [name, v] : request.parameters) params.set(name, v);
+  Json given = Json::array();
+  for (const auto& name : request.explicitParameters) given.push(name);
+  Json run = Json::object()
+                 .set("tool", "parcelscope")
+                 .set("version", analysis::version())
+                 .set("command", "compare")
+                 .set("style", request.style)
+                 .set("seed", static_cast<std::int64_t>(r.generated.seed))
+                 .set("gdal", io::gdalVersion())
+                 .set("vtk", figures ? vtkVersionString() : Json())
+                 .set("parameters", params)
+                 .set("parameters_given", given);
+  analysis::addObservedRecord(run, r.observed);
+  std::error_code ec;
+  const bool regular = std::filesystem::is_regular_file(request.input.path, ec);
+  run.set("input_file", Json::object()
+                            .set("path", request.input.path)
+                            .set("layer", request.input.layer)
+                            .set("where", request.input.where)
+                            .set("crs_override", request.input.crsOverride)
+                            .set("bytes", regular ? Json(static_cast<std::int64_t>(
+                                                        std::filesystem::file_size(request.input.path, ec)))
+                                                  : Json())
+                            .set("sha256", regular ? Json(io::sha256File(request.input.path)) : Json()));
+  Json failures = Json::array();
+  for (const auto& f : r.generated.failures) failures.push(f);
+  run.set("generated", Json::object()
+                           .set("blocks_subdivided", static_cast<std::int64_t>(r.generated.blocks.size()))
+                           .set("blocks_failed", r.generated.failedBlocks)
+                           .set("parcels", static_cast<std::int64_t>(r.generated.parcels.size()))
+                           .set("parcels_oversize", r.generated.oversize)
+                           .set("parcels_without_street_access", r.generated.withoutAccess)
+                           .set("per_block_bounds_clamped", r.generated.clampedBounds)
+                           .set("failures", failures));
+  run.set("timing_s", timing);
+  Json outputList = Json::array();
+  for (const auto& o : outputs) outputList.push(o);
+  run.set("outputs", outputList);
+  io::writeJson(out.stage("run.json"), run);
+
+  reportProgress(progress, 0.99, "writing");  // a last chance to cancel before anything appears
+  out.commit();
+  reportProgress(progress, 1.0, "writing");
+
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "\n%zu blocks: %lld observed parcels, %lld procedural (%s, seed %llu; %lld oversize, %lld blocks "
+                "refused)\n  KS area %.3f, width %.3f, aspect ratio %.3f; W1 area %.1f m2, width %.2f m\n"
+                "  undesirable share observed %.3f, procedural %.3f; %.1f s",
+                a.blocks.size(), static_cast<long long>(r.city.observed.parcels),
+                static_cast<long long>(r.city.generated.parcels), request.style.c_str(),
+                static_cast<unsigned long long>(r.generated.seed), static_cast<long long>(r.generated.oversize),
+                static_cast<long long>(r.generated.failedBlocks), r.city.area.ks, r.city.width.ks,
+                r.city.aspectRatio.ks, r.city.area.wasserstein, r.city.width.wasserstein,
+                r.city.observed.undesirableShare, r.city.generated.undesirableShare, secondsSince(started));
+  return {run, analysis::summarize(r.observed) + line};
+}
+
+}  // namespace parcelscope::viz

@@ -1,0 +1,465 @@
+#include "parcelscope/viz/Figures.h"
+
+#include <vtkActor.h>
+#include <vtkAxis.h>
+#include <vtkBrush.h>
+#include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkChartLegend.h>
+#include <vtkChartXY.h>
+#include <vtkContextScene.h>
+#include <vtkContextView.h>
+#include <vtkContourTriangulator.h>
+#include <vtkDoubleArray.h>
+#include <vtkGL2PSExporter.h>
+#include <vtkLookupTable.h>
+#include <vtkNew.h>
+#include <vtkPNGWriter.h>
+#include <vtkPen.h>
+#include <vtkPlotArea.h>
+#include <vtkPlotLine.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
+#include <vtkTable.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+#include <vtkVersion.h>
+#include <vtkWindowToImageFilter.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "parcelscope/core/Error.h"
+
+namespace parcelscope::viz {
+
+namespace {
+
+constexpr double kNoValueGrey = 0.82;
+
+void checkOutput(const FigureOutput& out) {
+  if (out.width < 200 || out.height < 150 || out.width > 10000 || out.height > 10000) {
+    throw usageError(out.png + ": figure size " + std::to_string(out.width) + " x " + std::to_string(out.height) +
+                     " px is outside 200 x 150 .. 10000 x 10000");
+  }
+}
+
+// Font sizes follow the figure height, so a figure stays legible at any size.
+int fontSize(const FigureOutput& out, double fraction) {
+  return std::max(8, static_cast<int>(std::lround(out.height * fraction)));
+}
+
+void styleText(vtkTextProperty* p, int size, bool bold = false) {
+  p->SetFontFamilyToArial();
+  p->SetFontSize(size);
+  p->SetBold(bold);
+  p->SetItalic(false);
+  p->SetShadow(false);
+  p->SetColor(0.1, 0.1, 0.1);
+}
+
+vtkSmartPointer<vtkRenderWindow> offscreenWindow(const FigureOutput& out) {
+  requireDisplay();
+  auto window = vtkSmartPointer<vtkRenderWindow>::New();
+  window->SetOffScreenRendering(1);
+  window->SetMultiSamples(8);
+  window->SetSize(out.width, out.height);
+  return window;
+}
+
+// Writes the PNG (and the vector copy) of what `window` shows.
+void writeFigure(vtkRenderWindow* window, const FigureOutput& out, const std::string& title) {
+  window->Render();
+  vtkNew<vtkWindowToImageFilter> grab;
+  grab->SetInput(window);
+  grab->SetInputBufferTypeToRGB();
+  grab->ReadFrontBufferOff();
+  grab->Update();
+  int dims[3];
+  grab->GetOutput()->GetDimensions(dims);
+  if (dims[0] != out.width || dims[1] != out.height) {
+    throw ioError(out.png + ": rendered " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) +
+                  " px instead of " + std::to_string(out.width) + " x " + std::to_string(out.height));
+  }
+  vtkNew<vtkPNGWriter> png;
+  png->SetFileName(out.png.c_str());
+  png->SetInputConnection(grab->GetOutputPort());
+  png->Write();
+  if (png->GetErrorCode() != 0 || !std::filesystem::exists(out.png)) throw ioError(out.png + ": cannot write PNG");
+  if (out.vector.empty()) return;
+
+  const std::filesystem::path path(out.vector);
+  vtkNew<vtkGL2PSExporter> exporter;
+  exporter->SetRenderWindow(window);
+  if (path.extension() == ".svg") {
+    exporter->SetFileFormatToSVG();
+  } else if (path.extension() == ".pdf") {
+    exporter->SetFileFormatToPDF();
+  } else {
+    throw usageError(out.vector + ": vector figures are .svg or .pdf");
+  }
+  exporter->SetFilePrefix((path.parent_path() / path.stem()).string().c_str());
+  exporter->CompressOff();  // compression would rename the file (.svgz)
+  exporter->SetSortToOff();  // flat figures: drawing order is the stacking order
+  exporter->SetTitle(title.c_str());
+  exporter->SilentOn();
+  exporter->Write();
+  if (!std::filesystem::exists(path)) throw ioError(out.vector + ": cannot write vector figure");
+}
+
+vtkSmartPointer<vtkLookupTable> lookupTable(const ColourScale& scale) {
+  auto lut = vtkSmartPointer<vtkLookupTable>::New();
+  const int n = 256;
+  lut->SetNumberOfTableValues(n);
+  lut->SetTableRange(scale.minimum, scale.maximum);
+  if (scale.kind == ColourScale::Kind::RedToGreen) {
+    // Hue from red (0) through orange and yellow to green (1/3).
+    lut->SetHueRange(0.0, 1.0 / 3.0);
+    lut->SetSaturationRange(0.85, 0.85);
+    lut->SetValueRange(0.92, 0.72);
+    lut->Build();
+  } else {
+    // Pale yellow to dark purple, perceptually ordered (after ColorBrewer YlOrRd/RdPu).
+    const double stops[][3] = {{1.0, 0.97, 0.74}, {0.99, 0.73, 0.36}, {0.94, 0.40, 0.22},
+                               {0.74, 0.10, 0.28}, {0.35, 0.0, 0.38}};
+    const int segments = 4;
+    for (int i = 0; i < n; ++i) {
+      const double t = static_cast<double>(i) / (n - 1) * segments;
+      const int s = std::min(segments - 1, static_cast<int>(t));
+      const double f = t - s;
+      lut->SetTableValue(i, stops[s][0] + f * (stops[s + 1][0] - stops[s][0]),
+                         stops[s][1] + f * (stops[s + 1][1] - stops[s][1]),
+                         stops[s][2] + f * (stops[s + 1][2] - stops[s][2]), 1.0);
+    }
+  }
+  lut->SetNanColor(kNoValueGrey, kNoValueGrey, kNoValueGrey, 1.0);
+  return lut;
+}
+
+// Triangles filling every shape (holes left open), one cell value per triangle,
+// and the shapes' rings as closed polylines.
+struct PanelGeometry {
+  vtkNew<vtkPolyData> fill;
+  vtkNew<vtkPolyData> rings;
+};
+
+void buildPanel(const MapPanel& panel, PanelGeometry& g) {
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  vtkNew<vtkCellArray> lines, triangles;
+  vtkNew<vtkDoubleArray> values;
+  values->SetName("value");
+  const double up[3] = {0, 0, 1};
+  // Each shape is triangulated on its own small contour set (the triangulator's
+  // cost grows with the whole input), then its triangles join the panel's.
+  for (std::size_t k = 0; k < panel.shapes.size(); ++k) {
+    const Polygon& shape = *panel.shapes[k];
+    const vtkIdType offset = points->GetNumberOfPoints();
+    vtkNew<vtkPolyData> contours;
+    vtkNew<vtkPoints> shapePoints;
+    vtkNew<vtkCellArray> shapeLines, shapeTriangles;
+    auto addRing = [&](const Ring& ring) {
+      const vtkIdType first = shapePoints->GetNumberOfPoints();
+      for (const Point& p : ring) {
+        shapePoints->InsertNextPoint(p.x, p.y, 0.0);
+        points->InsertNextPoint(p.x, p.y, 0.0);
+      }
+      lines->InsertNextCell(static_cast<int>(ring.size() + 1));
+      shapeLines->InsertNextCell(static_cast<int>(ring.size() + 1));
+      for (std::size_t v = 0; v < ring.size(); ++v) {
+        lines->InsertCellPoint(offset + first + static_cast<vtkIdType>(v));
+        shapeLines->InsertCellPoint(first + static_cast<vtkIdType>(v));
+      }
+      lines->InsertCellPoint(offset + first);
+      shapeLines->InsertCellPoint(first);
+    };
+    addRing(shape.outer);
+    for (const Ring& hole : shape.holes) addRing(hole);
+    contours->SetPoints(shapePoints);
+    contours->SetLines(shapeLines);
+    vtkContourTriangulator::TriangulateContours(contours, 0, shapeLines->GetNumberOfCells(), shapeTriangles, up);
+    vtkIdType count = 0;
+    const vtkIdType* ids = nullptr;
+    for (shapeTriangles->InitTraversal(); shapeTriangles->GetNextCell(count, ids);) {
+      triangles->InsertNextCell(static_cast<int>(count));
+      for (vtkIdType i = 0; i < count; ++i) triangles->InsertCellPoint(offset + ids[i]);
+      values->InsertNextValue(panel.values[k]);
+    }
+  }
+  g.rings->SetPoints(points);
+  g.rings->SetLines(lines);
+  g.fill->SetPoints(points);
+  g.fill->SetPolys(triangles);
+  g.fill->GetCellData()->SetScalars(values);
+}
+
+// A round length (1, 2 or 5 times a power of ten) of at most `limit` metres.
+double roundLength(double limit) {
+  const double p = std::pow(10.0, std::floor(std::log10(limit)));
+  for (double m : {5.0, 2.0, 1.0}) {
+    if (m * p <= limit) return m * p;
+  }
+  return p;
+}
+
+std::string lengthLabel(double metres) {
+  char buf[32];
+  if (metres >= 1000) {
+    std::snprintf(buf, sizeof buf, "%g km", metres / 1000);
+  } else {
+    std::snprintf(buf, sizeof buf, "%g m", metres);
+  }
+  return buf;
+}
+
+void addText(vtkRenderer* r, const std::string& text, double x, double y, int size, bool bold, int vertical) {
+  vtkNew<vtkTextActor> a;
+  a->SetInput(text.c_str());
+  styleText(a->GetTextProperty(), size, bold);
+  a->GetTextProperty()->SetJustificationToCentered();
+  a->GetTextProperty()->SetVerticalJustification(vertical);
+  a->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+  a->GetPositionCoordinate()->SetValue(x, y);
+  r->AddActor2D(a);
+}
+
+// A scale bar in the lower left of the visible region, in world coordinates.
+void addScaleBar(vtkRenderer* r, double left, double bottom, double visibleWidth, double visibleHeight,
+                 const FigureOutput& out) {
+  const double length = roundLength(0.25 * visibleWidth);
+  const double x0 = left + 0.04 * visibleWidth, y0 = bottom + 0.04 * visibleHeight;
+  const double tick = 0.012 * visibleHeight;
+  vtkNew<vtkPoints> pts;
+  for (const auto& [x, y] : {std::pair{x0, y0 + tick}, {x0, y0}, {x0 + length, y0}, {x0 + length, y0 + tick}}) {
+    pts->InsertNextPoint(x, y, 2.0);
+  }
+  vtkNew<vtkCellArray> line;
+  line->InsertNextCell(4);
+  for (vtkIdType i = 0; i < 4; ++i) line->InsertCellPoint(i);
+  vtkNew<vtkPolyData> bar;
+  bar->SetPoints(pts);
+  bar->SetLines(line);
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputData(bar);
+  vtkNew<vtkActor> actor;
+  actor->SetMapper(mapper);
+  actor->GetProperty()->SetColor(0, 0, 0);
+  actor->GetProperty()->SetLineWidth(3.0f);
+  r->AddActor(actor);
+  vtkNew<vtkTextActor> label;
+  label->SetInput(lengthLabel(length).c_str());
+  styleText(label->GetTextProperty(), fontSize(out, 0.022));
+  label->GetTextProperty()->SetJustificationToCentered();
+  label->GetTextProperty()->SetVerticalJustificationToBottom();
+  label->GetPositionCoordinate()->SetCoordinateSystemToWorld();
+  label->GetPositionCoordinate()->SetValue(x0 + 0.5 * length, y0 + 1.5 * tick, 2.0);
+  r->AddActor2D(label);
+}
+
+}  // namespace
+
+std::string vtkVersionString() { return std::string("VTK ") + vtkVersion::GetVTKVersion(); }
+
+void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, const ColourScale& scale,
+                const FigureOutput& out) {
+  checkOutput(out);
+  Box extent{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+             std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest()};
+  bool anyValue = false, anyNaN = false;
+  for (const MapPanel& p : panels) {
+    if (p.values.size() != p.shapes.size()) {
+      throw usageError(out.png + ": panel '" + p.title + "' has " + std::to_string(p.shapes.size()) +
+                       " shapes but " + std::to_string(p.values.size()) + " values");
+    }
+    for (const Polygon* s : p.shapes) {
+      const Box b = bounds(*s);
+      extent = {std::min(extent.minX, b.minX), std::min(extent.minY, b.minY), std::max(extent.maxX, b.maxX),
+                std::max(extent.maxY, b.maxY)};
+      anyValue = true;
+    }
+    for (double v : p.values) anyNaN = anyNaN || std::isnan(v);
+  }
+  if (!anyValue) throw usageError(out.png + ": no shape to draw");
+  auto window = offscreenWindow(out);
+
+  // Bands: title on top, colour bar below, panels in between.
+  const double barTop = 0.15, titleBottom = 0.87;
+  const auto lut = lookupTable(scale);
+  const int n = static_cast<int>(panels.size());
+  const double panelAspect = (out.width / static_cast<double>(n)) / (out.height * (titleBottom - barTop));
+  const double margin = 0.03 * std::max(extent.width(), extent.height());
+  const double halfHeight =
+      std::max(0.5 * extent.height() + margin, (0.5 * extent.width() + margin) / panelAspect);
+  const double cx = 0.5 * (extent.minX + extent.maxX), cy = 0.5 * (extent.minY + extent.maxY);
+
+  vtkNew<vtkRenderer> titles;
+  titles->SetViewport(0, titleBottom, 1, 1);
+  titles->SetBackground(1, 1, 1);
+  addText(titles, title, 0.5, 0.66, fontSize(out, 0.034), true, VTK_TEXT_CENTERED);
+  window->AddRenderer(titles);
+
+  std::vector<PanelGeometry> geometry(panels.size());
+  for (int i = 0; i < n; ++i) {
+    addText(titles, panels[i].title, (i + 0.5) / n, 0.18, fontSize(out, 0.026), false, VTK_TEXT_CENTERED);
+    buildPanel(panels[i], geometry[i]);
+    vtkNew<vtkRenderer> r;
+    r->SetViewport(static_cast<double>(i) / n, barTop, static_cast<double>(i + 1) / n, titleBottom);
+    r->SetBackground(1, 1, 1);
+    vtkNew<vtkPolyDataMapper> fillMapper;
+    fillMapper->SetInputData(geometry[i].fill);
+    fillMapper->SetLookupTable(lut);
+    fillMapper->SetScalarModeToUseCellData();
+    fillMapper->UseLookupTableScalarRangeOn();
+    fillMapper->ScalarVisibilityOn();
+    vtkNew<vtkActor> fill;
+    fill->SetMapper(fillMapper);
+    fill->GetProperty()->LightingOff();
+    r->AddActor(fill);
+    vtkNew<vtkPolyDataMapper> ringMapper;
+    ringMapper->SetInputData(geometry[i].rings);
+    ringMapper->ScalarVisibilityOff();
+    vtkNew<vtkActor> rings;
+    rings->SetMapper(ringMapper);
+    rings->SetPosition(0, 0, 1);  // above the fill
+    rings->GetProperty()->SetColor(0.45, 0.45, 0.45);
+    rings->GetProperty()->SetLineWidth(1.0f);
+    rings->GetProperty()->LightingOff();
+    r->AddActor(rings);
+
+    vtkCamera* camera = r->GetActiveCamera();
+    camera->ParallelProjectionOn();
+    camera->SetFocalPoint(cx, cy, 0);
+    camera->SetPosition(cx, cy, 100);
+    camera->SetViewUp(0, 1, 0);
+    camera->SetParallelScale(halfHeight);
+    camera->SetClippingRange(1, 1000);
+    addScaleBar(r, cx - halfHeight * panelAspect, cy - halfHeight, 2 * halfHeight * panelAspect, 2 * halfHeight,
+                out);
+    window->AddRenderer(r);
+  }
+
+  vtkNew<vtkRenderer> legend;
+  legend->SetViewport(0, 0, 1, barTop);
+  legend->SetBackground(1, 1, 1);
+  vtkNew<vtkScalarBarActor> bar;
+  bar->SetLookupTable(lut);
+  bar->SetOrientationToHorizontal();
+  // The bar's own title would sit among the labels: the title is a text of its own above the bar.
+  addText(legend, scale.title, 0.5, 0.97, fontSize(out, 0.024), false, VTK_TEXT_TOP);
+  bar->SetNumberOfLabels(6);
+  bar->SetLabelFormat("%.3g");
+  bar->UnconstrainedFontSizeOn();
+  bar->SetTextPositionToPrecedeScalarBar();
+  styleText(bar->GetLabelTextProperty(), fontSize(out, 0.02));
+  styleText(bar->GetAnnotationTextProperty(), fontSize(out, 0.02));
+  if (anyNaN) {
+    bar->DrawNanAnnotationOn();
+    bar->SetNanAnnotation("no value");
+  }
+  bar->SetBarRatio(0.45);
+  bar->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+  bar->GetPositionCoordinate()->SetValue(0.2, 0.02);
+  bar->SetWidth(0.6);
+  bar->SetHeight(0.66);
+  legend->AddActor2D(bar);
+  window->AddRenderer(legend);
+
+  writeFigure(window, out, title);
+}
+
+void renderHistogram(const std::string& title, const std::string& xTitle, const std::string& yTitle,
+                     const std::vector<double>& edges, const std::vector<HistogramSeries>& series,
+                     const FigureOutput& out) {
+  checkOutput(out);
+  if (edges.size() < 2) throw usageError(out.png + ": a histogram needs at least one bin");
+  const std::size_t bins = edges.size() - 1;
+  int highest = 1;
+  for (const HistogramSeries& s : series) {
+    if (s.counts.size() != bins) {
+      throw usageError(out.png + ": series '" + s.label + "' has " + std::to_string(s.counts.size()) +
+                       " counts for " + std::to_string(bins) + " bins");
+    }
+    for (int c : s.counts) highest = std::max(highest, c);
+  }
+  const auto window = offscreenWindow(out);
+  vtkNew<vtkContextView> view;
+  view->SetRenderWindow(window);
+  view->GetRenderer()->SetBackground(1, 1, 1);
+  vtkNew<vtkChartXY> chart;
+  view->GetScene()->AddItem(chart);
+  chart->SetTitle(title);
+  styleText(chart->GetTitleProperties(), fontSize(out, 0.034), true);
+
+  std::vector<vtkSmartPointer<vtkTable>> tables;
+  for (const HistogramSeries& s : series) {
+    // Step outline: up at each left edge, across the bin, down at the last edge.
+    auto table = vtkSmartPointer<vtkTable>::New();
+    for (const char* name : {"x", "zero", "count"}) {
+      vtkNew<vtkDoubleArray> column;
+      column->SetName(name);
+      table->AddColumn(column);
+    }
+    table->SetNumberOfRows(static_cast<vtkIdType>(2 * bins + 2));
+    vtkIdType row = 0;
+    auto put = [&](double x, double y) {
+      table->SetValue(row, 0, x);
+      table->SetValue(row, 1, 0.0);
+      table->SetValue(row, 2, y);
+      ++row;
+    };
+    put(edges.front(), 0);
+    for (std::size_t k = 0; k < bins; ++k) {
+      put(edges[k], s.counts[k]);
+      put(edges[k + 1], s.counts[k]);
+    }
+    put(edges.back(), 0);
+    tables.push_back(table);
+
+    auto* area = vtkPlotArea::SafeDownCast(chart->AddPlot(vtkChart::AREA));
+    area->SetInputData(table);
+    area->SetInputArray(0, "x");
+    area->SetInputArray(1, "zero");
+    area->SetInputArray(2, "count");
+    area->GetBrush()->SetColorF(s.colour.r, s.colour.g, s.colour.b, 0.3);
+    area->GetPen()->SetLineType(vtkPen::NO_PEN);
+    area->SetLabel(s.label);
+    auto* line = vtkPlotLine::SafeDownCast(chart->AddPlot(vtkChart::LINE));
+    line->SetInputData(table, "x", "count");
+    line->GetPen()->SetColorF(s.colour.r, s.colour.g, s.colour.b, 1.0);
+    line->SetWidth(2.5f);
+    line->SetLegendVisibility(false);
+  }
+
+  vtkAxis* x = chart->GetAxis(vtkAxis::BOTTOM);
+  vtkAxis* y = chart->GetAxis(vtkAxis::LEFT);
+  x->SetTitle(xTitle);
+  y->SetTitle(yTitle);
+  x->SetBehavior(vtkAxis::FIXED);
+  x->SetRange(edges.front(), edges.back());
+  y->SetBehavior(vtkAxis::FIXED);
+  y->SetRange(0, 1.08 * highest);
+  x->SetNotation(vtkAxis::FIXED_NOTATION);
+  x->SetPrecision(edges.back() - edges.front() >= 20 ? 0 : 1);
+  y->SetNotation(vtkAxis::FIXED_NOTATION);
+  y->SetPrecision(0);
+  for (vtkAxis* a : {x, y}) {
+    styleText(a->GetTitleProperties(), fontSize(out, 0.028), true);
+    styleText(a->GetLabelProperties(), fontSize(out, 0.022));
+    a->GetGridPen()->SetColorF(0.88, 0.88, 0.88);
+  }
+  chart->SetShowLegend(true);
+  chart->GetLegend()->SetLabelSize(fontSize(out, 0.026));
+  chart->GetLegend()->SetHorizontalAlignment(vtkChartLegend::RIGHT);
+  chart->GetLegend()->SetVerticalAlignment(vtkChartLegend::TOP);
+  writeFigure(window, out, title);
+}
+
+}  // namespace parcelscope::viz
