@@ -12,7 +12,7 @@ packages=(
   libgeographiclib-dev
   libgdal-dev gdal-bin
   libgtest-dev libgmock-dev googletest libbenchmark-dev
-  xvfb xauth
+  libx11-dev xvfb xauth libgl1-mesa-dri
 )
 
 missing=()

@@ -1,16 +1,24 @@
 // Benchmarks. 1) The stats pipeline (read + project + clean + metrics + blocks) on
 // cambridge_ma against a plain GDAL read of the same file (every feature and its
 // geometry fetched). Target: the pipeline within 3x of the plain read.
+// 2) OBB subdivision of every block. 3) The whole `compare` job, stage by stage
+// (figures only when an X server answers: run under scripts/with-xvfb.sh).
 //   build/release/tests/bench/parcelscope_bench
+//   scripts/with-xvfb.sh build/release/tests/bench/parcelscope_bench --benchmark_filter=Compare
 #include <benchmark/benchmark.h>
 #include <gdal_priv.h>
 #include <ogrsf_frmts.h>
 
+#include <cpl_json.h>
+
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <map>
 
 #include "parcelscope/analysis/StatsJob.h"
 #include "parcelscope/generation/GenerateJob.h"
+#include "parcelscope/viz/CompareJob.h"
 
 namespace {
 
@@ -89,6 +97,36 @@ void ObbSubdivisionPerBlock(benchmark::State& state) {
                                                       benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(ObbSubdivisionPerBlock)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
+
+// The whole `compare` job on cambridge_ma (right-of-way filtered as in the
+// README), as the command line runs it: read, blocks, generation, metrics,
+// tables and figures. Counters give the seconds of each stage (summary.json).
+void CompareCambridge(benchmark::State& state) {
+  if (!haveData(state)) return;
+  const bool figures = std::getenv("DISPLAY") != nullptr;
+  parcelscope::viz::CompareRequest request;
+  request.input.path = kCambridge;
+  request.input.where = "ML <> 'ROAD'";
+  request.parameters = parcelscope::defaultValues(parcelscope::viz::compareParameters());
+  request.parameters["figures"] = figures ? 1 : 0;
+  const auto out = std::filesystem::temp_directory_path() / "parcelscope-bench-compare";
+  std::map<std::string, double> seconds;
+  for (auto _ : state) {
+    std::filesystem::remove_all(out);
+    parcelscope::viz::runCompare(request, out.string());
+    CPLJSONDocument summary;
+    summary.Load((out / "summary.json").string());
+    for (const auto& stage : summary.GetRoot().GetObj("timing_s").GetChildren()) {
+      seconds[stage.GetName()] += stage.ToDouble();
+    }
+  }
+  std::filesystem::remove_all(out);
+  for (const auto& [stage, s] : seconds) {
+    state.counters[stage + "_s"] = benchmark::Counter(s, benchmark::Counter::kAvgIterations);
+  }
+  state.SetLabel(figures ? "with figures" : "no X server: without figures");
+}
+BENCHMARK(CompareCambridge)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(3);
 
 }  // namespace
 

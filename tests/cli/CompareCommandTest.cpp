@@ -2,7 +2,7 @@
 // parses, generated parcels tile their blocks, the distances lie in their
 // ranges, the figures have the requested size and ink, one figure matches its
 // baseline image; no display, a bad style and Ctrl-C leave nothing behind.
-// Runs under xvfb-run (tests/xvfb-run-test.sh).
+// Runs under xvfb-run (scripts/with-xvfb.sh).
 #include <cpl_json.h>
 #include <gdal_priv.h>
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // Off-screen figures read back pixel by pixel: the requested size, ink where
 // the shapes are, the colour scale's ends, holes left open, panels drawn at the
 // same extent and scale, and charts with their text in the SVG copy.
-// Runs under xvfb-run (tests/xvfb-run-test.sh).
+// Runs under xvfb-run (scripts/with-xvfb.sh).
 #include <gtest/gtest.h>
 
 #include <fstream>

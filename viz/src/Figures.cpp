@@ -70,7 +70,7 @@ vtkSmartPointer<vtkRenderWindow> offscreenWindow(const FigureOutput& out) {
   requireDisplay();
   auto window = vtkSmartPointer<vtkRenderWindow>::New();
   window->SetOffScreenRendering(1);
-  window->SetMultiSamples(8);
+  window->SetMultiSamples(8);  // smooth edges and text
   window->SetSize(out.width, out.height);
   return window;
 }
