@@ -78,6 +78,10 @@ CompareResult compare(const CompareRequest& request, const ProgressFn& progress)
   CompareResult r;
   r.observed = analysis::loadObserved(request.input, request.parameters, scaledProgress(progress, 0.0, 0.45));
   const analysis::ObservedAnalysis& a = r.observed.analysis;
+  if (a.blocks.empty()) {
+    throw inputError(request.input.path + ": no block to compare (no parcel is left once right-of-way parcels "
+                     "are set aside)");
+  }
 
   generation::GenerateRequest g;
   g.input = request.input;

@@ -25,6 +25,7 @@
 #include <vtkProperty.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
+#include <vtkRendererCollection.h>
 #include <vtkScalarBarActor.h>
 #include <vtkTable.h>
 #include <vtkTextActor.h>
@@ -66,11 +67,22 @@ void styleText(vtkTextProperty* p, int size, bool bold = false) {
   p->SetColor(0.1, 0.1, 0.1);
 }
 
+// One hidden window serves every figure of the process: a new window means a
+// new OpenGL context, whose shaders a software renderer (llvmpipe under Xvfb)
+// compiles again, about half a second each time. Each figure starts by
+// removing the renderers of the previous one. Rendering is not thread-safe:
+// figures are drawn one at a time.
 vtkSmartPointer<vtkRenderWindow> offscreenWindow(const FigureOutput& out) {
   requireDisplay();
-  auto window = vtkSmartPointer<vtkRenderWindow>::New();
-  window->SetOffScreenRendering(1);
-  window->SetMultiSamples(8);  // smooth edges and text
+  static vtkSmartPointer<vtkRenderWindow> window;
+  if (!window) {
+    window = vtkSmartPointer<vtkRenderWindow>::New();
+    window->SetOffScreenRendering(1);
+    window->SetMultiSamples(8);  // smooth edges and text
+  }
+  while (window->GetRenderers()->GetNumberOfItems() > 0) {
+    window->RemoveRenderer(window->GetRenderers()->GetFirstRenderer());
+  }
   window->SetSize(out.width, out.height);
   return window;
 }
