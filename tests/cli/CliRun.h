@@ -14,10 +14,9 @@ struct CliRun {
   std::string output;  ///< stdout and stderr
 };
 
-/// Runs `parcelscope ARGS` through the shell (ARGS quoted as needed), prefixed by `env`
-/// (e.g. "env -u DISPLAY").
-inline CliRun runCli(const std::string& args, const std::string& env = "") {
-  const std::string cmd = env + (env.empty() ? "" : " ") + "'" + PARCELSCOPE_CLI + "' " + args + " 2>&1";
+/// Runs a shell command line, collecting stdout and stderr.
+inline CliRun runShell(const std::string& commandLine) {
+  const std::string cmd = commandLine + " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");
   CliRun r{-1, ""};
   if (!pipe) return r;
@@ -26,6 +25,12 @@ inline CliRun runCli(const std::string& args, const std::string& env = "") {
   const int status = pclose(pipe);
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+/// Runs `parcelscope ARGS` through the shell (ARGS quoted as needed), prefixed by `env`
+/// (e.g. "env -u DISPLAY").
+inline CliRun runCli(const std::string& args, const std::string& env = "") {
+  return runShell(env + (env.empty() ? "" : " ") + "'" + PARCELSCOPE_CLI + "' " + args);
 }
 
 inline std::string slurp(const std::string& path) {

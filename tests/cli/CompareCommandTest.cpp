@@ -270,6 +270,20 @@ TEST(CompareCommand, WithoutDisplayFiguresFailCleanlyAndFiguresZeroSkipsThem) {
   EXPECT_FALSE(fs::exists(dir.file("b") + "/figures"));
 }
 
+TEST(CompareCommand, DrawsAProgressBarOnATerminal) {
+  TempDir dir;
+  // script(1) gives the command a pseudo-terminal, as a user's shell would.
+  const std::string command = "'" + std::string(PARCELSCOPE_CLI) + "' compare " + kSampleArgs +
+                              " --figures 0 --out '" + dir.file("out") + "'";
+  std::string quoted;
+  for (char c : command) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  const CliRun r = test::runShell("script -qec '" + quoted + "' /dev/null");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("\r[###"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("] 100%"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("subdividing"), std::string::npos) << r.output;
+}
+
 TEST(CompareCommand, UnknownStyleIsAUsageErrorAndWritesNothing) {
   TempDir dir;
   const CliRun r = runCli("compare " + kSampleArgs + " --style voronoi --out '" + dir.file("x") + "' --quiet");
