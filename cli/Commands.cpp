@@ -19,7 +19,7 @@ const char* kOverview =
     "commands:\n"
     "  stats     read observed parcels, build blocks, write per-parcel metrics,\n"
     "            per-block statistics and generator parameters\n"
-    "  generate  subdivide blocks into procedural parcels (OBB style)\n"
+    "  generate  subdivide blocks into procedural parcels (OBB, skeleton or offset style)\n"
     "  version   print the version\n"
     "\n"
     "'parcelscope COMMAND --help' describes a command's options.\n";
@@ -79,20 +79,16 @@ int statsCommand(const std::vector<std::string>& args) {
 
 int generateCommand(const std::vector<std::string>& args) {
   auto flags = inputFlags();
-  flags.push_back({"style", "subdivision style: obb (Vanegas et al. 2012, 4.3)"});
+  std::string styleHelp = "subdivision style (default obb):";
+  for (const auto& [name, help] : generation::generationStyles()) styleHelp += "\n      " + name + ": " + help;
+  flags.push_back({"style", styleHelp});
   flags.push_back({"from-parcels", "INPUT holds observed parcels: build blocks and per-block bounds as 'stats' does",
                    false});
   flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
   flags.push_back({"quiet", "no progress or summary on stderr", false});
-  // One list of parameters; a name shared by both (min-frontage) appears once.
-  std::vector<ParameterDescription> params = generation::obbParameterDescriptions();
-  for (const auto& d : analysis::analysisParameters()) {
-    bool seen = false;
-    for (const auto& p : params) seen = seen || p.name == d.name;
-    if (!seen) params.push_back(d);
-  }
+  const std::vector<ParameterDescription> params = generation::generationParameterDescriptions();
   if (wantsHelp(args)) {
-    std::fputs(usageText("parcelscope generate INPUT --style obb [options] [--seed N] --out DIR", flags, params)
+    std::fputs(usageText("parcelscope generate INPUT [--style obb|skeleton|offset|auto] [options] [--seed N] --out DIR", flags, params)
                    .c_str(),
                stdout);
     std::fputs("\nINPUT holds block polygons (e.g. blocks.gpkg from 'parcelscope stats', whose a_min, a_max,\n"
