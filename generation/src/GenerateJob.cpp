@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "parcelscope/analysis/StatsJob.h"
+#include "parcelscope/analysis/StreetWidth.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
 #include "parcelscope/io/OutputDirectory.h"
@@ -54,7 +55,7 @@ constexpr double kDefaultOffsetStyleDepth = 30.0;  // m, style offset without --
 }  // namespace
 
 Subdivision subdivideBlock(const Polygon& block, const std::string& style, const SkeletonParameters& parameters,
-                           std::uint64_t seed) {
+                           std::uint64_t seed, const StreetWidths& streetWidths) {
   if (style == "obb") return subdivideObb(block, parameters.bounds, seed);
   SkeletonParameters p = parameters;
   if (style == "offset") {
@@ -63,7 +64,7 @@ Subdivision subdivideBlock(const Polygon& block, const std::string& style, const
   } else if (style != "skeleton") {
     throw usageError("no subdivision style '" + style + "'");
   }
-  return subdivideSkeleton(block, p, seed);
+  return subdivideSkeleton(block, p, seed, streetWidths);
 }
 
 namespace {
@@ -163,6 +164,13 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
       styles[k] = std::isfinite(share) && share < kAutoSkeletonAccessShare ? "obb" : "skeleton";
     }
   }
+  // Street widths from the block layout, for the skeleton styles' StreetWidth rule.
+  std::vector<StreetWidths> widths;
+  if (std::count(styles.begin(), styles.end(), "obb") != static_cast<long>(styles.size())) {
+    std::vector<const Polygon*> shapes;
+    for (const Unit& u : units) shapes.push_back(&u.shape);
+    widths = analysis::streetWidths(shapes);
+  }
   std::vector<Subdivision> results(units.size());
   const ProgressFn sub = scaledProgress(progress, request.fromParcels ? 0.4 : 0.2, 0.9);
   parallelFor(
@@ -172,7 +180,7 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
         const std::uint64_t seed = blockSeed(out.seed, positionKey(u.shape, out.source.frame));
         SkeletonParameters p = skeleton;
         p.bounds = u.p;
-        results[k] = subdivideBlock(u.shape, styles[k], p, seed);
+        results[k] = subdivideBlock(u.shape, styles[k], p, seed, widths.empty() ? StreetWidths{} : widths[k]);
       },
       [&](std::size_t done) {
         reportProgress(sub, static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(1, units.size())),

@@ -1,10 +1,12 @@
 #include "parcelscope/generation/SkeletonSubdivision.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Straight_skeleton_builder_2.h>
 #include <CGAL/create_straight_skeleton_2.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -60,6 +62,43 @@ using detail::Region;
 using Kc = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Skeleton = CGAL::Straight_skeleton_2<Kc>;
 
+// Watches CGAL's skeleton construction. CGAL 5.5 tidies the finished wavefront
+// by walking each face's cycle of halfedges (MergeCoincidentNodes) without a
+// bound: on a structure that nearly degenerate input has left broken, it loops
+// until memory runs out or crashes. Before the tidying starts, every face cycle
+// is walked here with a bound; a broken one stops the construction (CGAL turns
+// the exception into a null skeleton).
+struct GuardVisitor : CGAL::Dummy_straight_skeleton_builder_2_visitor<Skeleton> {
+  using Halfedge = Skeleton::Halfedge_const_handle;
+  mutable std::vector<Halfedge> contour;
+  mutable bool broken = false;
+
+  void on_contour_edge_entered(const Halfedge& h) const { contour.push_back(h); }
+
+  void on_cleanup_started() const {
+    const std::size_t limit = 64 * contour.size() + 1024;
+    for (const Halfedge& c : contour) {
+      const auto face = c->face();
+      if (face == Skeleton::Face_const_handle()) return fail();
+      const Halfedge first = face->halfedge();
+      Halfedge h = first;
+      std::size_t steps = 0;
+      do {
+        h = h->next();
+        if (h == Halfedge() || ++steps > limit) return fail();
+      } while (h != first);
+    }
+  }
+
+private:
+  void fail() const {
+    broken = true;
+    throw std::runtime_error("broken skeleton face");
+  }
+};
+using SkeletonTraits = CGAL::Straight_skeleton_builder_traits_2<Kc>;
+using SkeletonMaker = CGAL::Straight_skeleton_builder_2<SkeletonTraits, Skeleton, GuardVisitor>;
+
 // Thrown inside the builder when the skeleton route cannot handle a block; the
 // block then goes to the OBB style.
 struct Fallback : std::runtime_error {
@@ -92,9 +131,8 @@ struct Edge {
 constexpr double kChordTolerances[] = {0.5, 1.0, 0.25, 0.0};  // m
 constexpr std::size_t kMaxFullVertices = 1500;
 
-// Parts of a skeleton face beyond d_offset thinner than this on average (m)
-// are left in the face's strip rather than made patio.
-constexpr double kPatioSliver = 0.01;
+// Largest move of a contour vertex in the skeleton's input (m); see buildSkeleton.
+constexpr double kJitter = 1e-6;
 
 // Indices of the ring's vertices that the skeleton keeps (Douglas-Peucker on
 // the closed ring, from its sharpest corner and the vertex furthest from it).
@@ -278,27 +316,61 @@ public:
   }
 
 private:
+  // The edge after edge g along its ring.
+  int nextEdge(int g) const {
+    const int r = edges_[g].ring;
+    return g + 1 == ringStart_[r + 1] ? ringStart_[r] : g + 1;
+  }
+
   // ---- 1. skeleton and initial split ------------------------------------
   void buildSkeleton() {
+    // The skeleton is built on the kept vertices moved by a deterministic
+    // jitter of up to kJitter: CGAL 5.5 can loop without end (allocating until
+    // memory runs out) while merging exactly coincident skeleton nodes, which
+    // symmetric block layouts produce. Contour vertices keep their own
+    // positions in everything built from the skeleton.
+    std::vector<Point> input(edges_.size());
+    std::map<std::pair<double, double>, int> edgeByStart;  // by jittered start
+    for (std::size_t g = 0; g < edges_.size(); ++g) {
+      const Point& a = edges_[g].a;
+      std::uint64_t bx, by;
+      std::memcpy(&bx, &a.x, sizeof bx);
+      std::memcpy(&by, &a.y, sizeof by);
+      std::uint64_t h = detail::splitmix64(bx ^ detail::splitmix64(by));
+      const double jx = (static_cast<double>(h >> 11) * 0x1.0p-53 * 2 - 1) * kJitter;
+      h = detail::splitmix64(h);
+      const double jy = (static_cast<double>(h >> 11) * 0x1.0p-53 * 2 - 1) * kJitter;
+      input[g] = {a.x + jx, a.y + jy};
+      if (!edgeByStart.emplace(std::make_pair(input[g].x, input[g].y), static_cast<int>(g)).second) {
+        throw Fallback("two contour vertices coincide");
+      }
+    }
     std::vector<Kc::Point_2> outer;
-    for (int g = ringStart_[0]; g < ringStart_[1]; ++g) outer.emplace_back(edges_[g].a.x, edges_[g].a.y);
+    for (int g = ringStart_[0]; g < ringStart_[1]; ++g) outer.emplace_back(input[g].x, input[g].y);
     std::vector<CGAL::Polygon_2<Kc>> holes;
     for (std::size_t r = 1; r + 1 < ringStart_.size(); ++r) {
       CGAL::Polygon_2<Kc> hole;
-      for (int g = ringStart_[r]; g < ringStart_[r + 1]; ++g) hole.push_back(Kc::Point_2(edges_[g].a.x, edges_[g].a.y));
+      for (int g = ringStart_[r]; g < ringStart_[r + 1]; ++g) hole.push_back(Kc::Point_2(input[g].x, input[g].y));
       holes.push_back(std::move(hole));
     }
-    const auto ss =
-        CGAL::create_interior_straight_skeleton_2(outer.begin(), outer.end(), holes.begin(), holes.end(), Kc());
-    if (!ss) throw Fallback("no straight skeleton could be built");
+    GuardVisitor guard;
+    SkeletonMaker maker(boost::none, SkeletonTraits(), guard);
+    maker.enter_contour(outer.begin(), outer.end());
+    for (const auto& hole : holes) maker.enter_contour(hole.vertices_begin(), hole.vertices_end());
+    const auto ss = maker.construct_skeleton();
+    if (!ss) throw Fallback(guard.broken ? "the straight skeleton came out broken" : "no straight skeleton could be built");
 
-    std::map<std::pair<double, double>, int> edgeByStart;
-    for (std::size_t g = 0; g < edges_.size(); ++g) edgeByStart[{edges_[g].a.x, edges_[g].a.y}] = static_cast<int>(g);
     std::unordered_map<const void*, int> vertexIndex;
     auto vertexOf = [&](auto v) {
       auto [it, added] = vertexIndex.emplace(&*v, static_cast<int>(vertices_.size()));
       if (added) {
-        vertices_.push_back({{v->point().x(), v->point().y()}, v->time()});
+        Point p{v->point().x(), v->point().y()};
+        if (v->is_contour()) {
+          auto e = edgeByStart.find({p.x, p.y});
+          if (e == edgeByStart.end()) throw Fallback("a skeleton contour vertex is not the block's");
+          p = edges_[e->second].a;
+        }
+        vertices_.push_back({p, v->is_contour() ? 0.0 : v->time()});
         maxTime_ = std::max(maxTime_, v->time());
       }
       return it->second;
@@ -309,7 +381,8 @@ private:
       const auto h = f->halfedge();
       const auto a = h->opposite()->vertex()->point(), b = h->vertex()->point();
       auto it = edgeByStart.find({a.x(), a.y()});
-      if (it == edgeByStart.end() || edges_[it->second].b.x != b.x() || edges_[it->second].b.y != b.y()) {
+      if (it == edgeByStart.end() || input[nextEdge(it->second)].x != b.x() ||
+          input[nextEdge(it->second)].y != b.y()) {
         throw Fallback("a skeleton face does not match a contour edge");
       }
       if (!edgeOfFace.emplace(&*f, it->second).second) throw Fallback("two skeleton faces on one edge");
@@ -410,16 +483,8 @@ private:
       if (normalise(nearPolygon)) {
         PWH strip(detail::toExact(nearPolygon.outer));
         if (!strip.outer_boundary().is_simple()) throw Fallback("an offset strip is not simple");
-        // What lies beyond d along a ridge only just deeper than d is a sliver
-        // (mean width 2A/P under kPatioSliver): it stays with the strip, or
-        // once rounded it would pinch the patio into invalid shapes.
-        Region near{strip};
-        for (PWH& part : detail::subtract({face}, strip)) {
-          Polygon r;
-          const bool sliver = !detail::toDouble(part, r) || 2 * area(r) / perimeter(r) < kPatioSliver;
-          (sliver ? near : patioParts).push_back(std::move(part));
-        }
-        regions_[g] = detail::join(near);
+        regions_[g] = {strip};
+        for (PWH& part : detail::subtract({face}, strip)) patioParts.push_back(std::move(part));
       } else {
         patioParts.push_back(face);
       }

@@ -34,8 +34,9 @@ std::vector<ParameterDescription> generationParameterDescriptions();
 /// Subdivides one block with a concrete style (obb, skeleton or offset; not
 /// auto): `parameters.bounds` for obb, all of `parameters` for the skeleton
 /// styles (offset: d_offset 30 m when 0, patios always subdivided).
+/// `streetWidths` (per contour edge, see StreetWidths) feed the StreetWidth rule.
 Subdivision subdivideBlock(const Polygon& block, const std::string& style, const SkeletonParameters& parameters,
-                           std::uint64_t seed);
+                           std::uint64_t seed, const StreetWidths& streetWidths = {});
 
 /// Share of observed parcels with street access at or above which `auto` picks skeleton.
 constexpr double kAutoSkeletonAccessShare = 0.9;
