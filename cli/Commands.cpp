@@ -21,7 +21,7 @@ const char* kOverview =
     "commands:\n"
     "  stats     read observed parcels, build blocks, write per-parcel metrics,\n"
     "            per-block statistics and generator parameters\n"
-    "  generate  subdivide blocks into procedural parcels (OBB style)\n"
+    "  generate  subdivide blocks into procedural parcels (OBB, skeleton or offset style)\n"
     "  compare   generate parcels in the blocks of observed ones and compare the two sets:\n"
     "            per-block and city-wide tables, distances, layers and figures\n"
     "  version   print the version\n"
@@ -32,6 +32,12 @@ std::vector<FlagSpec> inputFlags() {
   return {{"layer", "layer to read (default: the first)"},
           {"where", "OGR SQL attribute filter, e.g. \"ML <> 'ROAD'\""},
           {"crs", "CRS of the input (e.g. EPSG:2286), replacing a missing or wrong one"}};
+}
+
+FlagSpec styleFlag() {
+  std::string help = "subdivision style (default obb):";
+  for (const auto& [name, text] : generation::generationStyles()) help += "\n      " + name + ": " + text;
+  return {"style", help};
 }
 
 bool wantsHelp(const std::vector<std::string>& args) {
@@ -102,20 +108,14 @@ int statsCommand(const std::vector<std::string>& args) {
 
 int generateCommand(const std::vector<std::string>& args) {
   auto flags = inputFlags();
-  flags.push_back({"style", "subdivision style: obb (Vanegas et al. 2012, 4.3)"});
+  flags.push_back(styleFlag());
   flags.push_back({"from-parcels", "INPUT holds observed parcels: build blocks and per-block bounds as 'stats' does",
                    false});
   flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
   flags.push_back({"quiet", "no progress or summary on stderr", false});
-  // One list of parameters; a name shared by both (min-frontage) appears once.
-  std::vector<ParameterDescription> params = generation::obbParameterDescriptions();
-  for (const auto& d : analysis::analysisParameters()) {
-    bool seen = false;
-    for (const auto& p : params) seen = seen || p.name == d.name;
-    if (!seen) params.push_back(d);
-  }
+  const std::vector<ParameterDescription> params = generation::generationParameterDescriptions();
   if (wantsHelp(args)) {
-    std::fputs(usageText("parcelscope generate INPUT --style obb [options] [--seed N] --out DIR", flags, params)
+    std::fputs(usageText("parcelscope generate INPUT [--style obb|skeleton|offset|auto] [options] [--seed N] --out DIR", flags, params)
                    .c_str(),
                stdout);
     std::fputs("\nINPUT holds block polygons (e.g. blocks.gpkg from 'parcelscope stats', whose a_min, a_max,\n"
@@ -136,13 +136,12 @@ int generateCommand(const std::vector<std::string>& args) {
 
 int compareCommand(const std::vector<std::string>& args) {
   auto flags = inputFlags();
-  flags.push_back({"style", "subdivision style passed to generation, as for 'generate' (default obb; skeleton, "
-                            "offset and auto once generation offers them)"});
+  flags.push_back(styleFlag());
   flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
   flags.push_back({"quiet", "no progress or summary on stderr", false});
   const auto params = viz::compareParameters();
   if (wantsHelp(args)) {
-    std::fputs(usageText("parcelscope compare INPUT [--style obb] [--k 2] [--seed N] [options] --out DIR", flags,
+    std::fputs(usageText("parcelscope compare INPUT [--style obb|skeleton|offset|auto] [--k 2] [--seed N] [options] --out DIR", flags,
                          params)
                    .c_str(),
                stdout);

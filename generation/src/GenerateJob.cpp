@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "parcelscope/analysis/StatsJob.h"
+#include "parcelscope/analysis/StreetWidth.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
 #include "parcelscope/io/OutputDirectory.h"
@@ -25,6 +26,47 @@ ObbParameters blockParameters(const GenerateRequest& request, double aMin, doubl
   return p;
 }
 
+const std::vector<std::pair<std::string, std::string>>& generationStyles() {
+  static const std::vector<std::pair<std::string, std::string>> styles = {
+      {"obb", "OBB recursive subdivision (Vanegas et al. 2012, 4.3)"},
+      {"skeleton", "straight-skeleton strips along the streets (4.2); --offset M leaves patios"},
+      {"offset", "skeleton with a finite offset (30 m unless --offset) and patios subdivided by OBB"},
+      {"auto", "per block: skeleton where >= 90 % of observed parcels have street access, else obb"},
+  };
+  return styles;
+}
+
+std::vector<ParameterDescription> generationParameterDescriptions() {
+  std::vector<ParameterDescription> params = obbParameterDescriptions();
+  auto add = [&](const std::vector<ParameterDescription>& more) {
+    for (const auto& d : more) {
+      bool seen = false;
+      for (const auto& p : params) seen = seen || p.name == d.name;
+      if (!seen) params.push_back(d);
+    }
+  };
+  add(skeletonParameterDescriptions());
+  add(analysis::analysisParameters());
+  return params;
+}
+
+namespace {
+constexpr double kDefaultOffsetStyleDepth = 30.0;  // m, style offset without --offset
+}  // namespace
+
+Subdivision subdivideBlock(const Polygon& block, const std::string& style, const SkeletonParameters& parameters,
+                           std::uint64_t seed, const StreetWidths& streetWidths) {
+  if (style == "obb") return subdivideObb(block, parameters.bounds, seed);
+  SkeletonParameters p = parameters;
+  if (style == "offset") {
+    if (p.offset <= 0) p.offset = kDefaultOffsetStyleDepth;
+    p.subdividePatios = true;
+  } else if (style != "skeleton") {
+    throw usageError("no subdivision style '" + style + "'");
+  }
+  return subdivideSkeleton(block, p, seed, streetWidths);
+}
+
 namespace {
 // A block's seed key: its centroid in the input CRS, rounded to about 0.1 m, so
 // that adding, removing or renumbering other blocks does not reseed it.
@@ -38,9 +80,16 @@ std::int64_t positionKey(const Polygon& shape, const io::LocalFrame& frame) {
 }  // namespace
 
 GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& progress) {
-  if (request.style != "obb") {
-    throw usageError("--style " + request.style + " is not available (styles: obb)");
+  {
+    std::string names;
+    bool known = false;
+    for (const auto& [name, help] : generationStyles()) {
+      known = known || name == request.style;
+      names += (names.empty() ? "" : ", ") + name;
+    }
+    if (!known) throw usageError("--style " + request.style + " is not available (styles: " + names + ")");
   }
+  const SkeletonParameters skeleton = skeletonParametersFrom(request.parameters);
   const ObbParameters global = obbParametersFrom(request.parameters);
   if (global.aMin > global.aMax) throw usageError("--a-min must not exceed --a-max");
   if (global.wMin > global.wMax) throw usageError("--w-min must not exceed --w-max");
@@ -53,6 +102,7 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
     std::int64_t blockId;
     Polygon shape;
     ObbParameters p;
+    double accessShare;  // of the block's observed parcels; NaN when unknown
   };
   std::vector<Unit> units;
   if (request.fromParcels) {
@@ -65,7 +115,7 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
       const auto& s = observed.analysis.statistics[b];
       const ObbParameters p = blockParameters(request, s.aMin, s.aMax, s.wMin, s.wMax);
       for (const Polygon& shape : observed.analysis.blocks[b].parts) {
-        units.push_back({observed.analysis.blocks[b].id, shape, p});
+        units.push_back({observed.analysis.blocks[b].id, shape, p, s.streetAccessShare});
       }
     }
     if (request.observed) {
@@ -75,12 +125,12 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
     }
   } else {
     io::ReadOptions in = request.input;
-    in.numericFields = {"block_id", "a_min", "a_max", "w_min", "w_max"};
+    in.numericFields = {"block_id", "a_min", "a_max", "w_min", "w_max", "street_access_share"};
     out.source = io::readParcels(in, scaledProgress(progress, 0.0, 0.2));
     for (std::size_t i = 0; i < out.source.parcels.size(); ++i) {
       const auto& f = out.source.fields[i];
       const std::int64_t id = std::isfinite(f[0]) ? static_cast<std::int64_t>(f[0]) : out.source.parcels[i].sourceFid;
-      units.push_back({id, out.source.parcels[i].shape, blockParameters(request, f[1], f[2], f[3], f[4])});
+      units.push_back({id, out.source.parcels[i].shape, blockParameters(request, f[1], f[2], f[3], f[4]), f[5]});
     }
   }
   // Per-block bounds (derived from observed parcels or read from the input) are
@@ -115,13 +165,30 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
 
   // Subdivide every block, in parallel; each block's seed depends only on its id.
   out.timings.start("subdivide");
+  std::vector<std::string> styles(units.size(), request.style);
+  if (request.style == "auto") {
+    for (std::size_t k = 0; k < units.size(); ++k) {
+      const double share = units[k].accessShare;
+      styles[k] = std::isfinite(share) && share < kAutoSkeletonAccessShare ? "obb" : "skeleton";
+    }
+  }
+  // Street widths from the block layout, for the skeleton styles' StreetWidth rule.
+  std::vector<StreetWidths> widths;
+  if (std::count(styles.begin(), styles.end(), "obb") != static_cast<long>(styles.size())) {
+    std::vector<const Polygon*> shapes;
+    for (const Unit& u : units) shapes.push_back(&u.shape);
+    widths = analysis::streetWidths(shapes);
+  }
   std::vector<Subdivision> results(units.size());
   const ProgressFn sub = scaledProgress(progress, request.fromParcels ? 0.4 : 0.2, 0.9);
   parallelFor(
       units.size(),
       [&](std::size_t k) {
         const Unit& u = units[k];
-        results[k] = subdivideObb(u.shape, u.p, blockSeed(out.seed, positionKey(u.shape, out.source.frame)));
+        const std::uint64_t seed = blockSeed(out.seed, positionKey(u.shape, out.source.frame));
+        SkeletonParameters p = skeleton;
+        p.bounds = u.p;
+        results[k] = subdivideBlock(u.shape, styles[k], p, seed, widths.empty() ? StreetWidths{} : widths[k]);
       },
       [&](std::size_t done) {
         reportProgress(sub, static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(1, units.size())),
@@ -138,8 +205,15 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
     }
     out.blocks.push_back(std::move(block));
     out.blockIds.push_back(units[k].blockId);
+    out.blockStyles.push_back(results[k].fallback ? "obb" : styles[k]);
     out.oversize += results[k].oversize;
     out.withoutAccess += results[k].withoutAccess;
+    out.patioParcels += results[k].patioParcels;
+    if (results[k].fallback) {
+      ++out.fallbackBlocks;
+      out.failures.push_back("block " + std::to_string(units[k].blockId) + ": skeleton not usable (" +
+                             results[k].fallbackReason + "), subdivided with obb");
+    }
     if (results[k].failed) {
       ++out.failedBlocks;
       out.failures.push_back("block " + std::to_string(units[k].blockId) + ": " + results[k].failure);
@@ -211,8 +285,16 @@ analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::stri
                         .set("parcels", static_cast<std::int64_t>(g.parcels.size()))
                         .set("parcels_oversize", g.oversize)
                         .set("parcels_without_street_access", g.withoutAccess)
+                        .set("patio_parcels", g.patioParcels)
+                        .set("blocks_fallback_obb", g.fallbackBlocks)
                         .set("per_block_bounds_clamped", g.clampedBounds)
                         .set("parcels_with_street_access_measured", withAccess));
+  Json styleCounts = Json::object();
+  for (const auto& [name, help] : generationStyles()) {
+    const auto n = std::count(g.blockStyles.begin(), g.blockStyles.end(), name);
+    if (n > 0) styleCounts.set(name, static_cast<std::int64_t>(n));
+  }
+  run.set("blocks_by_style", styleCounts);
   run.set("failures", failures);
   run.set("outputs", Json::array().push("parcels.gpkg").push("parcels.csv").push("run.json"));
   io::writeJson(out.stage("run.json"), run);
@@ -222,7 +304,9 @@ analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::stri
                         request.style + ", seed " + std::to_string(g.seed) + ") into " +
                         std::to_string(g.parcels.size()) + " parcels\n  " + std::to_string(g.oversize) +
                         " oversize (no admissible split), " + std::to_string(g.withoutAccess) +
-                        " without street access, " + std::to_string(g.failedBlocks) + " blocks refused";
+                        " without street access (" + std::to_string(g.patioParcels) + " patio parcels), " +
+                        std::to_string(g.fallbackBlocks) + " blocks fell back to obb, " +
+                        std::to_string(g.failedBlocks) + " blocks refused";
   for (const auto& f : g.failures) summary += "\n  " + f;
   return {run, summary};
 }

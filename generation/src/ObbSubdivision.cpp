@@ -4,7 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include "LocalShift.h"
 #include "PolygonSplit.h"
+#include "Random.h"
 #include "parcelscope/analysis/Metrics.h"
 #include "parcelscope/io/GeometryOps.h"
 
@@ -48,20 +50,8 @@ ObbParameters obbParametersFrom(const ParameterValues& v) {
 
 namespace {
 
-std::uint64_t splitmix64(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-
-// A tiny deterministic generator: the same seed gives the same sequence on
-// every platform (unlike the std distributions).
-struct Rng {
-  std::uint64_t state;
-  std::uint64_t next() { return state = splitmix64(state); }
-  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }  // [0, 1)
-};
+using detail::Rng;
+using detail::splitmix64;
 
 // The OBB of Vanegas et al.: the smallest box with a side along one of the
 // ring's own edges (edge-aligned, so small edits elsewhere do not turn it).
@@ -262,25 +252,8 @@ Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, 
   ObbParameters p = parameters;
   p.aMax = std::max(p.aMax, p.aMin);
   p.wMax = std::max(p.wMax, p.wMin);
-  // Blocks far from the origin are moved next to it (the exact kernel is much
-  // faster there), but only by a shift that is exact both ways: by Sterbenz's
-  // lemma x - o is exact when o/2 <= x <= 2o, and then (x - o) + o == x. Blocks
-  // already near the origin (io/ centres its frame on the data) stay put.
-  const Box b = bounds(block);
-  Point o{0.5 * (b.minX + b.maxX), 0.5 * (b.minY + b.maxY)};
-  auto exactShift = [](double lo, double hi, double c) {
-    return (c > 0 && lo >= 0.5 * c && hi <= 2 * c) || (c < 0 && hi <= 0.5 * c && lo >= 2 * c);
-  };
-  if (!exactShift(b.minX, b.maxX, o.x)) o.x = 0;
-  if (!exactShift(b.minY, b.maxY, o.y)) o.y = 0;
-  auto shift = [](const Polygon& in, double dx, double dy) {
-    Polygon r = in;
-    for (Point& q : r.outer) q = {q.x + dx, q.y + dy};
-    for (Ring& h : r.holes)
-      for (Point& q : h) q = {q.x + dx, q.y + dy};
-    return r;
-  };
-  Polygon local = shift(block, -o.x, -o.y);
+  const Point o = detail::exactShiftOrigin(block);
+  Polygon local = detail::translated(block, -o.x, -o.y);
   try {
     if (!normalise(local) || !detail::isValidForSplit(local)) {
       out.failed = true;
@@ -298,7 +271,7 @@ Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, 
     return out;
   }
   if (o.x != 0 || o.y != 0) {
-    for (Polygon& parcel : out.parcels) parcel = shift(parcel, o.x, o.y);
+    for (Polygon& parcel : out.parcels) parcel = detail::translated(parcel, o.x, o.y);
   }
   return out;
 }

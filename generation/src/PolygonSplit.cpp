@@ -1,40 +1,34 @@
 #include "PolygonSplit.h"
 
-#include <CGAL/Boolean_set_operations_2.h>
-#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
-#include <CGAL/Polygon_2.h>
-#include <CGAL/Polygon_with_holes_2.h>
-
+#include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <map>
+
+#include "Exact.h"
 
 namespace parcelscope::generation::detail {
 
-namespace {
-using K = CGAL::Exact_predicates_exact_constructions_kernel;
-using P2 = CGAL::Polygon_2<K>;
-using PWH = CGAL::Polygon_with_holes_2<K>;
-using Traits = CGAL::Gps_segment_traits_2<K>;
-
-P2 toCgal(const Ring& ring) {
+P2 toExact(const Ring& ring) {
   P2 p;
   for (const Point& v : ring) p.push_back(K::Point_2(v.x, v.y));
   return p;
 }
 
-PWH toCgal(const Polygon& polygon) {
-  P2 outer = toCgal(polygon.outer);
+PWH toExact(const Polygon& polygon) {
+  P2 outer = toExact(polygon.outer);
   if (outer.orientation() != CGAL::COUNTERCLOCKWISE) outer.reverse_orientation();
   std::vector<P2> holes;
   for (const Ring& h : polygon.holes) {
-    P2 hole = toCgal(h);
+    P2 hole = toExact(h);
     if (hole.orientation() != CGAL::CLOCKWISE) hole.reverse_orientation();
     holes.push_back(std::move(hole));
   }
   return PWH(outer, holes.begin(), holes.end());
 }
 
-Ring fromCgal(const P2& p) {
+namespace {
+Ring ringToDouble(const P2& p) {
   Ring r;
   r.reserve(p.size());
   for (auto v = p.vertices_begin(); v != p.vertices_end(); ++v) {
@@ -42,50 +36,235 @@ Ring fromCgal(const P2& p) {
   }
   return r;
 }
+}  // namespace
 
-std::vector<Polygon> clip(const PWH& polygon, const P2& halfPlane) {
-  // With explicit segment traits: the default for Epeck polygons converts to
-  // polylines, a path that leaks in CGAL 5.5.
-  std::vector<PWH> parts;
+bool toDouble(const PWH& exact, Polygon& out) {
+  out.outer = ringToDouble(exact.outer_boundary());
+  out.holes.clear();
+  for (auto h = exact.holes_begin(); h != exact.holes_end(); ++h) out.holes.push_back(ringToDouble(*h));
+  return normalise(out);
+}
+
+K::FT exactArea(const PWH& p) {
+  K::FT a = p.outer_boundary().area();
+  for (auto h = p.holes_begin(); h != p.holes_end(); ++h) a += h->area();  // holes are clockwise
+  return a;
+}
+
+K::FT exactArea(const Region& r) {
+  K::FT a = 0;
+  for (const PWH& p : r) a += exactArea(p);
+  return a;
+}
+
+P2 leftHalfPlane(const K::Point_2& through, const K::Vector_2& dir, double reach) {
+  const double dx = CGAL::to_double(dir.x()), dy = CGAL::to_double(dir.y());
+  const double len = norm(dx, dy);
+  const K::Vector_2 u(dx / len * reach, dy / len * reach);
+  const K::Vector_2 n(-u.y(), u.x());
+  // The edge on the line runs along the exact direction, so both half-planes of
+  // one line share it exactly.
+  const K::FT s = reach / len;
+  const K::Vector_2 along = dir * s;
+  P2 q;
+  q.push_back(through - along);
+  q.push_back(through + along);
+  q.push_back(through + along + n);
+  q.push_back(through - along + n);
+  return q;
+}
+
+Region intersect(const PWH& a, const P2& b) {
+  Region out;
   Traits traits;
-  CGAL::intersection(polygon, halfPlane, std::back_inserter(parts), traits);
-  std::vector<Polygon> out;
-  for (const PWH& part : parts) {
-    Polygon p;
-    p.outer = fromCgal(part.outer_boundary());
-    for (auto h = part.holes_begin(); h != part.holes_end(); ++h) p.holes.push_back(fromCgal(*h));
-    if (normalise(p)) out.push_back(std::move(p));
+  CGAL::intersection(a, b, std::back_inserter(out), traits);
+  return out;
+}
+
+Region intersect(const Region& a, const P2& b) {
+  Region out;
+  for (const PWH& p : a) {
+    Region r = intersect(p, b);
+    out.insert(out.end(), r.begin(), r.end());
   }
   return out;
 }
+
+Region subtract(const Region& a, const PWH& b) {
+  Region out;
+  Traits traits;
+  const auto bb = b.outer_boundary().bbox();
+  for (const PWH& p : a) {
+    if (!CGAL::do_overlap(p.outer_boundary().bbox(), bb)) {
+      out.push_back(p);
+      continue;
+    }
+    CGAL::difference(p, b, std::back_inserter(out), traits);
+  }
+  return out;
+}
+
+Region clipLeft(const PWH& p, const K::Point_2& through, const K::Vector_2& dir, double reach) {
+  const P2& ring = p.outer_boundary();
+  const std::size_t n = ring.size();
+  if (p.has_holes() || n < 3) return intersect(p, leftHalfPlane(through, dir, reach));
+  const K::Point_2 ahead = through + dir;
+  std::vector<CGAL::Orientation> side(n);
+  std::size_t left = 0, right = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    side[i] = CGAL::orientation(through, ahead, ring[i]);
+    if (side[i] == CGAL::COLLINEAR) return intersect(p, leftHalfPlane(through, dir, reach));
+    (side[i] == CGAL::LEFT_TURN ? left : right) += 1;
+  }
+  if (right == 0) return {p};
+  if (left == 0) return {};
+  std::size_t changes = 0;
+  for (std::size_t i = 0; i < n; ++i) changes += side[i] != side[(i + 1) % n];
+  if (changes != 2) return intersect(p, leftHalfPlane(through, dir, reach));
+  P2 out;
+  for (std::size_t i = 0; i < n; ++i) {
+    const K::Point_2& a = ring[i];
+    const K::Point_2& b = ring[(i + 1) % n];
+    if (side[i] == CGAL::LEFT_TURN) out.push_back(a);
+    if (side[i] != side[(i + 1) % n]) {
+      // The crossing, computed from the segment in ring order on both sides
+      // of the line so that the two pieces share it exactly.
+      const bool forward = CGAL::compare_xy(a, b) == CGAL::SMALLER;
+      const K::Point_2& s = forward ? a : b;
+      const K::Point_2& e = forward ? b : a;
+      const K::Vector_2 se = e - s, st = through - s;
+      const K::FT t = (st.x() * dir.y() - st.y() * dir.x()) / (se.x() * dir.y() - se.y() * dir.x());
+      out.push_back(s + se * t);
+    }
+  }
+  return {PWH(out)};
+}
+
+Region clipLeft(const Region& r, const K::Point_2& through, const K::Vector_2& dir, double reach) {
+  Region out;
+  for (const PWH& p : r) {
+    Region part = clipLeft(p, through, dir, reach);
+    out.insert(out.end(), part.begin(), part.end());
+  }
+  return out;
+}
+
+namespace {
+struct PointLess {
+  bool operator()(const K::Point_2& a, const K::Point_2& b) const { return CGAL::compare_xy(a, b) == CGAL::SMALLER; }
+};
+struct EdgeLess {
+  bool operator()(const std::pair<K::Point_2, K::Point_2>& a, const std::pair<K::Point_2, K::Point_2>& b) const {
+    const auto c = CGAL::compare_xy(a.first, b.first);
+    if (c != CGAL::EQUAL) return c == CGAL::SMALLER;
+    return CGAL::compare_xy(a.second, b.second) == CGAL::SMALLER;
+  }
+};
+
+// Union of interior-disjoint polygons without holes that form one polygon
+// without holes: edges split at every vertex lying inside them, coinciding
+// opposite edges cancelled, the rest linked into a ring. False when the parts
+// do not form exactly one such ring.
+bool dissolve(const Region& parts, PWH& out) {
+  std::vector<K::Point_2> points;
+  std::vector<CGAL::Bbox_2> boxes;
+  for (const PWH& p : parts) {
+    if (p.has_holes()) return false;
+    for (auto v = p.outer_boundary().vertices_begin(); v != p.outer_boundary().vertices_end(); ++v) {
+      points.push_back(*v);
+      boxes.push_back(v->bbox());
+    }
+  }
+  std::map<std::pair<K::Point_2, K::Point_2>, int, EdgeLess> edges;
+  auto addEdge = [&](const K::Point_2& a, const K::Point_2& b) {
+    auto opposite = edges.find({b, a});
+    if (opposite != edges.end()) {
+      edges.erase(opposite);
+      return true;
+    }
+    return edges.emplace(std::make_pair(a, b), 0).second;  // a repeated edge: the parts overlap
+  };
+  for (const PWH& p : parts) {
+    const P2& ring = p.outer_boundary();
+    for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
+      const K::Point_2& a = ring[i];
+      const K::Point_2& b = ring[(i + 1) % n];
+      const CGAL::Bbox_2 box = a.bbox() + b.bbox();
+      std::vector<K::Point_2> inside;
+      for (std::size_t k = 0; k < points.size(); ++k) {
+        if (!CGAL::do_overlap(box, boxes[k])) continue;
+        if (CGAL::collinear(a, b, points[k]) && CGAL::collinear_are_strictly_ordered_along_line(a, points[k], b)) {
+          inside.push_back(points[k]);
+        }
+      }
+      std::sort(inside.begin(), inside.end(), [&](const K::Point_2& x, const K::Point_2& y) {
+        return CGAL::compare_distance_to_point(a, x, y) == CGAL::SMALLER;
+      });
+      inside.erase(std::unique(inside.begin(), inside.end()), inside.end());
+      K::Point_2 from = a;
+      for (const K::Point_2& x : inside) {
+        if (!addEdge(from, x)) return false;
+        from = x;
+      }
+      if (!addEdge(from, b)) return false;
+    }
+  }
+  if (edges.empty()) return false;
+  std::map<K::Point_2, K::Point_2, PointLess> next;
+  for (const auto& [e, unused] : edges) {
+    if (!next.emplace(e.first, e.second).second) return false;  // two ways on: a pinch
+  }
+  P2 ring;
+  K::Point_2 at = next.begin()->first;
+  for (std::size_t steps = 0; steps <= next.size(); ++steps) {
+    ring.push_back(at);
+    auto it = next.find(at);
+    if (it == next.end()) return false;
+    at = it->second;
+    if (at == ring[0]) break;
+  }
+  if (ring.size() != next.size()) return false;  // more than one ring: holes or separate pieces
+  out = PWH(ring);
+  return true;
+}
 }  // namespace
+
+Region join(const Region& parts) {
+  Region out;
+  if (parts.size() == 1) return parts;
+  if (parts.empty()) return out;
+  PWH dissolved;
+  if (dissolve(parts, dissolved)) return {dissolved};
+  Traits traits;
+  CGAL::join(parts.begin(), parts.end(), std::back_inserter(out), traits);
+  return out;
+}
+
+bool isValidExact(const PWH& p) {
+  Traits traits;
+  return CGAL::is_valid_polygon_with_holes(p, traits);
+}
 
 bool isValidForSplit(const Polygon& polygon) {
   if (polygon.outer.size() < 3) return false;
-  Traits traits;
-  return CGAL::is_valid_polygon_with_holes(toCgal(polygon), traits);
+  return isValidExact(toExact(polygon));
 }
 
 SplitPieces splitByLine(const Polygon& polygon, const Point& pivot, const Point& dir) {
   const Box b = bounds(polygon);
   const double reach = 4.0 * (b.width() + b.height()) + 1.0 +
                        std::fabs(pivot.x - b.minX) + std::fabs(pivot.y - b.minY);
-  const double len = norm(dir.x, dir.y);
-  const double ux = dir.x / len, uy = dir.y / len;
-  const K::Point_2 a(pivot.x - ux * reach, pivot.y - uy * reach);
-  const K::Point_2 c(pivot.x + ux * reach, pivot.y + uy * reach);
-  const K::Vector_2 n(-uy * reach, ux * reach);  // left normal
-  P2 left, right;
-  left.push_back(a);
-  left.push_back(c);
-  left.push_back(c + n);
-  left.push_back(a + n);
-  right.push_back(c);
-  right.push_back(a);
-  right.push_back(a - n);
-  right.push_back(c - n);
-  const PWH p = toCgal(polygon);
-  return {clip(p, left), clip(p, right)};
+  const K::Point_2 through(pivot.x, pivot.y);
+  const K::Vector_2 d(dir.x, dir.y);
+  const PWH p = toExact(polygon);
+  SplitPieces out;
+  for (const auto& [side, target] : {std::pair{d, &out.left}, std::pair{-d, &out.right}}) {
+    for (const PWH& part : intersect(p, leftHalfPlane(through, side, reach))) {
+      Polygon q;
+      if (toDouble(part, q)) target->push_back(std::move(q));
+    }
+  }
+  return out;
 }
 
 }  // namespace parcelscope::generation::detail

@@ -102,6 +102,23 @@ bool isValid(const Polygon& polygon) {
   return detail::toOgr(polygon)->IsValid();
 }
 
+std::vector<Polygon> validParts(const Polygon& polygon) {
+  detail::QuietErrors quiet;
+  const auto geometry = detail::toOgr(polygon);
+  if (geometry->IsValid()) return {polygon};
+  const char* const options[] = {"METHOD=STRUCTURE", nullptr};
+  std::unique_ptr<OGRGeometry> fixed(geometry->MakeValid(options));
+  std::vector<Polygon> out;
+  if (!fixed) return out;
+  std::vector<std::unique_ptr<OGRPolygon>> parts;
+  detail::collectPolygons(*fixed, parts);
+  for (const auto& part : parts) {
+    Polygon p = detail::fromOgr(*part);
+    if (normalise(p)) out.push_back(std::move(p));
+  }
+  return out;
+}
+
 double intersectionArea(const Polygon& a, const Polygon& b) {
   // Snap-rounded overlay on a 1e-6 m grid: floating overlay (GEOS 3.11) can
   // return a whole polygon as the intersection of two polygons whose shared

@@ -11,6 +11,8 @@
 
 #include <cpl_json.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -127,6 +129,52 @@ void CompareCambridge(benchmark::State& state) {
   state.SetLabel(figures ? "with figures" : "no X server: without figures");
 }
 BENCHMARK(CompareCambridge)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(3);
+
+// Straight-skeleton subdivision of every cambridge_ma block with its own
+// derived bounds, one block at a time (single thread). Target: median at most
+// 3 ms per block (Vanegas et al. 2012 report 1-10 ms). Counters give the
+// median, 90th percentile and mean per block of the last iteration.
+void SkeletonSubdivisionPerBlock(benchmark::State& state) {
+  if (!haveData(state)) return;
+  namespace gen = parcelscope::generation;
+  parcelscope::io::ReadOptions in;
+  in.path = kCambridge;
+  const auto d = parcelscope::analysis::loadObserved(
+      in, parcelscope::defaultValues(parcelscope::analysis::analysisParameters()));
+  gen::GenerateRequest request;
+  request.parameters = parcelscope::defaultValues(gen::generationParameterDescriptions());
+  gen::SkeletonParameters p = gen::skeletonParametersFrom(request.parameters);
+  std::size_t parcels = 0, fallbacks = 0;
+  std::vector<double> ms;
+  for (auto _ : state) {
+    parcels = fallbacks = 0;
+    ms.clear();
+    for (std::size_t b = 0; b < d.analysis.blocks.size(); ++b) {
+      const auto& s = d.analysis.statistics[b];
+      p.bounds = gen::blockParameters(request, s.aMin, s.aMax, s.wMin, s.wMax);
+      for (const auto& part : d.analysis.blocks[b].parts) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const auto sub = gen::subdivideSkeleton(part, p, b);
+        ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+        parcels += sub.parcels.size();
+        fallbacks += sub.fallback;
+      }
+    }
+  }
+  std::vector<double> sorted = ms;
+  std::sort(sorted.begin(), sorted.end());
+  double sum = 0;
+  for (double x : ms) sum += x;
+  state.counters["blocks"] = static_cast<double>(ms.size());
+  state.counters["parcels"] = static_cast<double>(parcels);
+  state.counters["fallbacks"] = static_cast<double>(fallbacks);
+  if (!sorted.empty()) {
+    state.counters["median_ms"] = sorted[sorted.size() / 2];
+    state.counters["p90_ms"] = sorted[sorted.size() * 9 / 10];
+    state.counters["mean_ms"] = sum / static_cast<double>(sorted.size());
+  }
+}
+BENCHMARK(SkeletonSubdivisionPerBlock)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
 }  // namespace
 

@@ -119,6 +119,29 @@ TEST(GenerateCommand, SubdividesTheBlocksThatStatsWrote) {
   EXPECT_NE(json.find("\"blocks\": 10"), std::string::npos) << json;
 }
 
+TEST(GenerateCommand, SkeletonOffsetAndAutoStylesRunOnTheSample) {
+  TempDir dir;
+  const std::string base = "generate '" + kSample + "' --where \"use <> 'ROW'\" --from-parcels --quiet --seed 3";
+  for (const char* style : {"skeleton", "offset", "auto"}) {
+    const std::string out = dir.file(style);
+    const CliRun r = run(base + " --style " + style + " --out '" + out + "'");
+    ASSERT_EQ(r.code, 0) << style << ": " << r.output;
+    const std::string json = slurp(out + "/run.json");
+    EXPECT_NE(json.find("\"style\": \"" + std::string(style) + "\""), std::string::npos) << json;
+    EXPECT_NE(json.find("\"blocks\": 10"), std::string::npos) << json;
+    EXPECT_NE(json.find("\"parcels_without_street_access\": 0"), std::string::npos) << json;
+    EXPECT_NE(json.find("\"blocks_by_style\""), std::string::npos) << json;
+    if (std::string(style) == "offset") {
+      EXPECT_EQ(json.find("\"patio_parcels\": 0,"), std::string::npos) << "the sample's big blocks get patios: " << json;
+    } else {
+      EXPECT_NE(json.find("\"patio_parcels\": 0"), std::string::npos) << json;
+    }
+  }
+  // Reproducible from the seed.
+  ASSERT_EQ(run(base + " --style skeleton --out '" + dir.file("again") + "'").code, 0);
+  EXPECT_EQ(slurp(dir.file("again") + "/parcels.csv"), slurp(dir.file("skeleton") + "/parcels.csv"));
+}
+
 TEST(GenerateCommand, BadStyleAndConflictingBoundsAreUsageErrors) {
   TempDir dir;
   EXPECT_EQ(run("generate '" + kSample + "' --style voronoi --out '" + dir.file("x") + "' --quiet").code, 2);

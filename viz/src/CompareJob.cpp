@@ -35,7 +35,7 @@ const std::vector<ParameterDescription>& comparisonParameters() {
 
 std::vector<ParameterDescription> compareParameters() {
   std::vector<ParameterDescription> all = analysis::analysisParameters();
-  appendParameters(all, generation::obbParameterDescriptions());
+  appendParameters(all, generation::generationParameterDescriptions());
   appendParameters(all, comparisonParameters());
   return all;
 }

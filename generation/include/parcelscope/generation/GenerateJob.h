@@ -11,9 +11,35 @@
 #include "parcelscope/analysis/StatsJob.h"
 #include "parcelscope/core/Json.h"
 #include "parcelscope/generation/ObbSubdivision.h"
+#include "parcelscope/generation/SkeletonSubdivision.h"
 #include "parcelscope/io/ParcelReader.h"
 
 namespace parcelscope::generation {
+
+/// The subdivision styles `generate` offers, each with a one-line description:
+///  - obb: OBB recursive subdivision (Vanegas et al. 2012, 4.3);
+///  - skeleton: straight-skeleton strips (4.2), d_offset from --offset (0: none);
+///  - offset: skeleton with a finite offset (30 m unless --offset is given) and
+///    the patios subdivided with the OBB style;
+///  - auto: per block, skeleton where at least 90 % of its observed parcels have
+///    street access (the paper's first variety: every parcel on a street, rears
+///    abutting), obb otherwise; blocks without observed parcels (a block layer
+///    without a street_access_share field) use skeleton.
+const std::vector<std::pair<std::string, std::string>>& generationStyles();
+
+/// Every parameter `generate` takes: OBB, skeleton and block-building ones, each
+/// name once (CLI flags, GUI sliders, run record).
+std::vector<ParameterDescription> generationParameterDescriptions();
+
+/// Subdivides one block with a concrete style (obb, skeleton or offset; not
+/// auto): `parameters.bounds` for obb, all of `parameters` for the skeleton
+/// styles (offset: d_offset 30 m when 0, patios always subdivided).
+/// `streetWidths` (per contour edge, see StreetWidths) feed the StreetWidth rule.
+Subdivision subdivideBlock(const Polygon& block, const std::string& style, const SkeletonParameters& parameters,
+                           std::uint64_t seed, const StreetWidths& streetWidths = {});
+
+/// Share of observed parcels with street access at or above which `auto` picks skeleton.
+constexpr double kAutoSkeletonAccessShare = 0.9;
 
 struct GenerateRequest {
   io::ReadOptions input;
@@ -45,13 +71,17 @@ struct GeneratedParcels {
   std::vector<analysis::ParcelMetrics> metrics;
   std::int64_t failedBlocks = 0, oversize = 0, withoutAccess = 0;
   std::int64_t clampedBounds = 0;         ///< per-block bounds moved into the parameter ranges
-  std::vector<std::string> failures;      ///< one line per failed block
+  std::int64_t fallbackBlocks = 0;        ///< skeleton blocks subdivided with OBB instead
+  std::int64_t patioParcels = 0;          ///< parcels that are (parts of) patios
+  std::vector<std::string> blockStyles;   ///< style each entry of `blocks` was subdivided with
+  std::vector<std::string> failures;      ///< one line per failed or fallen-back block
   std::uint64_t seed = 0;
   Timings timings;                        ///< "subdivide" and "measure"
 };
 
-/// Reads the input and subdivides every block (in parallel). Throws Error on bad
-/// input or parameters (A_min > A_max, W_min > W_max, unknown style).
+/// Reads the input and subdivides every block (in parallel) with the request's
+/// style. Throws Error on bad input or parameters (A_min > A_max, W_min > W_max,
+/// unknown style).
 GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& progress = {});
 
 /// The generated parcels as parcels.gpkg and parcels.csv hold them: one row per

@@ -44,6 +44,9 @@ struct Subdivision {
   int withoutAccess = 0;          ///< parcels without street access
   bool failed = false;            ///< the block could not be split (invalid for exact geometry); parcels = {block}
   std::string failure;            ///< why, when failed
+  bool fallback = false;          ///< another style could not subdivide the block; OBB did
+  std::string fallbackReason;     ///< why, when fallback
+  int patioParcels = 0;           ///< parcels that are (parts of) inner patios, without street access by design
 };
 
 /// Subdivides one block (normalised polygon, holes allowed) into parcels.

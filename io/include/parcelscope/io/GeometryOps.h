@@ -18,6 +18,11 @@ std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, 
 /// True when the polygon is valid in the OGC simple-features sense (GEOS IsValid).
 bool isValid(const Polygon& polygon);
 
+/// The polygon as valid polygons (GEOS make-valid, structure method: rings
+/// that pinch or fold split into their parts; zero-width corridors vanish).
+/// A valid polygon comes back as it is. Parts are normalised.
+std::vector<Polygon> validParts(const Polygon& polygon);
+
 /// Area in m² of the intersection of two polygons (GEOS, snap-rounded to a
 /// 1e-6 m grid, so the result is within about perimeter x 1e-6 m² of exact).
 /// Throws Error(Geometry) if GEOS fails.

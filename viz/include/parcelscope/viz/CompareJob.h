@@ -30,7 +30,7 @@ struct CompareRequest {
 /// size, the aspect ratio shown fully green.
 const std::vector<ParameterDescription>& comparisonParameters();
 /// Every parameter of `compare`: analysisParameters(), the generator's
-/// (obbParameterDescriptions(), "seed" included) and comparisonParameters(),
+/// (generationParameterDescriptions(), "seed" included) and comparisonParameters(),
 /// each name once.
 std::vector<ParameterDescription> compareParameters();
 

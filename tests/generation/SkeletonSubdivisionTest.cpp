@@ -1,0 +1,278 @@
+#include "parcelscope/generation/SkeletonSubdivision.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "TestUtil.h"
+#include "generation/RandomShapes.h"
+#include "generation/TilingCheck.h"
+#include "parcelscope/analysis/Metrics.h"
+
+namespace parcelscope::generation {
+namespace {
+
+using test::poly;
+using test::rect;
+
+// Skeleton nodes sit within a few micrometres of their exact place (the
+// skeleton's input is jittered by up to 1e-6 m), so positions derived from
+// them are compared with this tolerance (m).
+constexpr double kNode = 1e-5;
+
+SkeletonParameters params(double aMin, double aMax, double wMin, double wMax, double omega = 0.0) {
+  SkeletonParameters p;
+  p.bounds.aMin = aMin;
+  p.bounds.aMax = aMax;
+  p.bounds.wMin = wMin;
+  p.bounds.wMax = wMax;
+  p.bounds.omega = omega;
+  return p;
+}
+
+double frontage(const Polygon& parcel, const Polygon& block) {
+  return analysis::sharedBoundaryLength(parcel, Polygon{block.outer, {}}, 1e-6);
+}
+
+// The parcel containing point q.
+const Polygon* parcelAt(const std::vector<Polygon>& parcels, Point q) {
+  for (const Polygon& p : parcels) {
+    if (pointInPolygon(q, p)) return &p;
+  }
+  return nullptr;
+}
+
+TEST(SkeletonSubdivision, RectangleGivesTwoRowsBackToBackAlongTheCentreLine) {
+  const Polygon block = rect(0, 0, 120, 50);
+  const Subdivision s = subdivideSkeleton(block, params(100, 2000, 10, 20, 0.3), 7);
+  ASSERT_FALSE(s.fallback) << s.fallbackReason;
+  EXPECT_TILES(block, s.parcels, "rectangle");
+  int below = 0, above = 0;
+  for (const Polygon& p : s.parcels) {
+    const Box b = bounds(p);
+    // Each parcel lies in one row: its back is the centre line y = 25.
+    EXPECT_TRUE(b.maxY <= 25 + kNode || b.minY >= 25 - kNode) << b.minY << ".." << b.maxY;
+    EXPECT_NEAR(b.maxY - b.minY, 25, kNode);
+    below += b.maxY <= 25 + kNode;
+    above += b.minY >= 25 - kNode;
+    EXPECT_GE(frontage(p, block), 10 - kNode);  // every parcel touches the street
+  }
+  // 120 m of street at (10 + 20) / 2 = 15 m per parcel: 8 parcels a row.
+  EXPECT_EQ(below, 8);
+  EXPECT_EQ(above, 8);
+  EXPECT_EQ(s.withoutAccess, 0);
+  EXPECT_EQ(s.patioParcels, 0);
+}
+
+TEST(SkeletonSubdivision, LShapedBlockGivesParcelsAlongEveryStreet) {
+  const Polygon block = poly({{0, 0}, {100, 0}, {100, 40}, {40, 40}, {40, 100}, {0, 100}});
+  const Subdivision s = subdivideSkeleton(block, params(100, 1200, 10, 20, 0.3), 3);
+  ASSERT_FALSE(s.fallback) << s.fallbackReason;
+  EXPECT_TILES(block, s.parcels, "L");
+  EXPECT_EQ(s.withoutAccess, 0);
+  for (const Polygon& p : s.parcels) EXPECT_GE(frontage(p, block), 1.0);
+  // 400 m of street at about 15 m a parcel, less the corners.
+  EXPECT_GE(s.parcels.size(), 20u);
+  EXPECT_LE(s.parcels.size(), 30u);
+  // The reflex corner (40, 40) keeps the strips' diagonal: the parcels on
+  // either side of it face different streets.
+  const Polygon* a = parcelAt(s.parcels, {45, 39});
+  const Polygon* b = parcelAt(s.parcels, {39, 45});
+  ASSERT_TRUE(a && b);
+  EXPECT_NE(a, b);
+}
+
+TEST(SkeletonSubdivision, FiniteOffsetLeavesOnePatioInARectangle) {
+  const Polygon block = rect(0, 0, 100, 60);
+  SkeletonParameters p = params(100, 1000, 10, 20);
+  p.offset = 15;
+  const Subdivision s = subdivideSkeleton(block, p, 5);
+  ASSERT_FALSE(s.fallback) << s.fallbackReason;
+  EXPECT_TILES(block, s.parcels, "offset 15");
+  ASSERT_EQ(s.patioParcels, 1);
+  const Polygon* patio = parcelAt(s.parcels, {50, 30});
+  ASSERT_TRUE(patio);
+  EXPECT_NEAR(area(*patio), 70.0 * 30.0, 200 * kNode);
+  EXPECT_EQ(frontage(*patio, block), 0.0);
+  for (const Polygon& q : s.parcels) {
+    if (&q == patio) continue;
+    EXPECT_GE(frontage(q, block), 1.0);  // every parcel outside the patio has street access
+    const Box b = bounds(q);
+    EXPECT_TRUE(b.maxY <= 15 + kNode || b.minY >= 45 - kNode || b.maxX <= 15 + kNode || b.minX >= 85 - kNode);
+  }
+  // The patio subdivided with the OBB style instead.
+  p.subdividePatios = true;
+  const Subdivision t = subdivideSkeleton(block, p, 5);
+  ASSERT_FALSE(t.fallback) << t.fallbackReason;
+  EXPECT_TILES(block, t.parcels, "offset 15, OBB patio");
+  EXPECT_GT(t.patioParcels, 1);
+  EXPECT_EQ(t.parcels.size() - t.patioParcels, s.parcels.size() - 1);
+}
+
+TEST(SkeletonSubdivision, NonConvexBlockWithOffsetHasSeveralPatios) {
+  // Two 70 m squares joined by a 20 m neck: at 15 m the offset contour splits.
+  const Polygon block = poly({{0, 0}, {70, 0}, {70, 25}, {110, 25}, {110, 0}, {180, 0}, {180, 70}, {110, 70},
+                              {110, 45}, {70, 45}, {70, 70}, {0, 70}});
+  SkeletonParameters p = params(100, 1000, 10, 20);
+  p.offset = 15;
+  const Subdivision s = subdivideSkeleton(block, p, 11);
+  ASSERT_FALSE(s.fallback) << s.fallbackReason;
+  EXPECT_TILES(block, s.parcels, "dumbbell");
+  EXPECT_EQ(s.patioParcels, 2);
+  EXPECT_EQ(s.withoutAccess, 0);
+}
+
+TEST(SkeletonSubdivision, StreetWidthAndStreetLengthFlipTheCornerParcel) {
+  const Polygon block = rect(0, 0, 100, 40);
+  // Edges of the counter-clockwise ring: bottom, right, top, left. The short
+  // (right and left) streets are the wide ones.
+  const StreetWidths widths = {{10, 30, 10, 30}};
+  SkeletonParameters p = params(100, 1000, 10, 20);
+  p.corner = CornerRule::StreetLength;
+  const Subdivision byLength = subdivideSkeleton(block, p, 1, widths);
+  p.corner = CornerRule::StreetWidth;
+  const Subdivision byWidth = subdivideSkeleton(block, p, 1, widths);
+  ASSERT_FALSE(byLength.fallback || byWidth.fallback);
+  EXPECT_TILES(block, byLength.parcels, "StreetLength");
+  EXPECT_TILES(block, byWidth.parcels, "StreetWidth");
+  const Polygon* cornerLength = parcelAt(byLength.parcels, {1, 1});
+  const Polygon* cornerWidth = parcelAt(byWidth.parcels, {1, 1});
+  ASSERT_TRUE(cornerLength && cornerWidth);
+  // StreetLength: the corner parcel faces the long bottom street, its side
+  // cut perpendicular to it; StreetWidth: it faces the wide left street.
+  const Box l = bounds(*cornerLength), w = bounds(*cornerWidth);
+  EXPECT_NEAR(l.maxY, 20, kNode);   // reaches back to the centre line
+  EXPECT_LT(l.maxX, 20);           // one frontage width along the bottom
+  EXPECT_NEAR(w.maxX, 20, kNode);   // reaches back from the left street
+  EXPECT_LT(w.maxY, 20);           // one frontage width along the left street
+  // Without widths, StreetWidth falls back to StreetLength.
+  const Subdivision unknown = subdivideSkeleton(block, p, 1);
+  ASSERT_EQ(unknown.parcels.size(), byLength.parcels.size());
+  for (std::size_t k = 0; k < unknown.parcels.size(); ++k) {
+    EXPECT_EQ(area(unknown.parcels[k]), area(byLength.parcels[k]));
+  }
+}
+
+TEST(SkeletonSubdivision, ShallowBlockGetsOneRowReachingAcross) {
+  // 12 m deep: two back-to-back rows would be 6 m deep, below W_min = 8 m.
+  const Polygon block = rect(0, 0, 150, 12);
+  const Subdivision s = subdivideSkeleton(block, params(50, 600, 8, 20), 2);
+  ASSERT_FALSE(s.fallback) << s.fallbackReason;
+  EXPECT_TILES(block, s.parcels, "shallow");
+  for (const Polygon& p : s.parcels) {
+    const Box b = bounds(p);
+    EXPECT_NEAR(b.maxY - b.minY, 12, kNode);  // from one street to the other
+  }
+  EXPECT_EQ(s.parcels.size(), 11u);  // 150 m at 14 m a parcel
+}
+
+TEST(SkeletonSubdivision, DeepParcelsAboveAMaxAreSplitAgainFromTheStreet) {
+  // 50 m deep rows: 15 m wide parcels are 750 m2, above A_max = 600 m2. Halves
+  // (7.5 m wide) are narrower than W_min = 10 m: the parcels stay, oversize.
+  const Polygon block = rect(0, 0, 300, 100);
+  const Subdivision kept = subdivideSkeleton(block, params(100, 600, 10, 20), 4);
+  ASSERT_FALSE(kept.fallback) << kept.fallbackReason;
+  EXPECT_TILES(block, kept.parcels, "deep");
+  int middle = 0;  // parcels away from the short ends (corner parcels may face the short street instead)
+  for (const Polygon& q : kept.parcels) {
+    const Box b = bounds(q);
+    if (b.minX < kNode || b.maxX > 300 - kNode) continue;
+    EXPECT_NEAR(area(q), 750, 50 * kNode);
+    ++middle;
+  }
+  EXPECT_EQ(middle, 36);
+  EXPECT_GE(kept.oversize, middle);
+  // With W_min = 5 m (same spacing) each is split by a second ray from the street.
+  const Subdivision split = subdivideSkeleton(block, params(100, 600, 5, 25), 4);
+  ASSERT_FALSE(split.fallback) << split.fallbackReason;
+  EXPECT_TILES(block, split.parcels, "deep, split");
+  EXPECT_EQ(split.oversize, 0);
+  EXPECT_EQ(split.withoutAccess, 0);
+  for (const Polygon& q : split.parcels) EXPECT_LE(area(q), 600);
+}
+
+TEST(SkeletonSubdivision, SmallAndTriangularParcelsAreMergedIntoNeighbours) {
+  // A triangle block: its corner parcels are triangles; with A_min = 300 m2
+  // every parcel left is at least that large and none is a sliver.
+  const Polygon block = poly({{0, 0}, {120, 0}, {40, 90}});
+  const SkeletonParameters p = params(300, 1500, 10, 20, 0.3);
+  const Subdivision s = subdivideSkeleton(block, p, 9);
+  ASSERT_FALSE(s.fallback) << s.fallbackReason;
+  EXPECT_TILES(block, s.parcels, "triangle");
+  ASSERT_GT(s.parcels.size(), 1u);
+  for (const Polygon& q : s.parcels) EXPECT_GE(area(q), 300 * (1 - 1e-9));
+  EXPECT_EQ(s.withoutAccess, 0);
+}
+
+TEST(SkeletonSubdivision, SameSeedSameParcelsOtherSeedOtherParcels) {
+  const Polygon block = poly({{0, 0}, {130, 10}, {150, 90}, {60, 120}, {-10, 70}});
+  const SkeletonParameters p = params(100, 1200, 10, 20, 0.8);
+  const Subdivision a = subdivideSkeleton(block, p, 42), b = subdivideSkeleton(block, p, 42),
+                    c = subdivideSkeleton(block, p, 43);
+  ASSERT_FALSE(a.fallback) << a.fallbackReason;
+  ASSERT_EQ(a.parcels.size(), b.parcels.size());
+  for (std::size_t k = 0; k < a.parcels.size(); ++k) {
+    EXPECT_EQ(a.parcels[k].outer.size(), b.parcels[k].outer.size());
+    EXPECT_EQ(area(a.parcels[k]), area(b.parcels[k]));
+  }
+  bool differs = a.parcels.size() != c.parcels.size();
+  for (std::size_t k = 0; !differs && k < a.parcels.size(); ++k) differs = area(a.parcels[k]) != area(c.parcels[k]);
+  EXPECT_TRUE(differs);
+}
+
+TEST(SkeletonSubdivision, InvalidBlockFallsBackAndIsFlagged) {
+  const Polygon bowTie = poly({{0, 0}, {100, 100}, {100, 0}, {0, 100}});
+  const Subdivision s = subdivideSkeleton(bowTie, params(100, 1000, 10, 20), 1);
+  EXPECT_TRUE(s.fallback);
+  EXPECT_FALSE(s.fallbackReason.empty());
+  EXPECT_TRUE(s.failed);  // OBB cannot split it either: it comes back whole
+  ASSERT_EQ(s.parcels.size(), 1u);
+}
+
+constexpr int kRandomShapes = 700 / test::kSanitizerDivisor;
+
+TEST(SkeletonSubdivision, RandomShapesAreTiledValidlyWithStreetAccess) {
+  const std::uint64_t seed = 20261122;
+  std::printf("random shapes seed %llu\n", static_cast<unsigned long long>(seed));
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  int parcels = 0, fallbacks = 0, withoutAccess = 0, patios = 0;
+  for (int i = 0; i < kRandomShapes; ++i) {
+    const int kind = i % test::kShapeKinds;
+    const Polygon block = test::randomShape(rng, kind);
+    const double a = area(block);
+    SkeletonParameters p;
+    p.bounds = test::randomBounds(rng, a);
+    p.offset = i % 4 == 0 ? 5 + 30 * u(rng) : 0;
+    p.subdividePatios = i % 8 == 0;
+    p.corner = i % 2 ? CornerRule::StreetLength : CornerRule::StreetWidth;
+    p.streetAngle = 10 + 40 * u(rng);
+    const std::uint64_t s = rng();
+    const Subdivision sub = subdivideSkeleton(block, p, s);
+    const std::string what = "shape " + std::to_string(i) + " kind " + std::to_string(kind) +
+                             (sub.fallback ? " (fallback: " + sub.fallbackReason + ")" : "");
+    ASSERT_FALSE(sub.failed) << what << ": " << sub.failure;
+    EXPECT_TILES(block, sub.parcels, what);
+    if (!sub.fallback) {
+      withoutAccess += sub.withoutAccess;
+      patios += sub.patioParcels;
+    }
+    fallbacks += sub.fallback;
+    if (i % 25 == 0) {
+      const Subdivision again = subdivideSkeleton(block, p, s);
+      ASSERT_EQ(again.parcels.size(), sub.parcels.size()) << what;
+      for (std::size_t k = 0; k < sub.parcels.size(); ++k) {
+        EXPECT_EQ(area(again.parcels[k]), area(sub.parcels[k])) << what;
+      }
+    }
+    parcels += static_cast<int>(sub.parcels.size());
+  }
+  std::printf("%d shapes, %d parcels, %d patio parcels, %d fallbacks to OBB, %d without street access\n",
+              kRandomShapes, parcels, patios, fallbacks, withoutAccess);
+  EXPECT_EQ(withoutAccess, 0);
+  EXPECT_LE(fallbacks, kRandomShapes / 20);  // the skeleton route handles at least 95 %
+}
+
+}  // namespace
+}  // namespace parcelscope::generation
