@@ -12,6 +12,7 @@
 #include <cpl_json.h>
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -19,6 +20,7 @@
 #include <map>
 
 #include "parcelscope/analysis/StatsJob.h"
+#include "parcelscope/io/Writers.h"
 #include "parcelscope/generation/GenerateJob.h"
 #include "parcelscope/viz/CompareJob.h"
 
@@ -100,6 +102,20 @@ void ObbSubdivisionPerBlock(benchmark::State& state) {
 }
 BENCHMARK(ObbSubdivisionPerBlock)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
+// Runs `compare` into `out` and adds the seconds of each stage (summary.json)
+// to `seconds`; returns the summary.
+CPLJSONObject runTimed(const parcelscope::viz::CompareRequest& request, const std::filesystem::path& out,
+                       std::map<std::string, double>& seconds) {
+  std::filesystem::remove_all(out);
+  parcelscope::viz::runCompare(request, out.string());
+  CPLJSONDocument summary;
+  summary.Load((out / "summary.json").string());
+  for (const auto& stage : summary.GetRoot().GetObj("timing_s").GetChildren()) {
+    seconds[stage.GetName()] += stage.ToDouble();
+  }
+  return summary.GetRoot();
+}
+
 // The whole `compare` job on cambridge_ma (right-of-way filtered as in the
 // README), as the command line runs it: read, blocks, generation, metrics,
 // tables and figures. Counters give the seconds of each stage (summary.json).
@@ -113,15 +129,7 @@ void CompareCambridge(benchmark::State& state) {
   request.parameters["figures"] = figures ? 1 : 0;
   const auto out = std::filesystem::temp_directory_path() / "parcelscope-bench-compare";
   std::map<std::string, double> seconds;
-  for (auto _ : state) {
-    std::filesystem::remove_all(out);
-    parcelscope::viz::runCompare(request, out.string());
-    CPLJSONDocument summary;
-    summary.Load((out / "summary.json").string());
-    for (const auto& stage : summary.GetRoot().GetObj("timing_s").GetChildren()) {
-      seconds[stage.GetName()] += stage.ToDouble();
-    }
-  }
+  for (auto _ : state) runTimed(request, out, seconds);
   std::filesystem::remove_all(out);
   for (const auto& [stage, s] : seconds) {
     state.counters[stage + "_s"] = benchmark::Counter(s, benchmark::Counter::kAvgIterations);
@@ -129,6 +137,73 @@ void CompareCambridge(benchmark::State& state) {
   state.SetLabel(figures ? "with figures" : "no X server: without figures");
 }
 BENCHMARK(CompareCambridge)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(3);
+
+// The whole `compare` (figures off) on about 500,000 parcels: cambridge_ma
+// (right-of-way filtered) tiled by translation, copies on a square grid with
+// 300 m between them, written once to the temporary folder. Target (issue 5):
+// 500,000 parcels generated and measured in under 10 s on 2 cores. Counters:
+// the parcels read and the seconds of each stage (summary.json).
+std::filesystem::path tiledCambridge(std::size_t target) {
+  namespace fs = std::filesystem;
+  const fs::path file = fs::temp_directory_path() / ("parcelscope-bench-cambridge-" + std::to_string(target) + ".gpkg");
+  if (fs::exists(file)) return file;
+  parcelscope::io::ReadOptions in;
+  in.path = kCambridge;
+  in.where = "ML <> 'ROAD'";
+  const auto layer = parcelscope::io::readParcels(in);
+  parcelscope::Box all = parcelscope::bounds(layer.parcels.front().shape);
+  for (const auto& p : layer.parcels) {
+    const auto b = parcelscope::bounds(p.shape);
+    all = {std::min(all.minX, b.minX), std::min(all.minY, b.minY), std::max(all.maxX, b.maxX),
+           std::max(all.maxY, b.maxY)};
+  }
+  const std::size_t copies = (target + layer.parcels.size() - 1) / layer.parcels.size();
+  const auto side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(copies))));
+  const double dx = all.width() + 300, dy = all.height() + 300;
+  parcelscope::Table table;
+  table.columns = {{"copy", parcelscope::Column::Type::Integer, ""}, {"source_fid", parcelscope::Column::Type::Integer, ""}};
+  std::vector<std::vector<parcelscope::Polygon>> geometries;
+  for (std::size_t c = 0; c < copies; ++c) {
+    const double ox = (static_cast<double>(c % side) - 0.5 * static_cast<double>(side - 1)) * dx;
+    const double oy = (static_cast<double>(c / side) - 0.5 * static_cast<double>(side - 1)) * dy;
+    for (const auto& p : layer.parcels) {
+      parcelscope::Polygon q = p.shape;
+      for (auto& v : q.outer) v = {v.x + ox, v.y + oy};
+      for (auto& h : q.holes)
+        for (auto& v : h) v = {v.x + ox, v.y + oy};
+      geometries.push_back({std::move(q)});
+      table.rows.push_back({static_cast<std::int64_t>(c), p.sourceFid});
+    }
+  }
+  const fs::path partial = file.string() + ".partial";
+  fs::remove(partial);
+  parcelscope::io::writePolygonLayer(partial.string(), "parcels", geometries, table, layer.frame, layer.crs);
+  fs::rename(partial, file);
+  return file;
+}
+
+void CompareTiled500k(benchmark::State& state) {
+  if (!haveData(state)) return;
+  parcelscope::viz::CompareRequest request;
+  request.input.path = tiledCambridge(500000).string();
+  request.parameters = parcelscope::defaultValues(parcelscope::viz::compareParameters());
+  request.parameters["figures"] = 0;
+  const auto out = std::filesystem::temp_directory_path() / "parcelscope-bench-compare-tiled";
+  std::map<std::string, double> seconds;
+  double observed = 0, generated = 0;
+  for (auto _ : state) {
+    const CPLJSONObject summary = runTimed(request, out, seconds);
+    observed = summary.GetObj("observed").GetDouble("parcels");
+    generated = summary.GetObj("generated").GetDouble("parcels");
+  }
+  std::filesystem::remove_all(out);
+  for (const auto& [stage, s] : seconds) {
+    state.counters[stage + "_s"] = benchmark::Counter(s, benchmark::Counter::kAvgIterations);
+  }
+  state.counters["observed_parcels"] = observed;
+  state.counters["generated_parcels"] = generated;
+}
+BENCHMARK(CompareTiled500k)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
 // Straight-skeleton subdivision of every cambridge_ma block with its own
 // derived bounds, one block at a time (single thread). Target: median at most
