@@ -28,10 +28,6 @@ PWH toExact(const Polygon& polygon);
 /// Rounded to doubles and normalised; false when nothing of it is left.
 bool toDouble(const PWH& exact, Polygon& out);
 
-/// Exact area (outer minus holes).
-K::FT exactArea(const PWH& p);
-K::FT exactArea(const Region& r);
-
 /// The half-plane left of the directed line through `through` along `dir`, as a
 /// quadrilateral reaching `reach` (m) from `through` in every direction.
 P2 leftHalfPlane(const K::Point_2& through, const K::Vector_2& dir, double reach);
@@ -44,7 +40,6 @@ Region clipLeft(const PWH& p, const K::Point_2& through, const K::Vector_2& dir,
 Region clipLeft(const Region& r, const K::Point_2& through, const K::Vector_2& dir, double reach);
 
 Region intersect(const PWH& a, const P2& b);
-Region intersect(const Region& a, const P2& b);
 Region subtract(const Region& a, const PWH& b);
 /// Union of interior-disjoint parts; its disjoint components. Parts that meet
 /// along shared edges (T-junctions allowed) into one polygon without holes are

@@ -45,18 +45,6 @@ bool toDouble(const PWH& exact, Polygon& out) {
   return normalise(out);
 }
 
-K::FT exactArea(const PWH& p) {
-  K::FT a = p.outer_boundary().area();
-  for (auto h = p.holes_begin(); h != p.holes_end(); ++h) a += h->area();  // holes are clockwise
-  return a;
-}
-
-K::FT exactArea(const Region& r) {
-  K::FT a = 0;
-  for (const PWH& p : r) a += exactArea(p);
-  return a;
-}
-
 P2 leftHalfPlane(const K::Point_2& through, const K::Vector_2& dir, double reach) {
   const double dx = CGAL::to_double(dir.x()), dy = CGAL::to_double(dir.y());
   const double len = norm(dx, dy);
@@ -78,15 +66,6 @@ Region intersect(const PWH& a, const P2& b) {
   Region out;
   Traits traits;
   CGAL::intersection(a, b, std::back_inserter(out), traits);
-  return out;
-}
-
-Region intersect(const Region& a, const P2& b) {
-  Region out;
-  for (const PWH& p : a) {
-    Region r = intersect(p, b);
-    out.insert(out.end(), r.begin(), r.end());
-  }
   return out;
 }
 
