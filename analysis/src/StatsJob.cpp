@@ -22,6 +22,17 @@ ObservedData loadObserved(const io::ReadOptions& input, const ParameterValues& p
   return data;
 }
 
+Json runRecord(const std::string& command, const ParameterValues& parameters) {
+  Json params = Json::object();
+  for (const auto& [name, value] : parameters) params.set(name, value);
+  return Json::object()
+      .set("tool", "parcelscope")
+      .set("version", version())
+      .set("command", command)
+      .set("gdal", io::gdalVersion())
+      .set("parameters", params);
+}
+
 void addObservedRecord(Json& record, const ObservedData& data) {
   const io::ParcelLayer& l = data.layer;
   const io::CleaningReport& r = l.report;
@@ -97,14 +108,7 @@ JobOutcome runStats(const io::ReadOptions& input, const ParameterValues& paramet
   io::writePolygonLayer(out.stage("blocks.gpkg"), "blocks", outlines, blocks, data.layer.frame,
                         data.layer.crs);
 
-  Json params = Json::object();
-  for (const auto& [name, value] : parameters) params.set(name, value);
-  Json run = Json::object()
-                 .set("tool", "parcelscope")
-                 .set("version", version())
-                 .set("command", "stats")
-                 .set("gdal", io::gdalVersion())
-                 .set("parameters", params);
+  Json run = runRecord("stats", parameters);
   addObservedRecord(run, data);
   run.set("outputs", Json::array().push("parcels.csv").push("blocks.csv").push("blocks.gpkg").push("run.json"));
   io::writeJson(out.stage("run.json"), run);

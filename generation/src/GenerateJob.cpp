@@ -254,8 +254,6 @@ analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::stri
   io::writePolygonLayer(out.stage("parcels.gpkg"), "parcels", geometries, table, g.source.frame, g.source.crs);
   io::writeCsv(out.stage("parcels.csv"), table);
 
-  Json params = Json::object();
-  for (const auto& [name, value] : request.parameters) params.set(name, value);
   Json perBlock = Json::array();
   for (const char* name : {"a-min", "a-max", "w-min", "w-max"}) {
     if (!request.explicitParameters.count(name)) perBlock.push(name);
@@ -264,15 +262,10 @@ analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::stri
   for (const auto& m : g.metrics) withAccess += m.streetAccess;
   Json failures = Json::array();
   for (const auto& f : g.failures) failures.push(f);
-  Json run = Json::object()
-                 .set("tool", "parcelscope")
-                 .set("version", analysis::version())
-                 .set("command", "generate")
+  Json run = analysis::runRecord("generate", request.parameters)
                  .set("style", request.style)
                  .set("from_parcels", request.fromParcels)
                  .set("seed", static_cast<std::int64_t>(g.seed))
-                 .set("gdal", io::gdalVersion())
-                 .set("parameters", params)
                  .set("per_block_parameters_where_available", perBlock);
   run.set("input", Json::object()
                        .set("path", g.source.path)

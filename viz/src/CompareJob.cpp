@@ -328,19 +328,12 @@ analysis::JobOutcome runCompare(const CompareRequest& request, const std::string
                            .set("timing_s", timing);
   io::writeJson(out.stage("summary.json"), summary);
 
-  Json params = Json::object();
-  for (const auto& [name, v] : request.parameters) params.set(name, v);
   Json given = Json::array();
   for (const auto& name : request.explicitParameters) given.push(name);
-  Json run = Json::object()
-                 .set("tool", "parcelscope")
-                 .set("version", analysis::version())
-                 .set("command", "compare")
+  Json run = analysis::runRecord("compare", request.parameters)
                  .set("style", request.style)
                  .set("seed", static_cast<std::int64_t>(r.generated.seed))
-                 .set("gdal", io::gdalVersion())
                  .set("vtk", figures ? vtkVersionString() : Json())
-                 .set("parameters", params)
                  .set("parameters_given", given);
   analysis::addObservedRecord(run, r.observed);
   std::error_code ec;

@@ -41,4 +41,8 @@ JobOutcome runStats(const io::ReadOptions& input, const ParameterValues& paramet
 /// "0.1.0": the project version written into run records.
 std::string version();
 
+/// The opening of every run record: tool, version, command, GDAL version and the
+/// parameter values.
+Json runRecord(const std::string& command, const ParameterValues& parameters);
+
 }  // namespace parcelscope::analysis
