@@ -8,7 +8,9 @@
 #include "parcelscope/analysis/StatsJob.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/generation/GenerateJob.h"
+#include "parcelscope/analysis/Comparison.h"
 #include "parcelscope/viz/CompareJob.h"
+#include "parcelscope/viz/CompareSession.h"
 
 namespace parcelscope::cli {
 
@@ -137,11 +139,18 @@ int generateCommand(const std::vector<std::string>& args) {
 int compareCommand(const std::vector<std::string>& args) {
   auto flags = inputFlags();
   flags.push_back(styleFlag());
+  {
+    std::string help = "parcel quantity of the extra figures map_METRIC and hist_METRIC (default aspect_ratio):";
+    for (const auto& q : analysis::parcelQuantities()) help += "\n      " + q.name + ": " + q.title;
+    flags.push_back({"metric", help});
+  }
+  flags.push_back({"session", "session file (saved by parcelscope-gui, or a compare run.json): input, style,\n"
+                              "      parameters, per-block overrides and seed; INPUT and options given here win"});
   flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
   flags.push_back({"quiet", "no progress or summary on stderr", false});
   const auto params = viz::compareParameters();
   if (wantsHelp(args)) {
-    std::fputs(usageText("parcelscope compare INPUT [--style obb|skeleton|offset|auto] [--k 2] [--seed N] [options] --out DIR", flags,
+    std::fputs(usageText("parcelscope compare INPUT|--session FILE [--style obb|skeleton|offset|auto] [--k 2] [--seed N] [options] --out DIR", flags,
                          params)
                    .c_str(),
                stdout);
@@ -156,10 +165,27 @@ int compareCommand(const std::vector<std::string>& args) {
   }
   const Args a(args, flags, params);
   viz::CompareRequest request;
-  request.input = readOptions(a);
-  request.style = a.value("style").value_or("obb");
-  request.parameters = a.parameters();
-  request.explicitParameters = givenParameters(a, params);
+  if (const auto session = a.value("session")) {
+    // The session's request, with what the command line gives on top.
+    request = viz::readSession(*session);
+    if (!a.value("out")) throw usageError("--out DIR is required");
+    if (a.positional().size() > 1) throw usageError("expected at most one INPUT file");
+    if (a.positional().size() == 1) request.input.path = a.positional()[0];
+    if (auto v = a.value("layer")) request.input.layer = *v;
+    if (auto v = a.value("where")) request.input.where = *v;
+    if (auto v = a.value("crs")) request.input.crsOverride = *v;
+    const ParameterValues values = a.parameters();
+    for (const auto& name : givenParameters(a, params)) {
+      request.parameters[name] = values.at(name);
+      request.explicitParameters.insert(name);
+    }
+  } else {
+    request.input = readOptions(a);
+    request.parameters = a.parameters();
+    request.explicitParameters = givenParameters(a, params);
+  }
+  if (auto v = a.value("style")) request.style = *v;
+  if (auto v = a.value("metric")) request.metric = *v;
   return reportOutcome(viz::runCompare(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
 }
 

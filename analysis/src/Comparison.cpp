@@ -134,6 +134,42 @@ const char* metricUnit(ComparedMetric m) {
   return "";
 }
 
+const std::vector<ParcelQuantity>& parcelQuantities() {
+  static const std::vector<ParcelQuantity> q = {
+      {"aspect_ratio", "aspect ratio (length / width)", [](const ParcelMetrics& m) { return m.aspectRatio; }},
+      {"area", "area (m\xc2\xb2)", [](const ParcelMetrics& m) { return m.area; }},
+      {"width", "width, short side of the minimum bounding rectangle (m)",
+       [](const ParcelMetrics& m) { return m.width; }},
+      {"neighbours", "neighbours (parcels sharing at least 1 m of boundary)",
+       [](const ParcelMetrics& m) { return static_cast<double>(m.neighbours); }},
+      {"street_access", "street access (1: at least min-frontage on the block contour)",
+       [](const ParcelMetrics& m) { return m.streetAccess ? 1.0 : 0.0; }},
+      {"p_angle", "p_angle, mean corner deviation from 90\xc2\xb0 (degrees)",
+       [](const ParcelMetrics& m) { return m.pAngle; }},
+      {"p_area", "p_area, bounding rectangle area / area", [](const ParcelMetrics& m) { return m.pArea; }},
+  };
+  return q;
+}
+
+const ParcelQuantity& parcelQuantity(const std::string& name) {
+  std::string names;
+  for (const ParcelQuantity& q : parcelQuantities()) {
+    if (q.name == name) return q;
+    names += (names.empty() ? "" : ", ") + q.name;
+  }
+  throw usageError("no parcel quantity '" + name + "' (quantities: " + names + ")");
+}
+
+std::vector<double> quantitySample(const std::vector<ParcelMetrics>& metrics, const ParcelQuantity& q) {
+  std::vector<double> out;
+  out.reserve(metrics.size());
+  for (const ParcelMetrics& m : metrics) {
+    const double v = q.value(m);
+    if (std::isfinite(v)) out.push_back(v);
+  }
+  return out;
+}
+
 std::vector<double> metricSample(const std::vector<ParcelMetrics>& metrics, ComparedMetric m) {
   std::vector<double> out;
   out.reserve(metrics.size());

@@ -276,6 +276,25 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
   return out;
 }
 
+void rederiveBlockBounds(ObservedAnalysis& a, double k) {
+  a.clampedAMin = a.clampedWMin = 0;
+  for (std::size_t b = 0; b < a.blocks.size(); ++b) {
+    std::vector<double> areas, widths;
+    for (int i : a.blocks[b].parcels) {
+      areas.push_back(a.metrics[i].area);
+      widths.push_back(a.metrics[i].width);
+    }
+    const BlockStatistics old = a.statistics[b];
+    BlockStatistics& s = a.statistics[b];
+    s = blockStatistics(areas, widths, k);
+    s.blockId = old.blockId;
+    s.blockArea = old.blockArea;
+    s.streetAccessShare = old.streetAccessShare;
+    a.clampedAMin += s.aMinClamped;
+    a.clampedWMin += s.wMinClamped;
+  }
+}
+
 std::vector<ParcelMetrics> measureParcels(const std::vector<Polygon>& shapes, const std::vector<Block>& blocks,
                                           double tolerance, double minFrontage) {
   std::vector<ParcelMetrics> metrics(shapes.size());

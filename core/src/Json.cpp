@@ -47,6 +47,49 @@ Json& Json::push(Json value) {
   return *this;
 }
 
+bool Json::isNull() const { return std::holds_alternative<std::nullptr_t>(value_); }
+bool Json::isNumber() const {
+  return std::holds_alternative<std::int64_t>(value_) || std::holds_alternative<double>(value_);
+}
+bool Json::isString() const { return std::holds_alternative<std::string>(value_); }
+bool Json::isObject() const { return std::holds_alternative<std::shared_ptr<Object>>(value_); }
+bool Json::isArray() const { return std::holds_alternative<std::shared_ptr<Array>>(value_); }
+
+const Json* Json::find(const std::string& key) const {
+  const auto* o = std::get_if<std::shared_ptr<Object>>(&value_);
+  if (!o) return nullptr;
+  for (const auto& kv : **o) {
+    if (kv.first == key) return &kv.second;
+  }
+  return nullptr;
+}
+
+double Json::number() const {
+  if (const auto* i = std::get_if<std::int64_t>(&value_)) return static_cast<double>(*i);
+  if (const auto* d = std::get_if<double>(&value_)) return *d;
+  throw std::logic_error("Json::number on a non-number");
+}
+
+const std::string& Json::string() const {
+  if (const auto* s = std::get_if<std::string>(&value_)) return *s;
+  throw std::logic_error("Json::string on a non-string");
+}
+
+bool Json::boolean() const {
+  if (const auto* b = std::get_if<bool>(&value_)) return *b;
+  throw std::logic_error("Json::boolean on a non-boolean");
+}
+
+std::vector<std::pair<std::string, Json>> Json::members() const {
+  const auto* o = std::get_if<std::shared_ptr<Object>>(&value_);
+  return o ? **o : Object{};
+}
+
+std::vector<Json> Json::elements() const {
+  const auto* a = std::get_if<std::shared_ptr<Array>>(&value_);
+  return a ? **a : Array{};
+}
+
 namespace {
 void escape(std::string& out, const std::string& s) {
   out += '"';

@@ -79,151 +79,274 @@ std::int64_t positionKey(const Polygon& shape, const io::LocalFrame& frame) {
 }
 }  // namespace
 
-GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& progress) {
-  {
-    std::string names;
-    bool known = false;
-    for (const auto& [name, help] : generationStyles()) {
-      known = known || name == request.style;
-      names += (names.empty() ? "" : ", ") + name;
-    }
-    if (!known) throw usageError("--style " + request.style + " is not available (styles: " + names + ")");
-  }
-  const SkeletonParameters skeleton = skeletonParametersFrom(request.parameters);
-  const ObbParameters global = obbParametersFrom(request.parameters);
-  if (global.aMin > global.aMax) throw usageError("--a-min must not exceed --a-max");
-  if (global.wMin > global.wMax) throw usageError("--w-min must not exceed --w-max");
-  auto seedIt = request.parameters.find("seed");
-  GeneratedParcels out;
-  out.seed = seedIt == request.parameters.end() ? 1 : static_cast<std::uint64_t>(seedIt->second);
+namespace {
 
-  // Blocks and their own bounds (NaN where they have none).
-  struct Unit {
-    std::int64_t blockId;
-    Polygon shape;
-    ObbParameters p;
-    double accessShare;  // of the block's observed parcels; NaN when unknown
-  };
-  std::vector<Unit> units;
+void checkStyle(const std::string& style, bool allowAuto) {
+  std::string names;
+  bool known = false;
+  for (const auto& [name, help] : generationStyles()) {
+    if (name == "auto" && !allowAuto) continue;
+    known = known || name == style;
+    names += (names.empty() ? "" : ", ") + name;
+  }
+  if (!known) throw usageError("--style " + style + " is not available (styles: " + names + ")");
+}
+
+std::uint64_t runSeed(const ParameterValues& values) {
+  const auto it = values.find("seed");
+  return it == values.end() ? 1 : static_cast<std::uint64_t>(it->second);
+}
+
+bool sameBounds(const ObbParameters& a, const ObbParameters& b) {
+  return a.aMin == b.aMin && a.aMax == b.aMax && a.wMin == b.wMin && a.wMax == b.wMax && a.omega == b.omega &&
+         a.xi == b.xi && a.snapDistance == b.snapDistance && a.minFrontage == b.minFrontage;
+}
+
+}  // namespace
+
+bool BlockPlan::operator==(const BlockPlan& o) const {
+  return style == o.style && seed == o.seed && sameBounds(parameters.bounds, o.parameters.bounds) &&
+         parameters.offset == o.parameters.offset && parameters.streetAngle == o.parameters.streetAngle &&
+         parameters.corner == o.parameters.corner && parameters.subdividePatios == o.parameters.subdividePatios;
+}
+
+BlockInputs prepareBlocks(const GenerateRequest& request, const ProgressFn& progress) {
+  BlockInputs in;
   if (request.fromParcels) {
     analysis::ObservedData loaded;
-    if (!request.observed) {
-      loaded = analysis::loadObserved(request.input, request.parameters, scaledProgress(progress, 0.0, 0.4));
-    }
+    if (!request.observed) loaded = analysis::loadObserved(request.input, request.parameters, progress);
     const analysis::ObservedData& observed = request.observed ? *request.observed : loaded;
     for (std::size_t b = 0; b < observed.analysis.blocks.size(); ++b) {
       const auto& s = observed.analysis.statistics[b];
-      const ObbParameters p = blockParameters(request, s.aMin, s.aMax, s.wMin, s.wMax);
       for (const Polygon& shape : observed.analysis.blocks[b].parts) {
-        units.push_back({observed.analysis.blocks[b].id, shape, p, s.streetAccessShare});
+        in.entries.push_back({observed.analysis.blocks[b].id, shape, s.aMin, s.aMax, s.wMin, s.wMax,
+                              s.streetAccessShare});
       }
     }
     if (request.observed) {
-      out.source = request.observed->layer;
+      in.source = std::make_shared<const io::ParcelLayer>(request.observed->layer);
     } else {
-      out.source = std::move(loaded.layer);
+      in.source = std::make_shared<const io::ParcelLayer>(std::move(loaded.layer));
     }
   } else {
-    io::ReadOptions in = request.input;
-    in.numericFields = {"block_id", "a_min", "a_max", "w_min", "w_max", "street_access_share"};
-    out.source = io::readParcels(in, scaledProgress(progress, 0.0, 0.2));
-    for (std::size_t i = 0; i < out.source.parcels.size(); ++i) {
-      const auto& f = out.source.fields[i];
-      const std::int64_t id = std::isfinite(f[0]) ? static_cast<std::int64_t>(f[0]) : out.source.parcels[i].sourceFid;
-      units.push_back({id, out.source.parcels[i].shape, blockParameters(request, f[1], f[2], f[3], f[4]), f[5]});
+    io::ReadOptions options = request.input;
+    options.numericFields = {"block_id", "a_min", "a_max", "w_min", "w_max", "street_access_share"};
+    auto layer = std::make_shared<io::ParcelLayer>(io::readParcels(options, progress));
+    for (std::size_t i = 0; i < layer->parcels.size(); ++i) {
+      const auto& f = layer->fields[i];
+      const std::int64_t id = std::isfinite(f[0]) ? static_cast<std::int64_t>(f[0]) : layer->parcels[i].sourceFid;
+      in.entries.push_back({id, layer->parcels[i].shape, f[1], f[2], f[3], f[4], f[5]});
     }
+    in.source = std::move(layer);
   }
+  return in;
+}
+
+const std::vector<StreetWidths>& streetWidthsOf(BlockInputs& inputs) {
+  if (inputs.widths.size() != inputs.entries.size()) {
+    std::vector<const Polygon*> shapes;
+    for (const auto& e : inputs.entries) shapes.push_back(&e.shape);
+    inputs.widths = analysis::streetWidths(shapes);
+  }
+  return inputs.widths;
+}
+
+std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInputs& inputs,
+                                  std::int64_t* clampedBounds) {
+  checkStyle(request.style, true);
+  const std::vector<ParameterDescription> descriptions = generationParameterDescriptions();
+  auto check = [&](const ParameterValues& values, const std::string& where) {
+    for (const auto& [name, v] : values) {
+      const auto d = std::find_if(descriptions.begin(), descriptions.end(),
+                                  [&](const ParameterDescription& x) { return x.name == name; });
+      if (d == descriptions.end()) {
+        if (where.empty()) continue;  // the run's values also hold analysis and comparison parameters
+        throw usageError(where + ": no generator parameter named '" + name + "'");
+      }
+      checkValue(*d, v);
+    }
+    const ObbParameters p = obbParametersFrom(values);
+    if (p.aMin > p.aMax) throw usageError((where.empty() ? "" : where + ": ") + "--a-min must not exceed --a-max");
+    if (p.wMin > p.wMax) throw usageError((where.empty() ? "" : where + ": ") + "--w-min must not exceed --w-max");
+  };
+  check(request.parameters, "");
+  std::set<std::int64_t> ids;
+  for (const auto& e : inputs.entries) ids.insert(e.blockId);
+  for (const auto& [id, o] : request.overrides) {
+    const std::string where = "block " + std::to_string(id);
+    if (!ids.count(id)) throw usageError(where + ": no such block (override)");
+    if (!o.style.empty()) checkStyle(o.style, true);
+    ParameterValues merged = request.parameters;
+    for (const auto& [name, v] : o.parameters) merged[name] = v;
+    check(o.parameters, where);
+    check(merged, where);
+  }
+
   // Per-block bounds (derived from observed parcels or read from the input) are
   // clamped into the parameters' ranges: a block of tiny slivers can derive an
   // A_max below the 1 m2 minimum, and a zero would make splitting endless.
-  const auto& descriptions = obbParameterDescriptions();
+  const auto& ranges = obbParameterDescriptions();
+  std::int64_t clamped = 0;
   auto clampTo = [&](const char* name, double& value) {
-    for (const auto& d : descriptions) {
+    for (const auto& d : ranges) {
       if (d.name == name && (value < d.minimum || value > d.maximum)) {
         value = std::clamp(value, d.minimum, d.maximum);
-        ++out.clampedBounds;
+        ++clamped;
       }
     }
   };
-  for (Unit& u : units) {
-    clampTo("a-min", u.p.aMin);
-    clampTo("a-max", u.p.aMax);
-    clampTo("w-min", u.p.wMin);
-    clampTo("w-max", u.p.wMax);
+  std::vector<BlockPlan> plans(inputs.entries.size());
+  for (std::size_t k = 0; k < inputs.entries.size(); ++k) {
+    const BlockInputs::Entry& e = inputs.entries[k];
+    const auto ov = request.overrides.find(e.blockId);
+    const bool overridden = ov != request.overrides.end();
+    ParameterValues values;
+    std::set<std::string> given;
+    if (overridden) {
+      values = request.parameters;
+      given = request.explicitParameters;
+      for (const auto& [name, v] : ov->second.parameters) {
+        values[name] = v;
+        given.insert(name);
+      }
+    }
+    const ParameterValues& v = overridden ? values : request.parameters;
+    const std::set<std::string>& explicitNames = overridden ? given : request.explicitParameters;
+
+    ObbParameters p = obbParametersFrom(v);
+    auto pick = [&](const char* name, double perBlock, double& target) {
+      if (!explicitNames.count(name) && std::isfinite(perBlock)) {
+        target = perBlock;
+        clampTo(name, target);
+      }
+    };
+    pick("a-min", e.aMin, p.aMin);
+    pick("a-max", e.aMax, p.aMax);
+    pick("w-min", e.wMin, p.wMin);
+    pick("w-max", e.wMax, p.wMax);
     // A bound the user gave wins over a conflicting per-block one.
-    if (request.explicitParameters.count("a-min")) {
-      u.p.aMax = std::max(u.p.aMax, u.p.aMin);
+    if (explicitNames.count("a-min")) {
+      p.aMax = std::max(p.aMax, p.aMin);
     } else {
-      u.p.aMin = std::min(u.p.aMin, u.p.aMax);
+      p.aMin = std::min(p.aMin, p.aMax);
     }
-    if (request.explicitParameters.count("w-min")) {
-      u.p.wMax = std::max(u.p.wMax, u.p.wMin);
+    if (explicitNames.count("w-min")) {
+      p.wMax = std::max(p.wMax, p.wMin);
     } else {
-      u.p.wMin = std::min(u.p.wMin, u.p.wMax);
+      p.wMin = std::min(p.wMin, p.wMax);
     }
-  }
 
-  // Subdivide every block, in parallel; each block's seed depends only on its id.
-  out.timings.start("subdivide");
-  std::vector<std::string> styles(units.size(), request.style);
-  if (request.style == "auto") {
-    for (std::size_t k = 0; k < units.size(); ++k) {
-      const double share = units[k].accessShare;
-      styles[k] = std::isfinite(share) && share < kAutoSkeletonAccessShare ? "obb" : "skeleton";
+    BlockPlan& plan = plans[k];
+    plan.style = overridden && !ov->second.style.empty() ? ov->second.style : request.style;
+    if (plan.style == "auto") {
+      plan.style = std::isfinite(e.accessShare) && e.accessShare < kAutoSkeletonAccessShare ? "obb" : "skeleton";
     }
+    if (plan.style != "obb") plan.parameters = skeletonParametersFrom(v);
+    plan.parameters.bounds = p;
+    plan.seed = blockSeed(runSeed(v), positionKey(e.shape, inputs.source->frame));
   }
-  // Street widths from the block layout, for the skeleton styles' StreetWidth rule.
-  std::vector<StreetWidths> widths;
-  if (std::count(styles.begin(), styles.end(), "obb") != static_cast<long>(styles.size())) {
-    std::vector<const Polygon*> shapes;
-    for (const Unit& u : units) shapes.push_back(&u.shape);
-    widths = analysis::streetWidths(shapes);
-  }
-  std::vector<Subdivision> results(units.size());
-  const ProgressFn sub = scaledProgress(progress, request.fromParcels ? 0.4 : 0.2, 0.9);
-  parallelFor(
-      units.size(),
-      [&](std::size_t k) {
-        const Unit& u = units[k];
-        const std::uint64_t seed = blockSeed(out.seed, positionKey(u.shape, out.source.frame));
-        SkeletonParameters p = skeleton;
-        p.bounds = u.p;
-        results[k] = subdivideBlock(u.shape, styles[k], p, seed, widths.empty() ? StreetWidths{} : widths[k]);
-      },
-      [&](std::size_t done) {
-        reportProgress(sub, static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(1, units.size())),
-                       "subdividing");
-      });
+  if (clampedBounds) *clampedBounds = clamped;
+  return plans;
+}
 
-  for (std::size_t k = 0; k < units.size(); ++k) {
+namespace {
+
+Subdivision subdivideEntry(const BlockInputs& inputs, std::size_t entry, const BlockPlan& plan) {
+  const bool widths = plan.style != "obb" && inputs.widths.size() == inputs.entries.size();
+  return subdivideBlock(inputs.entries[entry].shape, plan.style, plan.parameters, plan.seed,
+                        widths ? inputs.widths[entry] : StreetWidths{});
+}
+
+std::vector<analysis::ParcelMetrics> measureEntry(const BlockInputs& inputs, std::size_t entry,
+                                                  const Subdivision& s, double minFrontage) {
+  Block block;
+  block.parts = {inputs.entries[entry].shape};
+  for (std::size_t i = 0; i < s.parcels.size(); ++i) block.parcels.push_back(static_cast<int>(i));
+  return analysis::measureParcels(s.parcels, {block}, 0.05, minFrontage);
+}
+
+}  // namespace
+
+BlockOutcome runBlock(const BlockInputs& inputs, std::size_t entry, const BlockPlan& plan, double minFrontage) {
+  BlockOutcome o;
+  o.subdivision = subdivideEntry(inputs, entry, plan);
+  o.metrics = measureEntry(inputs, entry, o.subdivision, minFrontage);
+  return o;
+}
+
+GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<BlockPlan>& plans,
+                                 const std::vector<const BlockOutcome*>& outcomes, std::uint64_t seed) {
+  if (plans.size() != inputs.entries.size() || outcomes.size() != inputs.entries.size()) {
+    throw std::logic_error("assembleParcels: one plan and one outcome per block entry");
+  }
+  GeneratedParcels out;
+  out.source = inputs.source;
+  out.seed = seed;
+  std::size_t total = 0;
+  for (const BlockOutcome* o : outcomes) total += o->subdivision.parcels.size();
+  out.parcels.reserve(total);
+  out.metrics.reserve(total);
+  for (std::size_t k = 0; k < inputs.entries.size(); ++k) {
+    const Subdivision& s = outcomes[k]->subdivision;
+    const std::int64_t id = inputs.entries[k].blockId;
     Block block;
     block.id = static_cast<int>(out.blocks.size());
-    block.parts = {units[k].shape};
-    for (Polygon& parcel : results[k].parcels) {
+    block.parts = {inputs.entries[k].shape};
+    for (const Polygon& parcel : s.parcels) {
       block.parcels.push_back(static_cast<int>(out.parcels.size()));
-      out.parcels.push_back(std::move(parcel));
+      out.parcels.push_back(parcel);
     }
+    out.metrics.insert(out.metrics.end(), outcomes[k]->metrics.begin(), outcomes[k]->metrics.end());
     out.blocks.push_back(std::move(block));
-    out.blockIds.push_back(units[k].blockId);
-    out.blockStyles.push_back(results[k].fallback ? "obb" : styles[k]);
-    out.oversize += results[k].oversize;
-    out.withoutAccess += results[k].withoutAccess;
-    out.patioParcels += results[k].patioParcels;
-    if (results[k].fallback) {
+    out.blockIds.push_back(id);
+    out.blockStyles.push_back(s.fallback ? "obb" : plans[k].style);
+    out.oversize += s.oversize;
+    out.withoutAccess += s.withoutAccess;
+    out.patioParcels += s.patioParcels;
+    if (s.fallback) {
       ++out.fallbackBlocks;
-      out.failures.push_back("block " + std::to_string(units[k].blockId) + ": skeleton not usable (" +
-                             results[k].fallbackReason + "), subdivided with obb");
+      out.failures.push_back("block " + std::to_string(id) + ": skeleton not usable (" + s.fallbackReason +
+                             "), subdivided with obb");
     }
-    if (results[k].failed) {
+    if (s.failed) {
       ++out.failedBlocks;
-      out.failures.push_back("block " + std::to_string(units[k].blockId) + ": " + results[k].failure);
+      out.failures.push_back("block " + std::to_string(id) + ": " + s.failure);
     }
   }
+  return out;
+}
+
+GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& progress) {
+  checkStyle(request.style, true);
+  BlockInputs inputs = prepareBlocks(request, scaledProgress(progress, 0.0, request.fromParcels ? 0.4 : 0.2));
+  std::int64_t clamped = 0;
+  const std::vector<BlockPlan> plans = planBlocks(request, inputs, &clamped);
+  Timings timings;
+  timings.start("subdivide");
+  if (std::any_of(plans.begin(), plans.end(), [](const BlockPlan& p) { return p.style != "obb"; })) {
+    streetWidthsOf(inputs);
+  }
+  // Every block in parallel; each block's seed depends only on its position.
+  std::vector<BlockOutcome> outcomes(plans.size());
+  const ProgressFn sub = scaledProgress(progress, request.fromParcels ? 0.4 : 0.2, 0.9);
+  const auto fraction = [&](std::size_t done) {
+    return static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(1, plans.size()));
+  };
+  parallelFor(
+      plans.size(), [&](std::size_t k) { outcomes[k].subdivision = subdivideEntry(inputs, k, plans[k]); },
+      [&](std::size_t done) { reportProgress(sub, fraction(done), "subdividing"); });
   reportProgress(progress, 0.9, "measuring");
-  out.timings.start("measure");
-  const double minFrontage = global.minFrontage;
-  out.metrics = analysis::measureParcels(out.parcels, out.blocks, 0.05, minFrontage);
-  out.timings.stop();
+  timings.start("measure");
+  const double minFrontage = obbParametersFrom(request.parameters).minFrontage;
+  parallelFor(plans.size(), [&](std::size_t k) {
+    outcomes[k].metrics = measureEntry(inputs, k, outcomes[k].subdivision, minFrontage);
+  });
+  std::vector<const BlockOutcome*> pointers;
+  for (const BlockOutcome& o : outcomes) pointers.push_back(&o);
+  GeneratedParcels out = assembleParcels(inputs, plans, pointers, runSeed(request.parameters));
+  timings.stop();
+  out.clampedBounds = clamped;
+  out.timings = timings;
   reportProgress(progress, 1.0, "measuring");
   return out;
 }
@@ -251,7 +374,7 @@ analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::stri
   reportProgress(progress, 0.9, "writing");
   std::vector<std::vector<Polygon>> geometries;
   const Table table = generatedParcelTable(g, &geometries);
-  io::writePolygonLayer(out.stage("parcels.gpkg"), "parcels", geometries, table, g.source.frame, g.source.crs);
+  io::writePolygonLayer(out.stage("parcels.gpkg"), "parcels", geometries, table, g.source->frame, g.source->crs);
   io::writeCsv(out.stage("parcels.csv"), table);
 
   Json perBlock = Json::array();
@@ -268,10 +391,10 @@ analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::stri
                  .set("seed", static_cast<std::int64_t>(g.seed))
                  .set("per_block_parameters_where_available", perBlock);
   run.set("input", Json::object()
-                       .set("path", g.source.path)
-                       .set("layer", g.source.layerName)
-                       .set("crs", g.source.crs.name)
-                       .set("local_frame", g.source.frame.describe()));
+                       .set("path", g.source->path)
+                       .set("layer", g.source->layerName)
+                       .set("crs", g.source->crs.name)
+                       .set("local_frame", g.source->frame.describe()));
   run.set("counts", Json::object()
                         .set("blocks", static_cast<std::int64_t>(g.blocks.size()))
                         .set("blocks_failed", g.failedBlocks)
@@ -293,7 +416,7 @@ analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::stri
   io::writeJson(out.stage("run.json"), run);
   out.commit();
   reportProgress(progress, 1.0, "writing");
-  std::string summary = std::to_string(g.blocks.size()) + " blocks of " + g.source.path + " subdivided (" +
+  std::string summary = std::to_string(g.blocks.size()) + " blocks of " + g.source->path + " subdivided (" +
                         request.style + ", seed " + std::to_string(g.seed) + ") into " +
                         std::to_string(g.parcels.size()) + " parcels\n  " + std::to_string(g.oversize) +
                         " oversize (no admissible split), " + std::to_string(g.withoutAccess) +

@@ -92,4 +92,32 @@ void OutputDirectory::commit() {
   committed_ = true;
 }
 
+StagedFile::StagedFile(std::string target, const std::vector<std::string>& inputs) : target_(std::move(target)) {
+  std::error_code ec;
+  if (target_.empty()) throw usageError("an output file name is required");
+  if (fs::is_directory(target_, ec)) throw usageError(target_ + ": is a folder, not a file");
+  for (const auto& in : inputs) {
+    if (sameFile(target_, in)) throw usageError(target_ + ": output would overwrite an input");
+  }
+  const fs::path t(target_);
+  const fs::path folder = t.parent_path().empty() ? fs::path(".") : t.parent_path();
+  if (!fs::is_directory(folder, ec)) throw ioError(target_ + ": folder " + folder.string() + " does not exist");
+  staging_ = (folder / ("." + t.stem().string() + ".partial-" + std::to_string(::getpid()) + t.extension().string()))
+                 .string();
+  fs::remove(staging_, ec);
+}
+
+StagedFile::~StagedFile() {
+  std::error_code ec;
+  if (!committed_) fs::remove(staging_, ec);
+}
+
+void StagedFile::commit() {
+  std::error_code ec;
+  if (!fs::exists(staging_, ec)) throw ioError(target_ + ": nothing was written");
+  fs::rename(staging_, target_, ec);
+  if (ec) throw ioError(target_ + ": cannot move into place (" + ec.message() + ")");
+  committed_ = true;
+}
+
 }  // namespace parcelscope::io

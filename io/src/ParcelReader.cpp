@@ -230,6 +230,13 @@ Cleaned cleanFeature(const Feature& f, const LocalFrame& frame) {
 
 }  // namespace
 
+std::vector<std::string> layerNames(const std::string& path) {
+  const GDALDatasetUniquePtr ds = openVector(path);
+  std::vector<std::string> names;
+  for (int i = 0; i < ds->GetLayerCount(); ++i) names.emplace_back(ds->GetLayer(i)->GetName());
+  return names;
+}
+
 ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) {
   const std::string& path = options.path;
   Timings timings;

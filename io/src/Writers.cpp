@@ -1,5 +1,6 @@
 #include "parcelscope/io/Writers.h"
 
+#include <cpl_json.h>
 #include <gdal_priv.h>
 #include <ogr_spatialref.h>
 #include <ogrsf_frmts.h>
@@ -56,6 +57,43 @@ void writeCsv(const std::string& path, const Table& table) {
 
 void writeJson(const std::string& path, const Json& json) { writeText(path, json.dump() + "\n"); }
 
+namespace {
+Json fromCpl(const CPLJSONObject& o) {
+  switch (o.GetType()) {
+    case CPLJSONObject::Type::Object: {
+      Json j = Json::object();
+      for (const CPLJSONObject& child : o.GetChildren()) j.set(child.GetName(), fromCpl(child));
+      return j;
+    }
+    case CPLJSONObject::Type::Array: {
+      Json j = Json::array();
+      const CPLJSONArray a = o.ToArray();
+      for (int i = 0; i < a.Size(); ++i) j.push(fromCpl(a[i]));
+      return j;
+    }
+    case CPLJSONObject::Type::Boolean: return Json(o.ToBool());
+    case CPLJSONObject::Type::String: return Json(o.ToString());
+    case CPLJSONObject::Type::Integer:
+    case CPLJSONObject::Type::Long: return Json(static_cast<long long>(o.ToLong()));
+    case CPLJSONObject::Type::Double: return Json(o.ToDouble());
+    default: return Json();
+  }
+}
+}  // namespace
+
+Json readJson(const std::string& path) {
+  detail::QuietErrors quiet;
+  CPLErrorReset();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw inputError(path + ": cannot open");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CPLJSONDocument doc;
+  if (!doc.LoadMemory(text)) {
+    throw inputError(path + ": not valid JSON (" + std::string(CPLGetLastErrorMsg()) + ")");
+  }
+  return fromCpl(doc.GetRoot());
+}
+
 void writePolygonLayer(const std::string& path, const std::string& layerName,
                        const std::vector<std::vector<Polygon>>& geometries, const Table& attributes,
                        const LocalFrame& frame, const CrsInfo& crs) {
@@ -65,10 +103,16 @@ void writePolygonLayer(const std::string& path, const std::string& layerName,
   auto fail = [&](const std::string& what) {
     return ioError(path + ": " + what + " (" + std::string(CPLGetLastErrorMsg()) + ")");
   };
-  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GPKG");
-  if (!driver) throw ioError(path + ": GDAL has no GPKG driver");
+  auto endsWith = [&](const char* suffix) {
+    const std::string s(suffix);
+    return path.size() >= s.size() && path.compare(path.size() - s.size(), s.size(), s) == 0;
+  };
+  const bool geojson = endsWith(".geojson") || endsWith(".json");
+  const char* format = geojson ? "GeoJSON" : "GPKG";
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(format);
+  if (!driver) throw ioError(path + ": GDAL has no " + format + " driver");
   GDALDatasetUniquePtr ds(driver->Create(path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
-  if (!ds) throw fail("cannot create GeoPackage");
+  if (!ds) throw fail(std::string("cannot create ") + format + " file");
 
   OGRSpatialReference srs;
   if (!crs.wkt.empty()) {
@@ -86,7 +130,7 @@ void writePolygonLayer(const std::string& path, const std::string& layerName,
     OGRFieldDefn field(c.name.c_str(), type);
     if (layer->CreateField(&field) != OGRERR_NONE) throw fail("cannot create field " + c.name);
   }
-  if (ds->StartTransaction() != OGRERR_NONE) throw fail("cannot start transaction");
+  if (!geojson && ds->StartTransaction() != OGRERR_NONE) throw fail("cannot start transaction");
   for (std::size_t i = 0; i < geometries.size(); ++i) {
     OGRFeature feature(layer->GetLayerDefn());
     for (std::size_t c = 0; c < attributes.columns.size(); ++c) {
@@ -114,7 +158,7 @@ void writePolygonLayer(const std::string& path, const std::string& layerName,
       throw fail("cannot write feature " + std::to_string(i));
     }
   }
-  if (ds->CommitTransaction() != OGRERR_NONE) throw fail("cannot commit");
+  if (!geojson && ds->CommitTransaction() != OGRERR_NONE) throw fail("cannot commit");
   ds.reset();  // flush and close before the caller renames the file
   if (CPLGetLastErrorType() == CE_Failure) throw fail("closing failed");
 }

@@ -28,7 +28,7 @@ TEST(GenerateJob, ObservedDataPassedInGivesTheSameParcelsAsReadingTheInput) {
     EXPECT_DOUBLE_EQ(area(given.parcels[i]), area(read.parcels[i])) << i;
   }
   EXPECT_EQ(given.blockIds, read.blockIds);
-  EXPECT_EQ(given.source.parcels.size(), observed.layer.parcels.size());
+  EXPECT_EQ(given.source->parcels.size(), observed.layer.parcels.size());
   ASSERT_EQ(given.timings.stages().size(), 2u);
   EXPECT_EQ(given.timings.stages()[0].first, "subdivide");
   EXPECT_EQ(given.timings.stages()[1].first, "measure");

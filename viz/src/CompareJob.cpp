@@ -1,16 +1,21 @@
 #include "parcelscope/viz/CompareJob.h"
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <numeric>
+#include <optional>
 
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
 #include "parcelscope/io/FileHash.h"
 #include "parcelscope/io/OutputDirectory.h"
 #include "parcelscope/io/Writers.h"
+#include "parcelscope/viz/CompareSession.h"
 #include "parcelscope/viz/Figures.h"
+#include "CompareStages.h"
 
 namespace parcelscope::viz {
 
@@ -40,9 +45,7 @@ std::vector<ParameterDescription> compareParameters() {
   return all;
 }
 
-namespace {
-
-double value(const CompareRequest& request, const std::string& name) {
+double compareValue(const CompareRequest& request, const std::string& name) {
   const auto it = request.parameters.find(name);
   if (it != request.parameters.end()) return it->second;
   for (const auto& d : compareParameters()) {
@@ -50,6 +53,10 @@ double value(const CompareRequest& request, const std::string& name) {
   }
   throw std::logic_error("compare: no parameter named " + name);
 }
+
+namespace {
+
+double value(const CompareRequest& request, const std::string& name) { return compareValue(request, name); }
 
 double secondsIn(const Timings& t) {
   double s = 0;
@@ -70,38 +77,46 @@ std::vector<ParcelMetrics> pick(const std::vector<ParcelMetrics>& all, const std
 
 }  // namespace
 
-CompareResult compare(const CompareRequest& request, const ProgressFn& progress) {
-  for (const auto& d : compareParameters()) {
-    const auto it = request.parameters.find(d.name);
-    if (it != request.parameters.end()) checkValue(d, it->second);
-  }
-  CompareResult r;
-  r.observed = analysis::loadObserved(request.input, request.parameters, scaledProgress(progress, 0.0, 0.45));
-  const analysis::ObservedAnalysis& a = r.observed.analysis;
-  if (a.blocks.empty()) {
-    throw inputError(request.input.path + ": no block to compare (no parcel is left once right-of-way parcels "
-                     "are set aside)");
-  }
+namespace detail {
 
+generation::GenerateRequest generateRequest(const CompareRequest& request, const analysis::ObservedData* observed) {
   generation::GenerateRequest g;
   g.input = request.input;
   g.fromParcels = true;
   g.style = request.style;
   g.parameters = request.parameters;
   g.explicitParameters = request.explicitParameters;
-  g.observed = &r.observed;
-  r.generated = generation::generate(g, scaledProgress(progress, 0.45, 0.9));
+  g.observed = observed;
+  g.overrides = request.overrides;
+  return g;
+}
 
-  // Both sets measured with the same metrics; compared block by block, in parallel.
-  reportProgress(progress, 0.9, "comparing");
-  const auto compareStart = std::chrono::steady_clock::now();
+void requireBlocks(const CompareRequest& request, const analysis::ObservedData& observed) {
+  if (observed.analysis.blocks.empty()) {
+    throw inputError(request.input.path + ": no block to compare (no parcel is left once right-of-way parcels "
+                     "are set aside)");
+  }
+}
+
+void checkRequest(const CompareRequest& request) {
+  for (const auto& d : compareParameters()) {
+    const auto it = request.parameters.find(d.name);
+    if (it != request.parameters.end()) checkValue(d, it->second);
+  }
+  analysis::parcelQuantity(request.metric);
+}
+
+void compareStage(CompareResult& r, const CompareRequest& request, const std::vector<char>* keep) {
+  const analysis::ObservedAnalysis& a = r.observed->analysis;
   const int bins = static_cast<int>(value(request, "bins"));
   const double quantile = value(request, "histogram-quantile");
-  std::vector<int> lots;
-  for (std::size_t i = 0; i < a.blockOf.size(); ++i) {
-    if (a.blockOf[i] >= 0) lots.push_back(static_cast<int>(i));
+  if (r.observedLots.empty()) {
+    std::vector<int> lots;
+    for (std::size_t i = 0; i < a.blockOf.size(); ++i) {
+      if (a.blockOf[i] >= 0) lots.push_back(static_cast<int>(i));
+    }
+    r.observedLots = pick(a.metrics, lots);
   }
-  r.observedLots = pick(a.metrics, lots);
   std::vector<std::vector<int>> generatedIn(a.blocks.size());
   for (std::size_t k = 0; k < r.generated.blocks.size(); ++k) {
     const std::int64_t id = r.generated.blockIds[k];
@@ -110,8 +125,14 @@ CompareResult compare(const CompareRequest& request, const ProgressFn& progress)
     }
     for (int i : r.generated.blocks[k].parcels) generatedIn[id].push_back(i);
   }
-  r.blocks.resize(a.blocks.size());
-  parallelFor(a.blocks.size(), [&](std::size_t b) {
+  const bool reuse = keep && keep->size() == a.blocks.size() && r.blocks.size() == a.blocks.size();
+  if (!reuse) r.blocks.assign(a.blocks.size(), {});
+  std::vector<std::size_t> todo;
+  for (std::size_t b = 0; b < a.blocks.size(); ++b) {
+    if (!reuse || !(*keep)[b]) todo.push_back(b);
+  }
+  parallelFor(todo.size(), [&](std::size_t t) {
+    const std::size_t b = todo[t];
     analysis::BlockComparison& c = r.blocks[b];
     c.blockId = a.blocks[b].id;
     c.blockArea = a.statistics[b].blockArea;
@@ -119,13 +140,32 @@ CompareResult compare(const CompareRequest& request, const ProgressFn& progress)
                                          pick(r.generated.metrics, generatedIn[b]), bins, quantile);
   });
   r.city = analysis::compareSets(r.observedLots, r.generated.metrics, bins, quantile);
+  r.histograms.clear();
   for (ComparedMetric m : analysis::kComparedMetrics) {
     r.histograms.push_back(analysis::sharedHistogram(analysis::metricSample(r.observedLots, m),
                                                      analysis::metricSample(r.generated.metrics, m), bins,
                                                      quantile));
   }
+}
+
+}  // namespace detail
+
+CompareResult compare(const CompareRequest& request, const ProgressFn& progress) {
+  detail::checkRequest(request);
+  CompareResult r;
+  r.observed = std::make_shared<const analysis::ObservedData>(
+      analysis::loadObserved(request.input, request.parameters, scaledProgress(progress, 0.0, 0.45)));
+  const analysis::ObservedAnalysis& a = r.observed->analysis;
+  detail::requireBlocks(request, *r.observed);
+  r.generated = generation::generate(detail::generateRequest(request, r.observed.get()),
+                                     scaledProgress(progress, 0.45, 0.9));
+
+  // Both sets measured with the same metrics; compared block by block, in parallel.
+  reportProgress(progress, 0.9, "comparing");
+  const auto compareStart = std::chrono::steady_clock::now();
+  detail::compareStage(r, request);
   const double measure = r.generated.timings.stages().empty() ? 0.0 : r.generated.timings.stages().back().second;
-  r.seconds = {{"read", secondsIn(r.observed.layer.timings)},
+  r.seconds = {{"read", secondsIn(r.observed->layer.timings)},
                {"blocks", secondsIn(a.timings)},
                {"generate", secondsIn(r.generated.timings) - measure},
                {"metrics", measure + secondsSince(compareStart)}};
@@ -159,6 +199,236 @@ Json summaryJson(const analysis::SetSummary& s) {
       .set("undesirable_share", s.undesirableShare);
 }
 
+std::string generatedName(const CompareRequest& request, const CompareResult& r) {
+  std::string name = "procedural (" + request.style + ", seed " + std::to_string(r.generated.seed);
+  if (!request.overrides.empty()) name += ", " + std::to_string(request.overrides.size()) + " blocks overridden";
+  return name + ")";
+}
+
+std::string inputName(const CompareRequest& request) {
+  return std::filesystem::path(request.input.path).filename().string();
+}
+
+// Histograms, figures and extra files drawn by compare, by quantity name.
+bool drawnAnyway(const std::string& quantity, bool histogram) {
+  if (histogram) return quantity == "area" || quantity == "width" || quantity == "aspect_ratio";
+  return quantity == "aspect_ratio";
+}
+
+}  // namespace
+
+ColourScale quantityScale(const CompareResult& r, const CompareRequest& request, const std::string& quantity) {
+  const analysis::ParcelQuantity& q = analysis::parcelQuantity(quantity);
+  ColourScale scale;
+  char title[160];
+  if (q.name == "aspect_ratio") {
+    scale.kind = ColourScale::Kind::RedToGreen;
+    scale.minimum = 1;
+    scale.maximum = value(request, "map-aspect-ratio-max");
+    std::snprintf(title, sizeof title, "Aspect ratio (length / width; %g and above drawn green)", scale.maximum);
+    scale.title = title;
+    return scale;
+  }
+  scale.kind = ColourScale::Kind::Sequential;
+  scale.title = q.title;
+  scale.title[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(scale.title[0])));
+  if (q.name == "street_access") {
+    scale.minimum = 0;
+    scale.maximum = 1;
+    return scale;
+  }
+  std::vector<double> pooled = analysis::quantitySample(r.observedLots, q);
+  const std::vector<double> generated = analysis::quantitySample(r.generated.metrics, q);
+  pooled.insert(pooled.end(), generated.begin(), generated.end());
+  if (pooled.empty()) {
+    scale.minimum = 0;
+    scale.maximum = 1;
+    return scale;
+  }
+  std::sort(pooled.begin(), pooled.end());
+  const double quantile = value(request, "histogram-quantile");
+  scale.minimum = pooled.front();
+  scale.maximum = pooled[static_cast<std::size_t>(std::floor(quantile * static_cast<double>(pooled.size() - 1)))];
+  if (!(scale.maximum > scale.minimum)) scale.maximum = scale.minimum + 1;
+  if (quantile < 1 && pooled.back() > scale.maximum) {
+    std::snprintf(title, sizeof title, "; %.4g and above drawn darkest", scale.maximum);
+    scale.title += title;
+  }
+  return scale;
+}
+
+void renderQuantityMap(const CompareResult& r, const CompareRequest& request, const std::string& quantity,
+                       const FigureOutput& output) {
+  const analysis::ParcelQuantity& q = analysis::parcelQuantity(quantity);
+  MapPanel observed, generated;
+  const auto& parcels = r.observed->layer.parcels;
+  for (std::size_t i = 0; i < parcels.size(); ++i) {
+    if (r.observed->analysis.blockOf[i] < 0) continue;
+    observed.shapes.push_back(&parcels[i].shape);
+    observed.values.push_back(q.value(r.observed->analysis.metrics[i]));
+  }
+  for (std::size_t i = 0; i < r.generated.parcels.size(); ++i) {
+    generated.shapes.push_back(&r.generated.parcels[i]);
+    generated.values.push_back(q.value(r.generated.metrics[i]));
+  }
+  observed.title = "Observed: " + std::to_string(observed.shapes.size()) + " parcels";
+  generated.title = "Procedural (" + request.style + "): " + std::to_string(generated.shapes.size()) + " parcels";
+  std::string what = q.title.substr(0, q.title.find(" ("));
+  what[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(what[0])));
+  renderMaps("Parcel " + (q.name == "aspect_ratio" ? std::string("aspect ratio") : q.name) + ", observed and " +
+                 generatedName(request, r) + ": " + inputName(request),
+             {observed, generated}, quantityScale(r, request, quantity), output);
+}
+
+QuantityHistogram quantityHistogram(const CompareResult& r, const CompareRequest& request,
+                                    const std::string& quantity) {
+  const analysis::ParcelQuantity& q = analysis::parcelQuantity(quantity);
+  const analysis::SharedHistogram h = analysis::sharedHistogram(
+      analysis::quantitySample(r.observedLots, q), analysis::quantitySample(r.generated.metrics, q),
+      static_cast<int>(value(request, "bins")), value(request, "histogram-quantile"));
+  QuantityHistogram out;
+  out.edges = h.edges;
+  out.xTitle = q.title;
+  if (h.aOverflow + h.bOverflow > 0) {
+    char note[96];
+    std::snprintf(note, sizeof note, "; the last bin holds every value above %.4g", h.edges.back());
+    out.xTitle += note;
+  }
+  out.yTitle = "parcels (count)";
+  auto counts = [](const std::vector<int>& c) { return std::accumulate(c.begin(), c.end(), 0); };
+  out.series = {{"observed (n = " + std::to_string(counts(h.a)) + ")", h.a, {0.84, 0.15, 0.16}},
+                {"procedural, " + request.style + " (n = " + std::to_string(counts(h.b)) + ")", h.b,
+                 {0.12, 0.38, 0.75}}};
+  const std::string what = q.name == "aspect_ratio" ? std::string("Parcel aspect ratio") : "Parcel " + q.name;
+  out.title = what + ": observed and " + generatedName(request, r) + ", " + inputName(request);
+  return out;
+}
+
+int blockAt(const CompareResult& r, const Point& p) {
+  const auto& blocks = r.observed->analysis.blocks;
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    for (const Polygon& part : blocks[b].parts) {
+      const Box box = bounds(part);
+      if (p.x < box.minX || p.x > box.maxX || p.y < box.minY || p.y > box.maxY) continue;
+      if (pointInPolygon(p, part)) return static_cast<int>(b);
+    }
+  }
+  return -1;
+}
+
+void renderQuantityHistogram(const CompareResult& r, const CompareRequest& request, const std::string& quantity,
+                             const FigureOutput& output) {
+  const QuantityHistogram h = quantityHistogram(r, request, quantity);
+  if (h.edges.empty()) throw usageError(output.png + ": no finite " + quantity + " value on either side to draw");
+  renderHistogram(h.title, h.xTitle, h.yTitle, h.edges, h.series, output);
+}
+
+void renderBlocksMap(const CompareResult& r, const CompareRequest& request, const FigureOutput& output) {
+  MapPanel blocks;
+  int withValue = 0;
+  const analysis::ObservedAnalysis& a = r.observed->analysis;
+  for (std::size_t b = 0; b < a.blocks.size(); ++b) {
+    const double ks = r.blocks[b].comparison.area.ks;
+    withValue += !std::isnan(ks);
+    for (const Polygon& part : a.blocks[b].parts) {
+      blocks.shapes.push_back(&part);
+      blocks.values.push_back(ks);
+    }
+  }
+  blocks.title = std::to_string(a.blocks.size()) + " blocks (" + std::to_string(withValue) +
+                 " with parcels on both sides)";
+  ColourScale scale;
+  scale.kind = ColourScale::Kind::Sequential;
+  scale.minimum = 0;
+  scale.maximum = 1;
+  scale.title = "KS statistic of parcel area (0: same distribution, 1: disjoint)";
+  renderMaps("Per-block difference in parcel area, observed and " + generatedName(request, r) + ": " +
+                 inputName(request),
+             {blocks}, scale, output);
+}
+
+std::vector<std::pair<std::string, Table>> comparisonTables(const CompareResult& r) {
+  std::vector<std::pair<std::string, Table>> tables;
+  Table observed = analysis::parcelTable(r.observed->layer.parcels, r.observed->analysis);
+  addUndesirable(observed, r.observed->analysis.metrics);
+  tables.emplace_back("observed_parcels.csv", std::move(observed));
+  Table generated = generation::generatedParcelTable(r.generated);
+  addUndesirable(generated, r.generated.metrics);
+  tables.emplace_back("generated_parcels.csv", std::move(generated));
+  tables.emplace_back("blocks.csv", analysis::blockComparisonTable(r.blocks));
+  tables.emplace_back("summary.csv", analysis::summaryTable(r.city));
+  tables.emplace_back("distances.csv", analysis::distanceTable(r.city));
+  return tables;
+}
+
+std::vector<std::string> figureNames() {
+  std::vector<std::string> names;
+  for (const auto& q : analysis::parcelQuantities()) names.push_back("map_" + q.name);
+  for (const auto& q : analysis::parcelQuantities()) names.push_back("hist_" + q.name);
+  names.push_back("map_blocks");
+  return names;
+}
+
+void exportFigure(const CompareResult& r, const CompareRequest& request, const std::string& name,
+                  const std::string& path, int width, int height) {
+  const auto names = figureNames();
+  if (std::find(names.begin(), names.end(), name) == names.end()) {
+    throw usageError("no figure named '" + name + "'");
+  }
+  const std::string extension = std::filesystem::path(path).extension().string();
+  const bool histogram = name.rfind("hist_", 0) == 0;
+  if (extension != ".png" && !(histogram && (extension == ".svg" || extension == ".pdf"))) {
+    throw usageError(path + ": " + name + " is written as " + (histogram ? ".png, .svg or .pdf" : ".png"));
+  }
+  const std::vector<std::string> inputs = {request.input.path};
+  io::StagedFile file(path, inputs);
+  std::optional<io::StagedFile> bitmap;  // the PNG every render writes, thrown away for a vector export
+  FigureOutput o;
+  o.width = width;
+  o.height = height;
+  if (extension == ".png") {
+    o.png = file.path();
+  } else {
+    bitmap.emplace(path + ".png", inputs);
+    o.png = bitmap->path();
+    o.vector = file.path();
+  }
+  if (name == "map_blocks") {
+    renderBlocksMap(r, request, o);
+  } else if (histogram) {
+    renderQuantityHistogram(r, request, name.substr(5), o);
+  } else {
+    renderQuantityMap(r, request, name.substr(4), o);
+  }
+  file.commit();
+}
+
+void exportParcels(const CompareResult& r, const std::string& path, const std::vector<std::string>& inputs) {
+  io::StagedFile file(path, inputs);
+  std::vector<std::vector<Polygon>> geometries;
+  Table table = generation::generatedParcelTable(r.generated, &geometries);
+  addUndesirable(table, r.generated.metrics);
+  io::writePolygonLayer(file.path(), "parcels", geometries, table, r.observed->layer.frame, r.observed->layer.crs);
+  file.commit();
+}
+
+void exportTables(const CompareResult& r, const std::string& folder, const std::vector<std::string>& inputs) {
+  if (!std::filesystem::is_directory(folder)) throw usageError(folder + ": not a folder");
+  for (const auto& [name, table] : comparisonTables(r)) {
+    io::StagedFile file((std::filesystem::path(folder) / name).string(), inputs);
+    io::writeCsv(file.path(), table);
+    file.commit();
+  }
+}
+
+void exportSession(const CompareRequest& request, const std::string& path) {
+  io::StagedFile file(path, {request.input.path});
+  io::writeJson(file.path(), sessionJson(request));
+  file.commit();
+}
+
+namespace {
+
 struct FigureSet {
   const CompareRequest& request;
   const CompareResult& r;
@@ -180,79 +450,6 @@ struct FigureSet {
     o.height = static_cast<int>(value(request, "figure-height"));
     return o;
   }
-
-  std::string generatedName() const {
-    return "procedural (" + request.style + ", seed " + std::to_string(r.generated.seed) + ")";
-  }
-  std::string inputName() const { return std::filesystem::path(request.input.path).filename().string(); }
-
-  void aspectRatioMap() {
-    MapPanel observed, generated;
-    const auto& parcels = r.observed.layer.parcels;
-    for (std::size_t i = 0; i < parcels.size(); ++i) {
-      if (r.observed.analysis.blockOf[i] < 0) continue;
-      observed.shapes.push_back(&parcels[i].shape);
-      observed.values.push_back(r.observed.analysis.metrics[i].aspectRatio);
-    }
-    for (std::size_t i = 0; i < r.generated.parcels.size(); ++i) {
-      generated.shapes.push_back(&r.generated.parcels[i]);
-      generated.values.push_back(r.generated.metrics[i].aspectRatio);
-    }
-    observed.title = "Observed: " + std::to_string(observed.shapes.size()) + " parcels";
-    generated.title = "Procedural (" + request.style + "): " + std::to_string(generated.shapes.size()) + " parcels";
-    ColourScale scale;
-    scale.kind = ColourScale::Kind::RedToGreen;
-    scale.minimum = 1;
-    scale.maximum = value(request, "map-aspect-ratio-max");
-    char title[128];
-    std::snprintf(title, sizeof title, "Aspect ratio (length / width; %g and above drawn green)", scale.maximum);
-    scale.title = title;
-    renderMaps("Parcel aspect ratio, observed and " + generatedName() + ": " + inputName(), {observed, generated},
-               scale, output("map_aspect_ratio"));
-  }
-
-  void histogram(ComparedMetric m, std::size_t index) {
-    static const char* titles[] = {"Parcel area", "Parcel width", "Parcel aspect ratio"};
-    static const char* axes[] = {"area (m\xc2\xb2)", "width, short side of the minimum bounding rectangle (m)",
-                                 "aspect ratio (length / width)"};
-    const analysis::SharedHistogram& h = r.histograms[index];
-    if (h.edges.empty()) return;  // nothing to draw: no finite value on either side
-    std::string xTitle = axes[index];
-    if (h.aOverflow + h.bOverflow > 0) {
-      char note[96];
-      std::snprintf(note, sizeof note, "; the last bin holds every value above %.4g", h.edges.back());
-      xTitle += note;
-    }
-    auto counts = [](const std::vector<int>& c) { return std::accumulate(c.begin(), c.end(), 0); };
-    HistogramSeries observed{"observed (n = " + std::to_string(counts(h.a)) + ")", h.a, {0.84, 0.15, 0.16}};
-    HistogramSeries generated{"procedural, " + request.style + " (n = " + std::to_string(counts(h.b)) + ")", h.b,
-                              {0.12, 0.38, 0.75}};
-    renderHistogram(std::string(titles[index]) + ": observed and " + generatedName() + ", " + inputName(), xTitle,
-                    "parcels (count)", h.edges, {observed, generated},
-                    output(std::string("hist_") + analysis::metricName(m)));
-  }
-
-  void blocksMap() {
-    MapPanel blocks;
-    int withValue = 0;
-    for (std::size_t b = 0; b < r.observed.analysis.blocks.size(); ++b) {
-      const double ks = r.blocks[b].comparison.area.ks;
-      withValue += !std::isnan(ks);
-      for (const Polygon& part : r.observed.analysis.blocks[b].parts) {
-        blocks.shapes.push_back(&part);
-        blocks.values.push_back(ks);
-      }
-    }
-    blocks.title = std::to_string(r.observed.analysis.blocks.size()) + " blocks (" + std::to_string(withValue) +
-                   " with parcels on both sides)";
-    ColourScale scale;
-    scale.kind = ColourScale::Kind::Sequential;
-    scale.minimum = 0;
-    scale.maximum = 1;
-    scale.title = "KS statistic of parcel area (0: same distribution, 1: disjoint)";
-    renderMaps("Per-block difference in parcel area, observed and " + generatedName() + ": " + inputName(), {blocks},
-               scale, output("map_blocks"));
-  }
 };
 
 }  // namespace
@@ -263,42 +460,52 @@ analysis::JobOutcome runCompare(const CompareRequest& request, const std::string
   if (figures) requireDisplay();  // before the long work, not after it
   io::OutputDirectory out(outDir, {request.input.path});
   const CompareResult r = compare(request, scaledProgress(progress, 0.0, 0.8));
-  const analysis::ObservedAnalysis& a = r.observed.analysis;
+  const analysis::ObservedAnalysis& a = r.observed->analysis;
 
   reportProgress(progress, 0.8, "writing");
   const auto writeStart = std::chrono::steady_clock::now();
-  Table observedTable = analysis::parcelTable(r.observed.layer.parcels, a);
-  addUndesirable(observedTable, a.metrics);
-  io::writeCsv(out.stage("observed_parcels.csv"), observedTable);
+  std::vector<std::string> outputs = {"parcels.gpkg", "blocks.gpkg"};
+  const auto tables = comparisonTables(r);
+  for (const auto& [name, table] : tables) {
+    io::writeCsv(out.stage(name), table);
+    outputs.push_back(name);
+  }
   std::vector<std::vector<Polygon>> geometries;
-  Table generatedTable = generation::generatedParcelTable(r.generated, &geometries);
-  addUndesirable(generatedTable, r.generated.metrics);
-  io::writeCsv(out.stage("generated_parcels.csv"), generatedTable);
-  io::writePolygonLayer(out.stage("parcels.gpkg"), "parcels", geometries, generatedTable,
-                        r.observed.layer.frame, r.observed.layer.crs);
-  const Table blocks = analysis::blockComparisonTable(r.blocks);
-  io::writeCsv(out.stage("blocks.csv"), blocks);
+  const Table generatedTable = tables[1].second;
+  for (std::size_t b = 0; b < r.generated.blocks.size(); ++b) {
+    for (int i : r.generated.blocks[b].parcels) geometries.push_back({r.generated.parcels[i]});
+  }
+  io::writePolygonLayer(out.stage("parcels.gpkg"), "parcels", geometries, generatedTable, r.observed->layer.frame,
+                        r.observed->layer.crs);
   std::vector<std::vector<Polygon>> outlines;
   for (const Block& b : a.blocks) outlines.push_back(b.parts);
-  io::writePolygonLayer(out.stage("blocks.gpkg"), "blocks", outlines, blocks, r.observed.layer.frame,
-                        r.observed.layer.crs);
-  io::writeCsv(out.stage("summary.csv"), analysis::summaryTable(r.city));
-  io::writeCsv(out.stage("distances.csv"), analysis::distanceTable(r.city));
+  io::writePolygonLayer(out.stage("blocks.gpkg"), "blocks", outlines, tables[2].second, r.observed->layer.frame,
+                        r.observed->layer.crs);
   const double writeSeconds = secondsSince(writeStart);
 
-  std::vector<std::string> outputs = {"parcels.gpkg", "blocks.gpkg", "observed_parcels.csv",
-                                      "generated_parcels.csv", "blocks.csv", "summary.csv", "distances.csv"};
   double figureSeconds = 0;
   if (figures) {
     reportProgress(progress, 0.85, "figures");
     const auto figureStart = std::chrono::steady_clock::now();
     FigureSet f{request, r, out, {}};
-    f.aspectRatioMap();
+    renderQuantityMap(r, request, "aspect_ratio", f.output("map_aspect_ratio"));
     reportProgress(progress, 0.9, "figures");
     std::size_t index = 0;
-    for (ComparedMetric m : analysis::kComparedMetrics) f.histogram(m, index++);
+    for (ComparedMetric m : analysis::kComparedMetrics) {
+      // Nothing to draw when neither side has a finite value.
+      if (!r.histograms[index++].edges.empty()) {
+        renderQuantityHistogram(r, request, analysis::metricName(m),
+                                f.output(std::string("hist_") + analysis::metricName(m)));
+      }
+    }
     reportProgress(progress, 0.93, "figures");
-    f.blocksMap();
+    renderBlocksMap(r, request, f.output("map_blocks"));
+    if (!drawnAnyway(request.metric, false)) {
+      renderQuantityMap(r, request, request.metric, f.output("map_" + request.metric));
+    }
+    if (!drawnAnyway(request.metric, true)) {
+      renderQuantityHistogram(r, request, request.metric, f.output("hist_" + request.metric));
+    }
     outputs.insert(outputs.end(), f.written.begin(), f.written.end());
     figureSeconds = secondsSince(figureStart);
   }
@@ -334,8 +541,9 @@ analysis::JobOutcome runCompare(const CompareRequest& request, const std::string
                  .set("style", request.style)
                  .set("seed", static_cast<std::int64_t>(r.generated.seed))
                  .set("vtk", figures ? vtkVersionString() : Json())
-                 .set("parameters_given", given);
-  analysis::addObservedRecord(run, r.observed);
+                 .set("parameters_given", given)
+                 .set("session", sessionJson(request));
+  analysis::addObservedRecord(run, *r.observed);
   std::error_code ec;
   const bool regular = std::filesystem::is_regular_file(request.input.path, ec);
   run.set("input_file", Json::object()
@@ -378,7 +586,7 @@ analysis::JobOutcome runCompare(const CompareRequest& request, const std::string
                 static_cast<long long>(r.generated.failedBlocks), r.city.area.ks, r.city.width.ks,
                 r.city.aspectRatio.ks, r.city.area.wasserstein, r.city.width.wasserstein,
                 r.city.observed.undesirableShare, r.city.generated.undesirableShare, secondsSince(started));
-  return {run, analysis::summarize(r.observed) + line};
+  return {run, analysis::summarize(*r.observed) + line};
 }
 
 }  // namespace parcelscope::viz

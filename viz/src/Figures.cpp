@@ -1,4 +1,5 @@
 #include "parcelscope/viz/Figures.h"
+#include "parcelscope/viz/Scenes.h"
 
 #include <vtkActor.h>
 #include <vtkAxis.h>
@@ -163,7 +164,7 @@ struct PanelGeometry {
   vtkNew<vtkPolyData> rings;
 };
 
-void buildPanel(const MapPanel& panel, PanelGeometry& g) {
+void buildPanel(const MapPanel& panel, PanelGeometry& g, std::vector<vtkIdType>* trianglesPerShape = nullptr) {
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   vtkNew<vtkCellArray> lines, triangles;
@@ -200,6 +201,7 @@ void buildPanel(const MapPanel& panel, PanelGeometry& g) {
     vtkContourTriangulator::TriangulateContours(contours, 0, shapeLines->GetNumberOfCells(), shapeTriangles, up);
     vtkIdType count = 0;
     const vtkIdType* ids = nullptr;
+    if (trianglesPerShape) trianglesPerShape->push_back(shapeTriangles->GetNumberOfCells());
     for (shapeTriangles->InitTraversal(); shapeTriangles->GetNextCell(count, ids);) {
       triangles->InsertNextCell(static_cast<int>(count));
       for (vtkIdType i = 0; i < count; ++i) triangles->InsertCellPoint(offset + ids[i]);
@@ -346,13 +348,7 @@ void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, c
     rings->GetProperty()->LightingOff();
     r->AddActor(rings);
 
-    vtkCamera* camera = r->GetActiveCamera();
-    camera->ParallelProjectionOn();
-    camera->SetFocalPoint(cx, cy, 0);
-    camera->SetPosition(cx, cy, 100);
-    camera->SetViewUp(0, 1, 0);
-    camera->SetParallelScale(halfHeight);
-    camera->SetClippingRange(1, 1000);
+    fitCamera(r, extent, panelAspect);
     addScaleBar(r, cx - halfHeight * panelAspect, cy - halfHeight, 2 * halfHeight * panelAspect, 2 * halfHeight,
                 out);
     window->AddRenderer(r);
@@ -387,33 +383,22 @@ void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, c
   writeFigure(window, out, title);
 }
 
-void renderHistogram(const std::string& title, const std::string& xTitle, const std::string& yTitle,
-                     const std::vector<double>& edges, const std::vector<HistogramSeries>& series,
-                     const FigureOutput& out) {
-  checkOutput(out);
-  if (edges.size() < 2) throw usageError(out.png + ": a histogram needs at least one bin");
+void fillHistogramChart(vtkChartXY* chart, const std::string& title, const std::string& xTitle,
+                        const std::string& yTitle, const std::vector<double>& edges,
+                        const std::vector<HistogramSeries>& series, int height) {
+  FigureOutput size;
+  size.height = height;
   const std::size_t bins = edges.size() - 1;
   int highest = 1;
   for (const HistogramSeries& s : series) {
-    if (s.counts.size() != bins) {
-      throw usageError(out.png + ": series '" + s.label + "' has " + std::to_string(s.counts.size()) +
-                       " counts for " + std::to_string(bins) + " bins");
-    }
     for (int c : s.counts) highest = std::max(highest, c);
   }
-  const auto window = offscreenWindow(out);
-  vtkNew<vtkContextView> view;
-  view->SetRenderWindow(window);
-  view->GetRenderer()->SetBackground(1, 1, 1);
-  vtkNew<vtkChartXY> chart;
-  view->GetScene()->AddItem(chart);
+  chart->ClearPlots();
   chart->SetTitle(title);
-  styleText(chart->GetTitleProperties(), fontSize(out, 0.034), true);
-
-  std::vector<vtkSmartPointer<vtkTable>> tables;
+  styleText(chart->GetTitleProperties(), fontSize(size, 0.034), true);
   for (const HistogramSeries& s : series) {
     // Step outline: up at each left edge, across the bin, down at the last edge.
-    auto table = vtkSmartPointer<vtkTable>::New();
+    vtkNew<vtkTable> table;
     for (const char* name : {"x", "zero", "count"}) {
       vtkNew<vtkDoubleArray> column;
       column->SetName(name);
@@ -433,7 +418,6 @@ void renderHistogram(const std::string& title, const std::string& xTitle, const 
       put(edges[k + 1], s.counts[k]);
     }
     put(edges.back(), 0);
-    tables.push_back(table);
 
     auto* area = vtkPlotArea::SafeDownCast(chart->AddPlot(vtkChart::AREA));
     area->SetInputData(table);
@@ -463,15 +447,165 @@ void renderHistogram(const std::string& title, const std::string& xTitle, const 
   y->SetNotation(vtkAxis::FIXED_NOTATION);
   y->SetPrecision(0);
   for (vtkAxis* a : {x, y}) {
-    styleText(a->GetTitleProperties(), fontSize(out, 0.028), true);
-    styleText(a->GetLabelProperties(), fontSize(out, 0.022));
+    styleText(a->GetTitleProperties(), fontSize(size, 0.028), true);
+    styleText(a->GetLabelProperties(), fontSize(size, 0.022));
     a->GetGridPen()->SetColorF(0.88, 0.88, 0.88);
   }
   chart->SetShowLegend(true);
-  chart->GetLegend()->SetLabelSize(fontSize(out, 0.026));
+  chart->GetLegend()->SetLabelSize(fontSize(size, 0.026));
   chart->GetLegend()->SetHorizontalAlignment(vtkChartLegend::RIGHT);
   chart->GetLegend()->SetVerticalAlignment(vtkChartLegend::TOP);
+}
+
+void renderHistogram(const std::string& title, const std::string& xTitle, const std::string& yTitle,
+                     const std::vector<double>& edges, const std::vector<HistogramSeries>& series,
+                     const FigureOutput& out) {
+  checkOutput(out);
+  if (edges.size() < 2) throw usageError(out.png + ": a histogram needs at least one bin");
+  const std::size_t bins = edges.size() - 1;
+  for (const HistogramSeries& s : series) {
+    if (s.counts.size() != bins) {
+      throw usageError(out.png + ": series '" + s.label + "' has " + std::to_string(s.counts.size()) +
+                       " counts for " + std::to_string(bins) + " bins");
+    }
+  }
+  const auto window = offscreenWindow(out);
+  vtkNew<vtkContextView> view;
+  view->SetRenderWindow(window);
+  view->GetRenderer()->SetBackground(1, 1, 1);
+  vtkNew<vtkChartXY> chart;
+  view->GetScene()->AddItem(chart);
+  fillHistogramChart(chart, title, xTitle, yTitle, edges, series, out.height);
   writeFigure(window, out, title);
+}
+
+// Interactive pieces (Scenes.h).
+
+struct MapLayer::Impl {
+  PanelGeometry geometry;
+  vtkNew<vtkPolyDataMapper> fillMapper, ringMapper;
+  vtkNew<vtkActor> fill, rings;
+  vtkSmartPointer<vtkLookupTable> lut = lookupTable(ColourScale{});
+  vtkNew<vtkScalarBarActor> bar;
+  std::vector<vtkIdType> trianglesPerShape;
+};
+
+MapLayer::MapLayer() : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.fillMapper->SetInputData(m.geometry.fill);
+  m.fillMapper->SetScalarModeToUseCellData();
+  m.fillMapper->UseLookupTableScalarRangeOn();
+  m.fillMapper->ScalarVisibilityOn();
+  m.fillMapper->SetLookupTable(m.lut);
+  m.fill->SetMapper(m.fillMapper);
+  m.fill->GetProperty()->LightingOff();
+  m.ringMapper->SetInputData(m.geometry.rings);
+  m.ringMapper->ScalarVisibilityOff();
+  m.rings->SetMapper(m.ringMapper);
+  m.rings->SetPosition(0, 0, 1);
+  m.rings->GetProperty()->SetColor(0.45, 0.45, 0.45);
+  m.rings->GetProperty()->LightingOff();
+  m.bar->SetLookupTable(m.lut);
+  m.bar->SetOrientationToHorizontal();
+  m.bar->SetNumberOfLabels(5);
+  m.bar->SetLabelFormat("%.3g");
+  m.bar->UnconstrainedFontSizeOn();
+  styleText(m.bar->GetLabelTextProperty(), 11);
+  styleText(m.bar->GetTitleTextProperty(), 12);
+  m.bar->SetTextPositionToPrecedeScalarBar();
+}
+
+MapLayer::~MapLayer() = default;
+
+void MapLayer::setShapes(const std::vector<const Polygon*>& shapes, const std::vector<double>& values) {
+  if (shapes.size() != values.size()) {
+    throw usageError("map layer: " + std::to_string(shapes.size()) + " shapes but " + std::to_string(values.size()) +
+                     " values");
+  }
+  MapPanel panel;
+  panel.shapes = shapes;
+  panel.values = values;
+  PanelGeometry fresh;
+  impl_->trianglesPerShape.clear();
+  buildPanel(panel, fresh, &impl_->trianglesPerShape);
+  impl_->geometry.fill->ShallowCopy(fresh.fill);
+  impl_->geometry.rings->ShallowCopy(fresh.rings);
+}
+
+void MapLayer::setValues(const std::vector<double>& values) {
+  if (values.size() != impl_->trianglesPerShape.size()) {
+    throw usageError("map layer: " + std::to_string(impl_->trianglesPerShape.size()) + " shapes but " +
+                     std::to_string(values.size()) + " values");
+  }
+  vtkNew<vtkDoubleArray> scalars;
+  scalars->SetName("value");
+  vtkIdType total = 0;
+  for (vtkIdType n : impl_->trianglesPerShape) total += n;
+  scalars->SetNumberOfValues(total);
+  vtkIdType next = 0;
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    for (vtkIdType t = 0; t < impl_->trianglesPerShape[k]; ++t) scalars->SetValue(next++, values[k]);
+  }
+  impl_->geometry.fill->GetCellData()->SetScalars(scalars);
+  impl_->geometry.fill->Modified();
+}
+
+void MapLayer::setScale(const ColourScale& scale) {
+  const auto lut = lookupTable(scale);
+  impl_->lut->DeepCopy(lut);
+  impl_->lut->Modified();
+  impl_->bar->SetTitle(scale.title.c_str());
+  impl_->fillMapper->Modified();
+}
+
+void MapLayer::addTo(vtkRenderer* renderer) {
+  renderer->AddActor(impl_->fill);
+  renderer->AddActor(impl_->rings);
+}
+
+vtkScalarBarActor* MapLayer::colourBar() { return impl_->bar; }
+
+struct OutlineLayer::Impl {
+  vtkNew<vtkPolyData> rings;
+  vtkNew<vtkPolyDataMapper> mapper;
+  vtkNew<vtkActor> actor;
+};
+
+OutlineLayer::OutlineLayer() : impl_(std::make_unique<Impl>()) {
+  impl_->mapper->SetInputData(impl_->rings);
+  impl_->mapper->ScalarVisibilityOff();
+  impl_->actor->SetMapper(impl_->mapper);
+  impl_->actor->SetPosition(0, 0, 2);
+  impl_->actor->GetProperty()->SetColor(0.05, 0.35, 0.95);
+  impl_->actor->GetProperty()->SetLineWidth(4.0f);
+  impl_->actor->GetProperty()->LightingOff();
+}
+
+OutlineLayer::~OutlineLayer() = default;
+
+void OutlineLayer::setShapes(const std::vector<const Polygon*>& shapes) {
+  MapPanel panel;
+  panel.shapes = shapes;
+  panel.values.assign(shapes.size(), 0.0);
+  PanelGeometry fresh;
+  buildPanel(panel, fresh);
+  impl_->rings->ShallowCopy(fresh.rings);
+}
+
+void OutlineLayer::addTo(vtkRenderer* renderer) { renderer->AddActor(impl_->actor); }
+
+void fitCamera(vtkRenderer* renderer, const Box& extent, double viewAspect) {
+  const double margin = 0.03 * std::max(extent.width(), extent.height());
+  const double halfHeight = std::max(0.5 * extent.height() + margin,
+                                     (0.5 * extent.width() + margin) / std::max(1e-3, viewAspect));
+  const double cx = 0.5 * (extent.minX + extent.maxX), cy = 0.5 * (extent.minY + extent.maxY);
+  vtkCamera* camera = renderer->GetActiveCamera();
+  camera->ParallelProjectionOn();
+  camera->SetFocalPoint(cx, cy, 0);
+  camera->SetPosition(cx, cy, 100);
+  camera->SetViewUp(0, 1, 0);
+  camera->SetParallelScale(halfHeight);
+  camera->SetClippingRange(1, 1000);
 }
 
 }  // namespace parcelscope::viz

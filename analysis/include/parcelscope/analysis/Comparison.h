@@ -86,6 +86,20 @@ const char* metricUnit(ComparedMetric m);
 /// The finite values of metric `m` over `metrics`.
 std::vector<double> metricSample(const std::vector<ParcelMetrics>& metrics, ComparedMetric m);
 
+/// A per-parcel quantity a map can be coloured by and a histogram drawn of (the
+/// GUI's colour choices, compare's --metric).
+struct ParcelQuantity {
+  std::string name;   ///< aspect_ratio, area, width, neighbours, street_access, p_angle, p_area
+  std::string title;  ///< for people, with the unit, e.g. "area (m²)"
+  double (*value)(const ParcelMetrics&);
+};
+/// Every ParcelQuantity, aspect_ratio (the paper's colour map) first.
+const std::vector<ParcelQuantity>& parcelQuantities();
+/// The quantity called `name`; throws Error(Usage) listing the names otherwise.
+const ParcelQuantity& parcelQuantity(const std::string& name);
+/// The finite values of `q` over `metrics`.
+std::vector<double> quantitySample(const std::vector<ParcelMetrics>& metrics, const ParcelQuantity& q);
+
 struct Comparison {
   SetSummary observed, generated;
   Distances area, width, aspectRatio;

@@ -81,6 +81,10 @@ struct ObservedAnalysis {
 ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const AnalysisOptions& options,
                                 const ProgressFn& progress = {});
 
+/// Derives every block's statistics and bounds again with another k; the
+/// blocks, metrics, block areas and street-access shares stay as they are.
+void rederiveBlockBounds(ObservedAnalysis& analysis, double k);
+
 /// Metrics of parcels whose blocks are already known (generated parcels):
 /// shape metrics, neighbours (>= 1 m of shared boundary within `tolerance`) and
 /// frontage on the outline of their block. `blocks[b].parcels` index `shapes`.

@@ -1,6 +1,7 @@
 #pragma once
-// Minimal ordered JSON builder for run records (run.json). Keys keep their
-// insertion order so that records are easy to read and to diff.
+// Minimal ordered JSON value for run records (run.json) and session files. Keys
+// keep their insertion order so that records are easy to read and to diff.
+// Parsing lives in io (io::readJson, through GDAL's JSON parser).
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -33,6 +34,24 @@ public:
   Json& push(Json value);
 
   std::string dump(int indent = 2) const;
+
+  bool isNull() const;
+  bool isNumber() const;  ///< integer or real
+  bool isString() const;
+  bool isObject() const;
+  bool isArray() const;
+  /// The value of `key` in an object; nullptr when absent or not an object.
+  const Json* find(const std::string& key) const;
+  /// The number (integer or real); throws std::logic_error on another type.
+  double number() const;
+  /// The string; throws std::logic_error on another type.
+  const std::string& string() const;
+  /// The boolean; throws std::logic_error on another type.
+  bool boolean() const;
+  /// An object's members in order (empty for a non-object).
+  std::vector<std::pair<std::string, Json>> members() const;
+  /// An array's elements (empty for a non-array).
+  std::vector<Json> elements() const;
 
 private:
   using Object = std::vector<std::pair<std::string, Json>>;

@@ -2,7 +2,10 @@
 // The `generate` job: blocks in (a block layer, or observed parcels grouped into
 // blocks exactly as `stats` does), procedural parcels out, with the same
 // metrics as observed parcels. The command line and the GUI both call this.
+#include <cmath>
 #include <cstdint>
+#include <map>
+#include <memory>
 #include <set>
 #include <string>
 #include <vector>
@@ -41,6 +44,18 @@ Subdivision subdivideBlock(const Polygon& block, const std::string& style, const
 /// Share of observed parcels with street access at or above which `auto` picks skeleton.
 constexpr double kAutoSkeletonAccessShare = 0.9;
 
+/// One block's own style and parameters, set by the user over the run's.
+struct BlockOverride {
+  /// A style of generationStyles(); empty keeps the run's style.
+  std::string style;
+  /// Generator parameters (names of generationParameterDescriptions(), "seed"
+  /// included). They win over the block's derived bounds and the run's values.
+  ParameterValues parameters;
+};
+/// Overrides by block id (the ids of `stats` and `compare`: ObservedAnalysis block
+/// ids, or the block_id field of a block layer).
+using BlockOverrides = std::map<std::int64_t, BlockOverride>;
+
 struct GenerateRequest {
   io::ReadOptions input;
   /// The input holds observed parcels: build blocks and per-block A_min, A_max,
@@ -56,6 +71,8 @@ struct GenerateRequest {
   /// With fromParcels: the input already read and analysed with `parameters`
   /// (as `compare` does before generating); used instead of reading it again.
   const analysis::ObservedData* observed = nullptr;
+  /// Per-block style and parameters; a block id no block has is Error(Usage).
+  BlockOverrides overrides;
 };
 
 /// Parameters a block runs with: the request's values, with the per-block bounds
@@ -64,7 +81,8 @@ ObbParameters blockParameters(const GenerateRequest& request, double aMin, doubl
                               double wMax);
 
 struct GeneratedParcels {
-  io::ParcelLayer source;                 ///< the input as read (frame, CRS, cleaning report)
+  /// The input as read (frame, CRS, cleaning report), shared with the BlockInputs it came from.
+  std::shared_ptr<const io::ParcelLayer> source;
   std::vector<Block> blocks;              ///< block outlines; `parcels` index `parcels` below
   std::vector<std::int64_t> blockIds;     ///< id of each entry of `blocks` (ids repeat for multipart blocks)
   std::vector<Polygon> parcels;           ///< generated parcels, local metres
@@ -79,8 +97,62 @@ struct GeneratedParcels {
   Timings timings;                        ///< "subdivide" and "measure"
 };
 
+/// The blocks of a run before any style or parameter is chosen: each block
+/// polygon with its id, its own bounds (NaN where it has none) and the share of
+/// its observed parcels with street access (NaN when unknown). Multipart blocks
+/// give one entry per part.
+struct BlockInputs {
+  struct Entry {
+    std::int64_t blockId = -1;
+    Polygon shape;
+    double aMin = NAN, aMax = NAN, wMin = NAN, wMax = NAN;
+    double accessShare = NAN;
+  };
+  std::shared_ptr<const io::ParcelLayer> source;  ///< the input as read (frame, CRS, cleaning report)
+  std::vector<Entry> entries;
+  /// Street widths per entry (see StreetWidths), measured on first need by streetWidthsOf().
+  std::vector<StreetWidths> widths;
+};
+
+/// Reads (or takes request.observed) and lists the blocks, as generate() does.
+BlockInputs prepareBlocks(const GenerateRequest& request, const ProgressFn& progress = {});
+
+/// Street widths of every entry, measured once from the block layout and kept in `inputs`.
+const std::vector<StreetWidths>& streetWidthsOf(BlockInputs& inputs);
+
+/// How one block is subdivided: a concrete style, every parameter, its own seed.
+/// Two equal plans give the same parcels.
+struct BlockPlan {
+  std::string style;  ///< obb, skeleton or offset
+  SkeletonParameters parameters;  ///< bounds included; skeleton-only fields at their defaults for obb
+  std::uint64_t seed = 0;         ///< the block's seed (blockSeed of the run seed and the block's position)
+  bool operator==(const BlockPlan& other) const;
+  bool operator!=(const BlockPlan& other) const { return !(*this == other); }
+};
+
+/// The plan of every entry of `inputs` under `request`: auto resolved, per-block
+/// bounds clamped into range (counted in `clampedBounds`), the user's explicit
+/// values and the block overrides applied. Throws Error(Usage) on an unknown
+/// style, a bound pair out of order or an override for a block that does not exist.
+std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInputs& inputs,
+                                  std::int64_t* clampedBounds = nullptr);
+
+/// One block subdivided and its parcels measured (shape metrics, neighbours
+/// within the block, frontage on the block).
+struct BlockOutcome {
+  Subdivision subdivision;
+  std::vector<analysis::ParcelMetrics> metrics;
+};
+/// Runs `plan` on entry `entry` of `inputs` (street widths must have been measured
+/// with streetWidthsOf when the style is not obb). `minFrontage` as the analysis's.
+BlockOutcome runBlock(const BlockInputs& inputs, std::size_t entry, const BlockPlan& plan, double minFrontage);
+
+/// The run's result from one outcome per entry (in entry order).
+GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<BlockPlan>& plans,
+                                 const std::vector<const BlockOutcome*>& outcomes, std::uint64_t seed);
+
 /// Reads the input and subdivides every block (in parallel) with the request's
-/// style. Throws Error on bad input or parameters (A_min > A_max, W_min > W_max,
+/// style: prepareBlocks, planBlocks, runBlock on every entry, assembleParcels. Throws Error on bad input or parameters (A_min > A_max, W_min > W_max,
 /// unknown style).
 GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& progress = {});
 

@@ -34,4 +34,25 @@ private:
   bool committed_ = false;
 };
 
+/// One output file that appears complete or not at all: written under a hidden
+/// temporary name in the same folder (same extension, so format detection by
+/// name still works), renamed onto `target` by commit(), removed otherwise.
+class StagedFile {
+public:
+  /// Throws Error(Usage) when `target` is one of `inputs` or an existing folder.
+  StagedFile(std::string target, const std::vector<std::string>& inputs);
+  ~StagedFile();
+  StagedFile(const StagedFile&) = delete;
+  StagedFile& operator=(const StagedFile&) = delete;
+  /// The temporary name to write to.
+  const std::string& path() const { return staging_; }
+  /// Renames the written file onto the target. Throws Error(IO) on failure.
+  void commit();
+
+private:
+  std::string target_;
+  std::string staging_;
+  bool committed_ = false;
+};
+
 }  // namespace parcelscope::io

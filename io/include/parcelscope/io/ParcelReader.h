@@ -60,6 +60,10 @@ struct ParcelLayer {
   std::vector<std::vector<double>> fields;
 };
 
+/// The names of the vector layers of `path`, in order. Throws Error(Input) as
+/// readParcels when the file cannot be opened or holds no layer.
+std::vector<std::string> layerNames(const std::string& path);
+
 /// Reads, projects and cleans the polygons of one layer.
 /// Throws Error(Input) with a one-line message naming the file (and the feature
 /// or layer) when the file is missing or unreadable, the layer or the filter is

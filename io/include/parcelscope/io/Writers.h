@@ -20,7 +20,12 @@ void writeCsv(const std::string& path, const Table& table);
 /// Writes `json.dump()` followed by a newline. Throws Error(IO) on failure.
 void writeJson(const std::string& path, const Json& json);
 
-/// Writes a GeoPackage with one polygon layer. Feature i has geometry
+/// Reads a JSON file (GDAL's JSON parser). Throws Error(Input) naming the file
+/// when it is missing or not valid JSON.
+Json readJson(const std::string& path);
+
+/// Writes a GeoPackage (or GeoJSON, for a path ending in .geojson or .json)
+/// with one polygon layer. Feature i has geometry
 /// `geometries[i]` (one or more polygons, written as a MultiPolygon) and the
 /// attributes of `attributes.rows[i]`. Coordinates are mapped back from local
 /// metres with `frame` and tagged with `crs` (OGC:CRS84 when the CRS was assumed).

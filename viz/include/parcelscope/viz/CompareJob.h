@@ -4,6 +4,7 @@
 // parcels generated in every block; both sets measured with the same metrics
 // and compared block by block and city-wide; tables, layers, run records and
 // figures out. The command line and the GUI both call this.
+#include <memory>
 #include <set>
 #include <string>
 #include <utility>
@@ -14,6 +15,7 @@
 #include "parcelscope/core/Parameter.h"
 #include "parcelscope/generation/GenerateJob.h"
 #include "parcelscope/io/ParcelReader.h"
+#include "parcelscope/viz/Figures.h"
 
 namespace parcelscope::viz {
 
@@ -24,7 +26,15 @@ struct CompareRequest {
   ParameterValues parameters;
   /// Names the user set explicitly: a generator bound given here overrides the per-block ones.
   std::set<std::string> explicitParameters;
+  /// Per-block style and parameters over the run's (see generation::BlockOverride).
+  generation::BlockOverrides overrides;
+  /// A parcel quantity (analysis::parcelQuantities()) drawn as the extra figures
+  /// map_<metric> and hist_<metric> when it is not one drawn anyway.
+  std::string metric = "aspect_ratio";
 };
+
+/// The value of compare parameter `name` in `request`, or its default.
+double compareValue(const CompareRequest& request, const std::string& name);
 
 /// The comparison's own parameters: histogram bins and range, figures and their
 /// size, the aspect ratio shown fully green.
@@ -35,7 +45,8 @@ const std::vector<ParameterDescription>& comparisonParameters();
 std::vector<ParameterDescription> compareParameters();
 
 struct CompareResult {
-  analysis::ObservedData observed;
+  /// Shared between successive results of a CompareSession.
+  std::shared_ptr<const analysis::ObservedData> observed;
   generation::GeneratedParcels generated;
   /// Metrics of the observed parcels that belong to a block (right-of-way left out).
   std::vector<analysis::ParcelMetrics> observedLots;
@@ -51,6 +62,58 @@ struct CompareResult {
   std::vector<std::pair<std::string, double>> seconds;
 };
 
+/// The colour scale of parcel quantity `quantity`, shared by both sets: aspect
+/// ratio red (1:1) to green (map-aspect-ratio-max, Vanegas et al. 2012, Figure 1);
+/// street access 0 to 1; the others pale to dark from the smallest value of
+/// both sets to their pooled histogram-quantile. Throws Error(Usage) for an unknown quantity.
+ColourScale quantityScale(const CompareResult& result, const CompareRequest& request, const std::string& quantity);
+
+/// The overlaid histograms of parcel quantity `quantity` on shared bins, with
+/// titles and legend labels, as hist_<quantity> draws them. Empty edges when
+/// neither side has a finite value. Throws Error(Usage) for an unknown quantity.
+struct QuantityHistogram {
+  std::string title, xTitle, yTitle;
+  std::vector<double> edges;
+  std::vector<HistogramSeries> series;  ///< observed (red), procedural (blue)
+};
+QuantityHistogram quantityHistogram(const CompareResult& result, const CompareRequest& request,
+                                    const std::string& quantity);
+
+/// Index of the observed block that contains `p` (local metres), or -1.
+int blockAt(const CompareResult& result, const Point& p);
+
+/// The figures of `compare`, one at a time (the GUI exports what it shows with
+/// these): observed and procedural parcels side by side coloured by
+/// `quantity`; the overlaid histograms of `quantity` (observed red, procedural
+/// blue); the blocks coloured by the KS statistic of area. Throw as renderMaps.
+void renderQuantityMap(const CompareResult& result, const CompareRequest& request, const std::string& quantity,
+                       const FigureOutput& output);
+void renderQuantityHistogram(const CompareResult& result, const CompareRequest& request,
+                             const std::string& quantity, const FigureOutput& output);
+void renderBlocksMap(const CompareResult& result, const CompareRequest& request, const FigureOutput& output);
+
+/// The tables of `compare`, by file name: observed_parcels.csv,
+/// generated_parcels.csv, blocks.csv, summary.csv, distances.csv.
+std::vector<std::pair<std::string, Table>> comparisonTables(const CompareResult& result);
+
+/// The figures a result can be exported as: map_<quantity> and hist_<quantity>
+/// for every parcel quantity, and map_blocks.
+std::vector<std::string> figureNames();
+
+/// Renders figure `name` (see figureNames()) into `path`, which appears only
+/// when complete: .png for every figure; .svg or .pdf for histograms (VTK
+/// rasterises maps). `inputs` are never overwritten. Throws Error(Usage) on an
+/// unknown figure or extension, Error(IO) as renderMaps.
+void exportFigure(const CompareResult& result, const CompareRequest& request, const std::string& name,
+                  const std::string& path, int width, int height);
+/// Writes the generated parcels as compare's parcels.gpkg does, into a
+/// GeoPackage (.gpkg) or GeoJSON (.geojson, .json) file, atomically.
+void exportParcels(const CompareResult& result, const std::string& path, const std::vector<std::string>& inputs);
+/// Writes comparisonTables() into the existing folder `folder`, each file atomically.
+void exportTables(const CompareResult& result, const std::string& folder, const std::vector<std::string>& inputs);
+/// Writes sessionJson(request) into `path`, atomically.
+void exportSession(const CompareRequest& request, const std::string& path);
+
 /// Reads, analyses, generates and compares (blocks in parallel). Throws Error on
 /// bad input or parameters (an unknown style is Error(Usage)), Error(Cancelled)
 /// when `progress` asks to stop.
@@ -62,7 +125,8 @@ CompareResult compare(const CompareRequest& request, const ProgressFn& progress 
 /// observed_parcels.csv, generated_parcels.csv, blocks.csv, summary.csv,
 /// distances.csv, summary.json, run.json and, unless figures = 0, the figures in
 /// figures/ (PNG; the histograms hist_area, hist_width and hist_aspect_ratio
-/// also as SVG; the maps map_aspect_ratio and map_blocks as PNG only). Throws as compare(), and Error(IO) when
+/// also as SVG; the maps map_aspect_ratio and map_blocks as PNG only; with
+/// another request.metric also map_<metric> and hist_<metric>). Throws as compare(), and Error(IO) when
 /// figures are asked for without an X server; the output directory is then
 /// left as it was.
 analysis::JobOutcome runCompare(const CompareRequest& request, const std::string& outDir,

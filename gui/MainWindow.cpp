@@ -1,0 +1,752 @@
+#include "MainWindow.h"
+
+#include <QAction>
+#include <QApplication>
+#include <QCheckBox>
+#include <QComboBox>
+#include <QDoubleSpinBox>
+#include <QDragEnterEvent>
+#include <QDropEvent>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QFormLayout>
+#include <QGroupBox>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QInputDialog>
+#include <QLabel>
+#include <QMenuBar>
+#include <QMimeData>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QScrollArea>
+#include <QSettings>
+#include <QSplitter>
+#include <QStatusBar>
+#include <QTableWidget>
+#include <QToolBar>
+#include <QVBoxLayout>
+#include <QVTKOpenGLNativeWidget.h>
+
+#include <vtkChartXY.h>
+#include <vtkContextScene.h>
+#include <vtkContextView.h>
+#include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkRenderer.h>
+
+#include <cmath>
+
+#include "MapView.h"
+#include "ParameterPanel.h"
+#include "parcelscope/analysis/Comparison.h"
+#include "parcelscope/core/Error.h"
+#include "parcelscope/generation/GenerateJob.h"
+#include "parcelscope/io/ParcelReader.h"
+#include "parcelscope/viz/Scenes.h"
+
+namespace parcelscope::gui {
+
+namespace {
+
+// Parameters the panel shows first (the list), then every other
+// parameter of compare except the figure settings, which only exports use.
+const char* kFirst[] = {"k", "a-min", "a-max", "w-min", "w-max", "omega", "xi", "offset", "seed"};
+const char* kBounds[] = {"a-min", "a-max", "w-min", "w-max"};
+const char* kBlockParameters[] = {"a-min", "a-max", "w-min", "w-max", "omega", "offset", "seed"};
+
+std::vector<ParameterDescription> panelParameters() {
+  const auto all = viz::compareParameters();
+  std::vector<ParameterDescription> out;
+  for (const char* name : kFirst) {
+    for (const auto& d : all) {
+      if (d.name == name) out.push_back(d);
+    }
+  }
+  for (const auto& d : all) {
+    if (d.name == "figures" || d.name == "figure-width" || d.name == "figure-height") continue;
+    bool seen = false;
+    for (const auto& o : out) seen = seen || o.name == d.name;
+    if (!seen) out.push_back(d);
+  }
+  return out;
+}
+
+const ParameterDescription& describe(const std::string& name) {
+  static const auto all = viz::compareParameters();
+  for (const auto& d : all) {
+    if (d.name == name) return d;
+  }
+  throw std::logic_error("no parameter " + name);
+}
+
+bool isBound(const std::string& name) {
+  for (const char* b : kBounds) {
+    if (name == b) return true;
+  }
+  return false;
+}
+
+QString number(double v) {
+  if (std::isnan(v)) return QStringLiteral("-");
+  return QString::number(v, 'g', 5);
+}
+
+QString sampleDirectory() { return QStringLiteral(PARCELSCOPE_SAMPLE_DIR); }
+
+}  // namespace
+
+MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new SessionWorker) {
+  setWindowTitle("ParcelScope");
+  setAcceptDrops(true);
+  request_.parameters = defaultValues(viz::compareParameters());
+  request_.parameters["figures"] = 0;
+  request_.explicitParameters = {"seed"};
+
+  worker_->moveToThread(&thread_);
+  connect(&thread_, &QThread::finished, worker_, &QObject::deleteLater);
+  connect(worker_, &SessionWorker::updated, this, &MainWindow::showReport);
+  connect(worker_, &SessionWorker::failed, this, [this](const QString& message, qint64 serial) {
+    if (serial == pendingSerial_) failedOrCancelled_ = true;
+    progress_->setVisible(false);
+    cancel_->setVisible(false);
+    showError(message);
+  });
+  connect(worker_, &SessionWorker::cancelled, this, [this](qint64 serial) {
+    if (serial == pendingSerial_) {
+      failedOrCancelled_ = true;
+      progress_->setVisible(false);
+      cancel_->setVisible(false);
+      status_->setText("cancelled");
+    }
+  });
+  connect(worker_, &SessionWorker::progress, this, [this](double fraction, const QString& stage) {
+    progress_->setVisible(true);
+    cancel_->setVisible(true);
+    progress_->setValue(static_cast<int>(fraction * 100));
+    progress_->setFormat(stage + " %p%");
+  });
+  thread_.start();
+
+  // Views: observed and procedural side by side, one camera.
+  observedView_ = new MapView("Observed", false);
+  proceduralView_ = new MapView("Procedural", true);
+  proceduralView_->useCamera(observedView_->camera());
+  auto* maps = new QSplitter(Qt::Horizontal);
+  maps->addWidget(observedView_);
+  maps->addWidget(proceduralView_);
+  for (MapView* v : {observedView_, proceduralView_}) {
+    connect(v, &MapView::clicked, this, [this](double x, double y) {
+      if (result_) selectBlock(viz::blockAt(*result_, {x, y}));
+    });
+  }
+
+  // Histogram and numbers.
+  histogramWidget_ = new QVTKOpenGLNativeWidget;
+  histogramWidget_->setRenderWindow(histogramWindow_);
+  histogramWidget_->setMinimumSize(300, 220);
+  histogramView_->SetRenderWindow(histogramWindow_);
+  histogramView_->SetInteractor(histogramWidget_->interactor());
+  histogramView_->GetRenderer()->SetBackground(1, 1, 1);
+  histogramView_->GetScene()->AddItem(chart_);
+  numbers_ = new QTableWidget;
+  numbers_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  numbers_->verticalHeader()->setVisible(false);
+  numbers_->setMinimumWidth(320);
+  auto* lower = new QSplitter(Qt::Horizontal);
+  lower->addWidget(histogramWidget_);
+  lower->addWidget(numbers_);
+  lower->setStretchFactor(0, 3);
+  lower->setStretchFactor(1, 2);
+
+  auto* central = new QWidget;
+  auto* layout = new QVBoxLayout(central);
+  layout->setContentsMargins(4, 4, 4, 4);
+  errorBar_ = new QLabel;
+  errorBar_->setObjectName("errorBar");
+  errorBar_->setWordWrap(true);
+  errorBar_->setStyleSheet("QLabel { background: #fde2e1; color: #8a1414; padding: 6px; border: 1px solid #e0a0a0; }");
+  errorBar_->setVisible(false);
+  errorBar_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  layout->addWidget(errorBar_);
+  auto* vertical = new QSplitter(Qt::Vertical);
+  vertical->addWidget(maps);
+  vertical->addWidget(lower);
+  vertical->setStretchFactor(0, 3);
+  vertical->setStretchFactor(1, 2);
+  layout->addWidget(vertical, 1);
+
+  auto* outer = new QSplitter(Qt::Horizontal);
+  outer->addWidget(central);
+  outer->addWidget(buildControls());
+  outer->setStretchFactor(0, 1);
+  outer->setStretchFactor(1, 0);
+  setCentralWidget(outer);
+
+  status_ = new QLabel("Open a parcel dataset (File > Open, drag and drop, or File > Open sample)");
+  progress_ = new QProgressBar;
+  progress_->setMaximumWidth(260);
+  progress_->setVisible(false);
+  cancel_ = new QPushButton("Cancel");
+  cancel_->setVisible(false);
+  connect(cancel_, &QPushButton::clicked, this, [this] { worker_->cancel(); });
+  statusBar()->addWidget(status_, 1);
+  statusBar()->addPermanentWidget(progress_);
+  statusBar()->addPermanentWidget(cancel_);
+  buildMenus();
+  resize(1600, 1000);
+}
+
+MainWindow::~MainWindow() {
+  worker_->cancel();
+  thread_.quit();
+  thread_.wait();
+}
+
+QWidget* MainWindow::buildControls() {
+  auto* controls = new QWidget;
+  auto* v = new QVBoxLayout(controls);
+
+  auto* run = new QGroupBox("Generator");
+  auto* form = new QFormLayout(run);
+  style_ = new QComboBox;
+  style_->setObjectName("style");
+  for (const auto& [name, help] : generation::generationStyles()) {
+    style_->addItem(QString::fromStdString(name));
+    style_->setItemData(style_->count() - 1, QString::fromStdString(help), Qt::ToolTipRole);
+  }
+  connect(style_, &QComboBox::currentTextChanged, this, [this](const QString& s) { setStyle(s); });
+  form->addRow("style", style_);
+  colourBy_ = new QComboBox;
+  colourBy_->setObjectName("colourBy");
+  for (const auto& q : analysis::parcelQuantities()) {
+    colourBy_->addItem(QString::fromStdString(q.name));
+    colourBy_->setItemData(colourBy_->count() - 1, QString::fromStdString(q.title), Qt::ToolTipRole);
+  }
+  connect(colourBy_, &QComboBox::currentTextChanged, this, [this](const QString& q) { setColourBy(q); });
+  form->addRow("colour by", colourBy_);
+  perBlockBounds_ = new QCheckBox("per-block bounds (A-bar -/+ k s_A, W-bar -/+ k s_W)");
+  perBlockBounds_->setChecked(true);
+  perBlockBounds_->setToolTip("Each block's A_min, A_max, W_min, W_max come from its observed parcels; "
+                              "moving one of those sliders sets it for every block instead");
+  connect(perBlockBounds_, &QCheckBox::toggled, this, [this](bool on) {
+    for (const char* b : kBounds) {
+      if (on) {
+        request_.explicitParameters.erase(b);
+      } else {
+        request_.explicitParameters.insert(b);
+      }
+    }
+    submit();
+  });
+  form->addRow(perBlockBounds_);
+  v->addWidget(run);
+
+  panel_ = new ParameterPanel(panelParameters());
+  panel_->setValues(request_.parameters);
+  connect(panel_, &ParameterPanel::changed, this,
+          [this](const QString& name, double value) { setParameter(name.toStdString(), value); });
+  auto* scroll = new QScrollArea;
+  scroll->setWidget(panel_);
+  scroll->setWidgetResizable(true);
+  scroll->setMinimumWidth(440);
+  v->addWidget(scroll, 1);
+
+  auto* block = new QGroupBox("Block");
+  auto* b = new QVBoxLayout(block);
+  blockInfo_ = new QLabel("Click a block in either view.");
+  blockInfo_->setObjectName("blockInfo");
+  blockInfo_->setWordWrap(true);
+  blockInfo_->setTextFormat(Qt::RichText);
+  b->addWidget(blockInfo_);
+  auto* overrides = new QFormLayout;
+  blockStyle_ = new QComboBox;
+  blockStyle_->addItem("(run's style)");
+  for (const auto& [name, help] : generation::generationStyles()) blockStyle_->addItem(QString::fromStdString(name));
+  overrides->addRow("style", blockStyle_);
+  for (const char* name : kBlockParameters) {
+    const ParameterDescription& d = describe(name);
+    auto* check = new QCheckBox(QString::fromStdString(d.name));
+    auto* spin = new QDoubleSpinBox;
+    spin->setRange(d.minimum, d.maximum);
+    spin->setDecimals(d.integer ? 0 : 2);
+    spin->setValue(d.defaultValue);
+    spin->setEnabled(false);
+    connect(check, &QCheckBox::toggled, spin, &QWidget::setEnabled);
+    overrides->addRow(check, spin);
+    blockParameters_[name] = {check, spin};
+  }
+  b->addLayout(overrides);
+  auto* buttons = new QHBoxLayout;
+  auto* apply = new QPushButton("Override block");
+  auto* clear = new QPushButton("Clear override");
+  connect(apply, &QPushButton::clicked, this, [this] {
+    ParameterValues values;
+    for (const auto& [name, widgets] : blockParameters_) {
+      if (widgets.first->isChecked()) values[name] = widgets.second->value();
+    }
+    overrideSelectedBlock(blockStyle_->currentIndex() == 0 ? QString() : blockStyle_->currentText(), values);
+  });
+  connect(clear, &QPushButton::clicked, this, [this] { clearSelectedOverride(); });
+  buttons->addWidget(apply);
+  buttons->addWidget(clear);
+  b->addLayout(buttons);
+  v->addWidget(block);
+  return controls;
+}
+
+void MainWindow::buildMenus() {
+  QMenu* file = menuBar()->addMenu("&File");
+  file->addAction("&Open...", this, [this] {
+    const QString path = QFileDialog::getOpenFileName(
+        this, "Open parcels", {}, "Parcel data (*.gpkg *.geojson *.json *.topojson *.shp *.fgb);;All files (*)");
+    if (!path.isEmpty()) openFile(path);
+  }, QKeySequence::Open);
+  file->addAction("Open &sample", this, [this] { openSample(); });
+  recentMenu_ = file->addMenu("Open &recent");
+  refreshRecent();
+  file->addAction("Set input &CRS...", this, [this] {
+    bool ok = false;
+    const QString crs = QInputDialog::getText(this, "Input CRS", "CRS of the input (e.g. EPSG:2249), empty: as declared",
+                                              QLineEdit::Normal, QString::fromStdString(request_.input.crsOverride), &ok);
+    if (ok && loaded_) openFile(QString::fromStdString(request_.input.path), QString::fromStdString(request_.input.layer),
+                                QString::fromStdString(request_.input.where), crs);
+  });
+  file->addSeparator();
+  file->addAction("Open session...", this, [this] {
+    const QString path = QFileDialog::getOpenFileName(this, "Open session", {}, "ParcelScope session (*.json)");
+    if (!path.isEmpty()) openSession(path);
+  });
+  file->addAction("Save session...", this, [this] {
+    const QString path = QFileDialog::getSaveFileName(this, "Save session", "session.json", "ParcelScope session (*.json)");
+    if (!path.isEmpty()) saveSession(path);
+  });
+  file->addSeparator();
+  QMenu* exports = file->addMenu("&Export");
+  exports->addAction("Figure...", this, [this] { exportFigureDialog(); });
+  exports->addAction("Tables (CSV)...", this, [this] {
+    const QString folder = QFileDialog::getExistingDirectory(this, "Export tables into folder");
+    if (!folder.isEmpty()) exportTables(folder);
+  });
+  exports->addAction("Generated parcels...", this, [this] {
+    const QString path = QFileDialog::getSaveFileName(this, "Export generated parcels", "parcels.gpkg",
+                                                      "GeoPackage (*.gpkg);;GeoJSON (*.geojson)");
+    if (!path.isEmpty()) exportParcels(path);
+  });
+  file->addSeparator();
+  file->addAction("&Quit", this, &QWidget::close, QKeySequence::Quit);
+  QToolBar* bar = addToolBar("Main");
+  bar->setObjectName("mainToolBar");
+  bar->addAction("Open sample", this, [this] { openSample(); });
+}
+
+void MainWindow::openFile(const QString& path, const QString& layer, const QString& where, const QString& crs) {
+  viz::CompareRequest next = request_;
+  next.input = {};
+  next.input.path = path.toStdString();
+  next.input.where = where.toStdString();
+  next.input.crsOverride = crs.toStdString();
+  next.input.layer = layer.toStdString();
+  next.overrides.clear();
+  if (layer.isEmpty()) {
+    try {
+      const auto names = io::layerNames(next.input.path);
+      if (names.size() > 1) {
+        QStringList items;
+        for (const auto& n : names) items << QString::fromStdString(n);
+        bool ok = false;
+        const QString chosen = QInputDialog::getItem(this, "Layer", QFileInfo(path).fileName() + " holds several layers:",
+                                                     items, 0, false, &ok);
+        if (!ok) return;
+        next.input.layer = chosen.toStdString();
+      }
+    } catch (const Error& e) {
+      showError(e.what());
+      return;
+    }
+  }
+  request_ = next;
+  selected_ = -1;
+  loaded_ = true;
+  rememberRecent(path);
+  setWindowTitle("ParcelScope - " + QFileInfo(path).fileName());
+  submit();
+}
+
+void MainWindow::openSample() {
+  openFile(sampleDirectory() + "/sample_town.geojson", {}, "use <> 'ROW'");
+}
+
+void MainWindow::openSession(const QString& path) {
+  try {
+    viz::CompareRequest next = viz::readSession(path.toStdString());
+    next.parameters["figures"] = 0;
+    request_ = next;
+  } catch (const Error& e) {
+    showError(e.what());
+    return;
+  }
+  loaded_ = true;
+  selected_ = -1;
+  {
+    const QSignalBlocker a(style_), b(colourBy_), c(perBlockBounds_);
+    style_->setCurrentText(QString::fromStdString(request_.style));
+    colourBy_->setCurrentText(QString::fromStdString(request_.metric));
+    bool perBlock = true;
+    for (const char* bound : kBounds) perBlock = perBlock && !request_.explicitParameters.count(bound);
+    perBlockBounds_->setChecked(perBlock);
+  }
+  panel_->setValues(request_.parameters);
+  setWindowTitle("ParcelScope - " + QFileInfo(QString::fromStdString(request_.input.path)).fileName());
+  submit();
+}
+
+void MainWindow::saveSession(const QString& path) {
+  try {
+    viz::exportSession(request_, path.toStdString());
+    status_->setText("session saved to " + path);
+  } catch (const Error& e) {
+    showError(e.what());
+  }
+}
+
+void MainWindow::exportFigure(const QString& name, const QString& path, int width, int height) {
+  if (!result_) return showError("nothing to export yet: open a dataset first");
+  try {
+    viz::exportFigure(*result_, request_, name.toStdString(), path.toStdString(), width, height);
+    status_->setText(name + " exported to " + path);
+  } catch (const Error& e) {
+    showError(e.what());
+  }
+}
+
+void MainWindow::exportTables(const QString& folder) {
+  if (!result_) return showError("nothing to export yet: open a dataset first");
+  try {
+    viz::exportTables(*result_, folder.toStdString(), {request_.input.path});
+    status_->setText("tables exported to " + folder);
+  } catch (const Error& e) {
+    showError(e.what());
+  }
+}
+
+void MainWindow::exportParcels(const QString& path) {
+  if (!result_) return showError("nothing to export yet: open a dataset first");
+  try {
+    viz::exportParcels(*result_, path.toStdString(), {request_.input.path});
+    status_->setText("generated parcels exported to " + path);
+  } catch (const Error& e) {
+    showError(e.what());
+  }
+}
+
+void MainWindow::exportFigureDialog() {
+  const QString metric = QString::fromStdString(request_.metric);
+  const QStringList items = {"map_" + metric, "hist_" + metric, "map_blocks"};
+  bool ok = false;
+  const QString name = QInputDialog::getItem(this, "Export figure", "Figure:", items, 0, false, &ok);
+  if (!ok) return;
+  const QString filter = name.startsWith("hist_") ? "PNG (*.png);;SVG (*.svg);;PDF (*.pdf)" : "PNG (*.png)";
+  const QString path = QFileDialog::getSaveFileName(this, "Export figure", name + ".png", filter);
+  if (!path.isEmpty()) exportFigure(name, path);
+}
+
+void MainWindow::setParameter(const std::string& name, double value) {
+  request_.parameters[name] = value;
+  request_.explicitParameters.insert(name);
+  if (isBound(name) && perBlockBounds_->isChecked()) {
+    const QSignalBlocker block(perBlockBounds_);
+    perBlockBounds_->setChecked(false);
+    for (const char* b : kBounds) request_.explicitParameters.insert(b);
+  }
+  {
+    ParameterValues shown;
+    shown[name] = value;
+    panel_->setValues(shown);
+  }
+  submit();
+}
+
+void MainWindow::setStyle(const QString& style) {
+  request_.style = style.toStdString();
+  if (style_->currentText() != style) {
+    const QSignalBlocker block(style_);
+    style_->setCurrentText(style);
+  }
+  submit();
+}
+
+void MainWindow::setColourBy(const QString& quantity) {
+  request_.metric = quantity.toStdString();
+  if (colourBy_->currentText() != quantity) {
+    const QSignalBlocker block(colourBy_);
+    colourBy_->setCurrentText(quantity);
+  }
+  if (!result_) return;
+  QElapsedTimer t;
+  t.start();
+  recolour();
+  drawHistogram();
+  observedView_->render();
+  proceduralView_->render();
+  lastLatencyMs_ = static_cast<double>(t.nsecsElapsed()) / 1e6;
+  emit viewsUpdated(shownSerial_);
+}
+
+void MainWindow::selectBlock(int block) {
+  selected_ = block;
+  showBlock();
+  observedView_->render();
+  proceduralView_->render();
+}
+
+void MainWindow::overrideSelectedBlock(const QString& style, const ParameterValues& parameters) {
+  if (!result_ || selected_ < 0) return showError("select a block first (click it in either view)");
+  generation::BlockOverride o;
+  o.style = style.toStdString();
+  o.parameters = parameters;
+  request_.overrides[result_->observed->analysis.blocks[selected_].id] = o;
+  submit();
+}
+
+void MainWindow::clearSelectedOverride() {
+  if (!result_ || selected_ < 0) return;
+  request_.overrides.erase(result_->observed->analysis.blocks[selected_].id);
+  submit();
+}
+
+void MainWindow::submit() {
+  if (!loaded_) return;
+  errorBar_->setVisible(false);
+  failedOrCancelled_ = false;
+  pendingSerial_ = worker_->submit(request_);
+  started_[pendingSerial_].start();
+  status_->setText("updating...");
+}
+
+void MainWindow::showReport(const UpdateReport& report) {
+  const bool first = !result_ || report.reloaded;
+  result_ = report.result;
+  shownSerial_ = report.serial;
+  progress_->setVisible(false);
+  cancel_->setVisible(false);
+  const viz::CompareResult& r = *result_;
+  if (first) selected_ = -1;
+
+  // Geometry: the observed parcels only when the input was read again.
+  const analysis::ObservedAnalysis& a = r.observed->analysis;
+  const analysis::ParcelQuantity& q = analysis::parcelQuantity(request_.metric);
+  if (first) {
+    std::vector<const Polygon*> shapes;
+    std::vector<double> values;
+    for (std::size_t i = 0; i < r.observed->layer.parcels.size(); ++i) {
+      if (a.blockOf[i] < 0) continue;
+      shapes.push_back(&r.observed->layer.parcels[i].shape);
+      values.push_back(q.value(a.metrics[i]));
+    }
+    observedView_->layer().setShapes(shapes, values);
+  }
+  {
+    std::vector<const Polygon*> shapes;
+    std::vector<double> values;
+    for (std::size_t i = 0; i < r.generated.parcels.size(); ++i) {
+      shapes.push_back(&r.generated.parcels[i]);
+      values.push_back(q.value(r.generated.metrics[i]));
+    }
+    proceduralView_->layer().setShapes(shapes, values);
+  }
+  recolour();
+  if (first) {
+    Box extent{1e300, 1e300, -1e300, -1e300};
+    for (const Block& b : a.blocks) {
+      for (const Polygon& part : b.parts) {
+        const Box x = bounds(part);
+        extent = {std::min(extent.minX, x.minX), std::min(extent.minY, x.minY), std::max(extent.maxX, x.maxX),
+                  std::max(extent.maxY, x.maxY)};
+      }
+    }
+    observedView_->fit(extent);
+  }
+  drawHistogram();
+  fillNumbers();
+  showBlock();
+  observedView_->render();
+  proceduralView_->render();
+
+  const auto it = started_.find(report.serial);
+  if (it != started_.end()) {
+    lastLatencyMs_ = static_cast<double>(it->second.nsecsElapsed()) / 1e6;
+    started_.erase(started_.begin(), std::next(it));
+  }
+  status_->setText(QString("%1 blocks, %2 observed and %3 procedural parcels; %4 of %5 block parts regenerated; %6 ms")
+                       .arg(a.blocks.size())
+                       .arg(r.observedLots.size())
+                       .arg(r.generated.parcels.size())
+                       .arg(report.blocksRegenerated)
+                       .arg(report.blocksTotal)
+                       .arg(lastLatencyMs_, 0, 'f', 0));
+  if (!r.generated.failures.empty()) {
+    status_->setToolTip(QString::fromStdString(std::to_string(r.generated.failures.size()) + " blocks fell back or "
+                                               "were refused; first: " + r.generated.failures.front()));
+  }
+  emit viewsUpdated(report.serial);
+}
+
+void MainWindow::recolour() {
+  if (!result_) return;
+  const viz::CompareResult& r = *result_;
+  const analysis::ParcelQuantity& q = analysis::parcelQuantity(request_.metric);
+  std::vector<double> observed, generated;
+  for (std::size_t i = 0; i < r.observed->layer.parcels.size(); ++i) {
+    if (r.observed->analysis.blockOf[i] >= 0) observed.push_back(q.value(r.observed->analysis.metrics[i]));
+  }
+  for (const auto& m : r.generated.metrics) generated.push_back(q.value(m));
+  observedView_->layer().setValues(observed);
+  proceduralView_->layer().setValues(generated);
+  const viz::ColourScale scale = viz::quantityScale(r, request_, request_.metric);
+  observedView_->layer().setScale(scale);
+  proceduralView_->layer().setScale(scale);
+  observedView_->setTitle(QString("Observed: %1 parcels").arg(observed.size()));
+  proceduralView_->setTitle(QString("Procedural (%1, seed %2): %3 parcels")
+                                .arg(QString::fromStdString(request_.style))
+                                .arg(r.generated.seed)
+                                .arg(generated.size()));
+}
+
+void MainWindow::drawHistogram() {
+  const viz::QuantityHistogram h = viz::quantityHistogram(*result_, request_, request_.metric);
+  histogramCounts_.clear();
+  if (h.edges.empty()) {
+    chart_->ClearPlots();
+    chart_->SetTitle("no finite value to draw");
+  } else {
+    viz::fillHistogramChart(chart_, h.title, h.xTitle, h.yTitle, h.edges, h.series,
+                            std::max(360, histogramWidget_->height()));
+    for (const auto& s : h.series) histogramCounts_.push_back(s.counts);
+  }
+  histogramWindow_->Render();
+}
+
+QString MainWindow::histogramTitle() const { return QString::fromStdString(chart_->GetTitle()); }
+
+void MainWindow::fillNumbers() {
+  const Table summary = analysis::summaryTable(result_->city);
+  const Table distances = analysis::distanceTable(result_->city);
+  const auto text = [](const Value& v) -> QString {
+    if (const auto* d = std::get_if<double>(&v)) return number(*d);
+    if (const auto* i = std::get_if<std::int64_t>(&v)) return QString::number(*i);
+    return QString::fromStdString(std::get<std::string>(v));
+  };
+  const int rows = static_cast<int>(summary.rows.size() + distances.rows.size());
+  const int columns = static_cast<int>(std::max(summary.columns.size(), distances.columns.size()));
+  numbers_->clear();
+  numbers_->setRowCount(rows + 1);
+  numbers_->setColumnCount(columns);
+  QStringList header;
+  for (const auto& c : summary.columns) header << QString::fromStdString(c.name);
+  numbers_->setHorizontalHeaderLabels(header);
+  int row = 0;
+  for (const auto& r : summary.rows) {
+    for (std::size_t c = 0; c < r.size(); ++c) numbers_->setItem(row, static_cast<int>(c), new QTableWidgetItem(text(r[c])));
+    ++row;
+  }
+  for (std::size_t c = 0; c < distances.columns.size(); ++c) {
+    auto* item = new QTableWidgetItem(QString::fromStdString(distances.columns[c].name));
+    QFont f = item->font();
+    f.setBold(true);
+    item->setFont(f);
+    numbers_->setItem(row, static_cast<int>(c), item);
+  }
+  ++row;
+  for (const auto& r : distances.rows) {
+    for (std::size_t c = 0; c < r.size(); ++c) numbers_->setItem(row, static_cast<int>(c), new QTableWidgetItem(text(r[c])));
+    ++row;
+  }
+  numbers_->resizeColumnsToContents();
+}
+
+void MainWindow::showBlock() {
+  std::vector<const Polygon*> outline;
+  if (!result_ || selected_ < 0) {
+    observedView_->outline().setShapes(outline);
+    proceduralView_->outline().setShapes(outline);
+    blockInfo_->setText("Click a block in either view.");
+    return;
+  }
+  const viz::CompareResult& r = *result_;
+  const Block& block = r.observed->analysis.blocks[selected_];
+  for (const Polygon& part : block.parts) outline.push_back(&part);
+  observedView_->outline().setShapes(outline);
+  proceduralView_->outline().setShapes(outline);
+  const analysis::BlockStatistics& s = r.observed->analysis.statistics[selected_];
+  const analysis::Comparison& c = r.blocks[selected_].comparison;
+  QString styles;
+  for (std::size_t k = 0; k < r.generated.blockIds.size(); ++k) {
+    if (r.generated.blockIds[k] == block.id && !styles.contains(QString::fromStdString(r.generated.blockStyles[k]))) {
+      styles += (styles.isEmpty() ? "" : ", ") + QString::fromStdString(r.generated.blockStyles[k]);
+    }
+  }
+  const bool overridden = request_.overrides.count(block.id) > 0;
+  blockInfo_->setText(
+      QString("<b>Block %1</b> (%2 m&sup2;; subdivided with %3%4)<br>"
+              "<table cellspacing=4><tr><th></th><th>observed</th><th>procedural</th></tr>"
+              "<tr><td>parcels</td><td>%5</td><td>%6</td></tr>"
+              "<tr><td>A-bar, s_A (m&sup2;)</td><td>%7, %8</td><td>%9, %10</td></tr>"
+              "<tr><td>W-bar, s_W (m)</td><td>%11, %12</td><td>%13, %14</td></tr></table>"
+              "derived A_min %15, A_max %16 m&sup2;; W_min %17, W_max %18 m; street access %19; KS area %20")
+          .arg(block.id)
+          .arg(number(s.blockArea))
+          .arg(styles)
+          .arg(overridden ? ", overridden" : "")
+          .arg(c.observed.parcels)
+          .arg(c.generated.parcels)
+          .arg(number(c.observed.meanArea), number(c.observed.sdArea), number(c.generated.meanArea),
+               number(c.generated.sdArea), number(c.observed.meanWidth), number(c.observed.sdWidth),
+               number(c.generated.meanWidth))
+          .arg(number(c.generated.sdWidth), number(s.aMin), number(s.aMax), number(s.wMin), number(s.wMax),
+               number(s.streetAccessShare), number(c.area.ks)));
+}
+
+QString MainWindow::lastError() const { return errorBar_->isVisible() ? errorBar_->text() : QString(); }
+
+void MainWindow::showError(const QString& message) {
+  errorBar_->setText(message);
+  errorBar_->setVisible(true);
+  status_->setText("error");
+  emit errorShown(message);
+}
+
+void MainWindow::dragEnterEvent(QDragEnterEvent* event) {
+  if (event->mimeData()->hasUrls()) event->acceptProposedAction();
+}
+
+void MainWindow::dropEvent(QDropEvent* event) {
+  const auto urls = event->mimeData()->urls();
+  if (urls.isEmpty() || !urls.front().isLocalFile()) return;
+  const QString path = urls.front().toLocalFile();
+  if (path.endsWith(".json") && path.contains("session")) {
+    openSession(path);
+  } else {
+    openFile(path);
+  }
+}
+
+void MainWindow::rememberRecent(const QString& path) {
+  QSettings settings("ParcelScope", "parcelscope-gui");
+  QStringList recent = settings.value("recent").toStringList();
+  recent.removeAll(path);
+  recent.prepend(path);
+  while (recent.size() > 8) recent.removeLast();
+  settings.setValue("recent", recent);
+  refreshRecent();
+}
+
+void MainWindow::refreshRecent() {
+  recentMenu_->clear();
+  QSettings settings("ParcelScope", "parcelscope-gui");
+  for (const QString& path : settings.value("recent").toStringList()) {
+    recentMenu_->addAction(path, this, [this, path] { openFile(path); });
+  }
+  recentMenu_->setEnabled(!recentMenu_->isEmpty());
+}
+
+}  // namespace parcelscope::gui

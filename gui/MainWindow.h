@@ -1,0 +1,140 @@
+#pragma once
+// The ParcelScope window: observed and procedural parcels side by side with
+// linked cameras, overlaid histograms and the comparison numbers, a parameter
+// panel and a block panel. Every change builds a viz::CompareRequest and hands
+// it to a SessionWorker, which calls the same library code as `parcelscope
+// compare`; this class only gathers input and shows results.
+#include <QElapsedTimer>
+#include <QMainWindow>
+#include <QString>
+#include <QThread>
+
+#include <map>
+#include <memory>
+
+#include <vtkNew.h>
+
+#include "SessionWorker.h"
+#include "parcelscope/viz/CompareSession.h"
+
+class QCheckBox;
+class QComboBox;
+class QDoubleSpinBox;
+class QLabel;
+class QMenu;
+class QProgressBar;
+class QPushButton;
+class QTableWidget;
+class QVTKOpenGLNativeWidget;
+class vtkChartXY;
+class vtkContextView;
+class vtkGenericOpenGLRenderWindow;
+
+namespace parcelscope::gui {
+
+class MapView;
+class ParameterPanel;
+
+class MainWindow : public QMainWindow {
+  Q_OBJECT
+public:
+  explicit MainWindow(QWidget* parent = nullptr);
+  ~MainWindow() override;
+
+  /// Opens `path` (asks for a layer when it holds several and none is given).
+  void openFile(const QString& path, const QString& layer = {}, const QString& where = {},
+                const QString& crs = {});
+  /// Opens the bundled sample.
+  void openSample();
+  /// Restores input, parameters, overrides and seed from a session file.
+  void openSession(const QString& path);
+  void saveSession(const QString& path);
+  /// Exports figure `name` (viz::figureNames()), the tables or the generated parcels.
+  void exportFigure(const QString& name, const QString& path, int width = 1800, int height = 900);
+  void exportTables(const QString& folder);
+  void exportParcels(const QString& path);
+
+  /// Sets one parameter as the user would (explicit from now on) and regenerates.
+  void setParameter(const std::string& name, double value);
+  void setStyle(const QString& style);
+  void setColourBy(const QString& quantity);
+  /// Selects the observed block with this index (-1: none).
+  void selectBlock(int block);
+  /// Overrides the selected block's style and parameters, or clears its override.
+  void overrideSelectedBlock(const QString& style, const ParameterValues& parameters);
+  void clearSelectedOverride();
+
+  const viz::CompareRequest& request() const { return request_; }
+  std::shared_ptr<const viz::CompareResult> result() const { return result_; }
+  ParameterPanel* parameterPanel() const { return panel_; }
+  MapView* observedView() const { return observedView_; }
+  MapView* proceduralView() const { return proceduralView_; }
+  QTableWidget* numbers() const { return numbers_; }
+  /// The histogram chart's title and series counts, as shown.
+  QString histogramTitle() const;
+  std::vector<std::vector<int>> histogramCounts() const { return histogramCounts_; }
+  int selectedBlock() const { return selected_; }
+  /// The message shown in the window's error bar (empty when none).
+  QString lastError() const;
+  /// Milliseconds from the last submitted change to views and histograms drawn.
+  double lastLatencyMs() const { return lastLatencyMs_; }
+  /// True while an update is queued or under way.
+  bool busy() const { return pendingSerial_ != shownSerial_ && !failedOrCancelled_; }
+
+signals:
+  /// Views, histograms and numbers show the result of request serial `serial`.
+  void viewsUpdated(qint64 serial);
+  void errorShown(const QString& message);
+
+protected:
+  void dragEnterEvent(QDragEnterEvent* event) override;
+  void dropEvent(QDropEvent* event) override;
+
+private:
+  void buildMenus();
+  QWidget* buildControls();
+  void submit();
+  void showReport(const UpdateReport& report);
+  void showError(const QString& message);
+  void recolour();
+  void drawHistogram();
+  void fillNumbers();
+  void showBlock();
+  void rememberRecent(const QString& path);
+  void refreshRecent();
+  void exportFigureDialog();
+
+  QThread thread_;
+  SessionWorker* worker_;
+  viz::CompareRequest request_;
+  std::shared_ptr<const viz::CompareResult> result_;
+  bool loaded_ = false;
+  qint64 pendingSerial_ = 0, shownSerial_ = 0;
+  bool failedOrCancelled_ = false;
+  std::map<qint64, QElapsedTimer> started_;
+  double lastLatencyMs_ = 0;
+  int selected_ = -1;
+  std::vector<std::vector<int>> histogramCounts_;
+
+  MapView* observedView_;
+  MapView* proceduralView_;
+  QVTKOpenGLNativeWidget* histogramWidget_;
+  vtkNew<vtkGenericOpenGLRenderWindow> histogramWindow_;
+  vtkNew<vtkContextView> histogramView_;
+  vtkNew<vtkChartXY> chart_;
+  QTableWidget* numbers_;
+  QLabel* errorBar_;
+  QLabel* status_;
+  QProgressBar* progress_;
+  QPushButton* cancel_;
+  QComboBox* style_;
+  QComboBox* colourBy_;
+  QCheckBox* perBlockBounds_;
+  ParameterPanel* panel_;
+  QLabel* blockInfo_;
+  QComboBox* blockStyle_;
+  std::map<std::string, std::pair<QCheckBox*, QDoubleSpinBox*>> blockParameters_;
+  QMenu* recentMenu_;
+};
+
+}  // namespace parcelscope::gui

@@ -1,0 +1,159 @@
+#include "MapView.h"
+
+#include <QLabel>
+#include <QTimer>
+#include <QVBoxLayout>
+#include <QVTKOpenGLNativeWidget.h>
+
+#include <vtkCallbackCommand.h>
+#include <vtkCamera.h>
+#include <vtkCoordinate.h>
+#include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkInteractorStyleTrackballCamera.h>
+#include <vtkObjectFactory.h>
+#include <vtkRenderWindowInteractor.h>
+#include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+
+#include <cmath>
+#include <functional>
+
+namespace parcelscope::gui {
+
+namespace {
+
+constexpr double kLegendBand = 0.14;  // of the view's height
+
+// Left drag pans, the wheel and right drag zoom, a click without movement picks.
+class PanZoomStyle : public vtkInteractorStyleTrackballCamera {
+public:
+  static PanZoomStyle* New();
+  vtkTypeMacro(PanZoomStyle, vtkInteractorStyleTrackballCamera)
+  std::function<void(int, int)> onClick;
+
+  void OnLeftButtonDown() override {
+    int* p = GetInteractor()->GetEventPosition();
+    pressX_ = p[0];
+    pressY_ = p[1];
+    FindPokedRenderer(p[0], p[1]);
+    if (!CurrentRenderer) return;
+    GrabFocus(EventCallbackCommand);
+    StartPan();
+  }
+  void OnLeftButtonUp() override {
+    if (State == VTKIS_PAN) {
+      EndPan();
+      if (Interactor) ReleaseFocus();
+    }
+    int* p = GetInteractor()->GetEventPosition();
+    if (std::abs(p[0] - pressX_) + std::abs(p[1] - pressY_) <= 3 && onClick) onClick(p[0], p[1]);
+  }
+
+private:
+  int pressX_ = 0, pressY_ = 0;
+};
+vtkStandardNewMacro(PanZoomStyle);
+
+}  // namespace
+
+MapView::MapView(const QString& title, bool withColourBar, QWidget* parent) : QWidget(parent) {
+  auto* layout = new QVBoxLayout(this);
+  layout->setContentsMargins(0, 0, 0, 0);
+  layout->setSpacing(2);
+  title_ = new QLabel(title, this);
+  title_->setAlignment(Qt::AlignCenter);
+  QFont f = title_->font();
+  f.setBold(true);
+  title_->setFont(f);
+  layout->addWidget(title_);
+  widget_ = new QVTKOpenGLNativeWidget(this);
+  widget_->setMinimumSize(240, 200);
+  widget_->setRenderWindow(window_);
+  layout->addWidget(widget_, 1);
+
+  // The map above, a legend band below (the same in both views, so that
+  // linked views show the same extent).
+  renderer_->SetBackground(1, 1, 1);
+  renderer_->SetViewport(0, kLegendBand, 1, 1);
+  legend_->SetBackground(1, 1, 1);
+  legend_->SetViewport(0, 0, 1, kLegendBand);
+  legend_->InteractiveOff();
+  window_->AddRenderer(renderer_);
+  window_->AddRenderer(legend_);
+  layer_.addTo(renderer_);
+  outline_.addTo(renderer_);
+  if (withColourBar) {
+    vtkScalarBarActor* bar = layer_.colourBar();
+    bar->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+    bar->GetPositionCoordinate()->SetValue(0.08, 0.05);
+    bar->SetWidth(0.84);
+    bar->SetHeight(0.9);
+    legend_->AddActor2D(bar);
+  } else {
+    vtkNew<vtkTextActor> hint;
+    hint->SetInput("drag: pan   wheel or right drag: zoom   click: select a block");
+    hint->GetTextProperty()->SetColor(0.35, 0.35, 0.35);
+    hint->GetTextProperty()->SetFontSize(12);
+    hint->GetTextProperty()->SetJustificationToCentered();
+    hint->GetTextProperty()->SetVerticalJustificationToCentered();
+    hint->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+    hint->GetPositionCoordinate()->SetValue(0.5, 0.5);
+    legend_->AddActor2D(hint);
+  }
+  vtkNew<PanZoomStyle> style;
+  style->onClick = [this](int x, int y) {
+    renderer_->SetDisplayPoint(x, y, 0);
+    renderer_->DisplayToWorld();
+    double w[4];
+    renderer_->GetWorldPoint(w);
+    if (w[3] != 0) emit clicked(w[0] / w[3], w[1] / w[3]);
+  };
+  window_->GetInteractor()->SetInteractorStyle(style);
+  useCamera(renderer_->GetActiveCamera());
+}
+
+MapView::~MapView() {
+  if (camera_ && observer_) camera_->RemoveObserver(observer_);
+}
+
+void MapView::setTitle(const QString& title) { title_->setText(title); }
+QString MapView::title() const { return title_->text(); }
+
+void MapView::useCamera(vtkCamera* camera) {
+  if (camera_ && observer_) camera_->RemoveObserver(observer_);
+  camera_ = camera;
+  renderer_->SetActiveCamera(camera);
+  vtkNew<vtkCallbackCommand> command;
+  command->SetClientData(this);
+  command->SetCallback([](vtkObject*, unsigned long, void* self, void*) {
+    static_cast<MapView*>(self)->scheduleRender();
+  });
+  observer_ = camera->AddObserver(vtkCommand::ModifiedEvent, command);
+}
+
+vtkCamera* MapView::camera() { return camera_; }
+
+void MapView::fit(const Box& extent) {
+  const double mapHeight = widget_->height() * (1 - kLegendBand);
+  const double aspect = mapHeight > 0 ? widget_->width() / mapHeight : 1.0;
+  viz::fitCamera(renderer_, extent, aspect);
+  renderer_->ResetCameraClippingRange();
+  camera_->SetClippingRange(1, 1000);
+}
+
+void MapView::render() {
+  renderPending_ = false;
+  window_->Render();
+}
+
+void MapView::scheduleRender() {
+  if (renderPending_) return;
+  renderPending_ = true;
+  QTimer::singleShot(0, this, [this] {
+    if (renderPending_) render();
+  });
+}
+
+}  // namespace parcelscope::gui

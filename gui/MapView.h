@@ -1,0 +1,55 @@
+#pragma once
+// One parcel map view: a VTK render window in a Qt widget, a map layer, the
+// selected block's outline and, optionally, the shared colour bar. Drag pans,
+// the wheel zooms, a click reports the world point under the cursor.
+#include <QWidget>
+
+#include <vtkNew.h>
+#include <vtkSmartPointer.h>
+
+#include "parcelscope/viz/Scenes.h"
+
+class QLabel;
+class QVTKOpenGLNativeWidget;
+class vtkCamera;
+class vtkGenericOpenGLRenderWindow;
+class vtkRenderer;
+
+namespace parcelscope::gui {
+
+class MapView : public QWidget {
+  Q_OBJECT
+public:
+  explicit MapView(const QString& title, bool withColourBar, QWidget* parent = nullptr);
+  ~MapView() override;
+
+  viz::MapLayer& layer() { return layer_; }
+  viz::OutlineLayer& outline() { return outline_; }
+  void setTitle(const QString& title);
+  QString title() const;
+  /// Shares `camera` with this view (linked views follow each other).
+  void useCamera(vtkCamera* camera);
+  vtkCamera* camera();
+  void fit(const Box& extent);
+  /// Renders now.
+  void render();
+  QVTKOpenGLNativeWidget* vtkWidget() { return widget_; }
+
+signals:
+  void clicked(double x, double y);  ///< local metres
+
+private:
+  void scheduleRender();
+  QLabel* title_;
+  QVTKOpenGLNativeWidget* widget_;
+  vtkNew<vtkGenericOpenGLRenderWindow> window_;
+  vtkNew<vtkRenderer> renderer_;
+  vtkNew<vtkRenderer> legend_;
+  viz::MapLayer layer_;
+  viz::OutlineLayer outline_;
+  bool renderPending_ = false;
+  unsigned long observer_ = 0;
+  vtkSmartPointer<vtkCamera> camera_;
+};
+
+}  // namespace parcelscope::gui

@@ -1,0 +1,74 @@
+#include "SessionWorker.h"
+
+#include <QMetaObject>
+
+#include <chrono>
+
+#include "parcelscope/core/Error.h"
+
+namespace parcelscope::gui {
+
+SessionWorker::SessionWorker() { qRegisterMetaType<parcelscope::gui::UpdateReport>(); }
+SessionWorker::~SessionWorker() = default;
+
+qint64 SessionWorker::submit(const viz::CompareRequest& request) {
+  qint64 serial;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_ = request;
+    serial = ++latest_;
+  }
+  QMetaObject::invokeMethod(this, "process", Qt::QueuedConnection);
+  return serial;
+}
+
+void SessionWorker::cancel() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  pending_.reset();
+  ++latest_;
+}
+
+void SessionWorker::process() {
+  for (;;) {
+    viz::CompareRequest request;
+    qint64 serial;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!pending_) return;
+      request = std::move(*pending_);
+      pending_.reset();
+      serial = latest_.load();
+    }
+    auto last = std::chrono::steady_clock::now() - std::chrono::seconds(1);
+    const ProgressFn progress = [&](double fraction, const std::string& stage) {
+      const auto now = std::chrono::steady_clock::now();
+      if (now - last > std::chrono::milliseconds(50)) {
+        last = now;
+        emit this->progress(fraction, QString::fromStdString(stage));
+      }
+      return latest_.load() == serial;
+    };
+    try {
+      const viz::CompareSession::Update u = session_.update(request, progress);
+      UpdateReport report;
+      report.result = u.result;
+      report.request = request;
+      report.serial = serial;
+      report.reloaded = u.reloaded;
+      report.blocksRegenerated = static_cast<int>(u.blocksRegenerated);
+      report.blocksTotal = static_cast<int>(u.blocksTotal);
+      report.seconds = u.seconds;
+      emit updated(report);
+    } catch (const Error& e) {
+      if (e.kind() == Error::Kind::Cancelled) {
+        emit cancelled(serial);
+      } else {
+        emit failed(QString::fromStdString(e.what()), serial);
+      }
+    } catch (const std::exception& e) {
+      emit failed(QString("internal error: ") + e.what(), serial);
+    }
+  }
+}
+
+}  // namespace parcelscope::gui

@@ -1,0 +1,56 @@
+#pragma once
+// Runs viz::CompareSession::update off the UI thread. The newest request wins:
+// submitting one cancels the update under way (through the progress callback),
+// and the session keeps the blocks it had finished.
+#include <QObject>
+#include <QString>
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <optional>
+
+#include "parcelscope/viz/CompareSession.h"
+
+namespace parcelscope::gui {
+
+/// What one finished update brings to the window.
+struct UpdateReport {
+  std::shared_ptr<const viz::CompareResult> result;
+  viz::CompareRequest request;
+  qint64 serial = 0;
+  bool reloaded = false;
+  int blocksRegenerated = 0;
+  int blocksTotal = 0;
+  double seconds = 0;
+};
+
+class SessionWorker : public QObject {
+  Q_OBJECT
+public:
+  SessionWorker();
+  ~SessionWorker() override;
+  /// Queues `request` (thread-safe) and returns its serial number.
+  qint64 submit(const viz::CompareRequest& request);
+  /// Cancels the update under way and drops any queued request.
+  void cancel();
+
+signals:
+  void updated(const parcelscope::gui::UpdateReport& report);
+  void failed(const QString& message, qint64 serial);
+  void cancelled(qint64 serial);
+  void progress(double fraction, const QString& stage);
+
+private slots:
+  void process();
+
+private:
+  std::mutex mutex_;
+  std::optional<viz::CompareRequest> pending_;
+  std::atomic<qint64> latest_{0};
+  viz::CompareSession session_;
+};
+
+}  // namespace parcelscope::gui
+
+Q_DECLARE_METATYPE(parcelscope::gui::UpdateReport)

@@ -1,0 +1,55 @@
+// parcelscope-gui [INPUT] [--layer L] [--where SQL] [--crs EPSG:N] [--session FILE] [--sample]
+//                 [--screenshot PNG]
+#include <QApplication>
+#include <QCommandLineParser>
+#include <QSurfaceFormat>
+#include <QTimer>
+#include <QVTKOpenGLNativeWidget.h>
+
+#include <cstdio>
+
+#include "MainWindow.h"
+
+int main(int argc, char** argv) {
+  QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
+  QApplication app(argc, argv);
+  QApplication::setApplicationName("parcelscope-gui");
+  QCommandLineParser parser;
+  parser.setApplicationDescription("ParcelScope: observed and procedural parcels side by side");
+  parser.addHelpOption();
+  parser.addPositionalArgument("INPUT", "parcel dataset to open (any polygon format GDAL reads)", "[INPUT]");
+  const QCommandLineOption layer("layer", "layer to read", "NAME");
+  const QCommandLineOption where("where", "OGR SQL attribute filter", "SQL");
+  const QCommandLineOption crs("crs", "CRS of the input, replacing a missing or wrong one", "CRS");
+  const QCommandLineOption session("session", "session file to restore", "FILE");
+  const QCommandLineOption sample("sample", "open the bundled sample");
+  const QCommandLineOption screenshot("screenshot", "save the window as PNG once it shows its first result, then quit",
+                                      "PNG");
+  parser.addOptions({layer, where, crs, session, sample, screenshot});
+  parser.process(app);
+
+  parcelscope::gui::MainWindow window;
+  window.show();
+  if (parser.isSet(screenshot)) {
+    const QString path = parser.value(screenshot);
+    QObject::connect(&window, &parcelscope::gui::MainWindow::viewsUpdated, &window, [&window, path] {
+      QTimer::singleShot(300, &window, [&window, path] {
+        const bool ok = window.grab().save(path);
+        std::fprintf(stderr, ok ? "screenshot written to %s\n" : "cannot write %s\n", path.toLocal8Bit().constData());
+        QApplication::exit(ok ? 0 : 1);
+      });
+    });
+    QObject::connect(&window, &parcelscope::gui::MainWindow::errorShown, &window, [](const QString& message) {
+      std::fprintf(stderr, "%s\n", message.toLocal8Bit().constData());
+      QApplication::exit(1);
+    });
+  }
+  if (parser.isSet(session)) {
+    window.openSession(parser.value(session));
+  } else if (parser.isSet(sample)) {
+    window.openSample();
+  } else if (!parser.positionalArguments().isEmpty()) {
+    window.openFile(parser.positionalArguments().front(), parser.value(layer), parser.value(where), parser.value(crs));
+  }
+  return QApplication::exec();
+}

@@ -1,0 +1,60 @@
+#pragma once
+// `compare` kept up to date across edits: the state behind the GUI, usable from
+// any program. The session holds the observed data and every block's plan and
+// outcome; update() reads and analyses again only when the input or a
+// block-building parameter changed, and regenerates only the blocks whose plan
+// (style, bounds, parameters, seed) changed, as Vanegas et al. 2012 (section 5)
+// regenerate only the blocks an edit touches. A request gives the same result
+// through a session as through compare().
+//
+// Session files (JSON) hold a request: input, style, parameters the user set,
+// per-block overrides, seed and figure quantity. `parcelscope compare --session
+// FILE` runs one; the GUI saves and restores them.
+#include <cstddef>
+#include <memory>
+#include <string>
+
+#include "parcelscope/core/Json.h"
+#include "parcelscope/viz/CompareJob.h"
+
+namespace parcelscope::viz {
+
+class CompareSession {
+public:
+  CompareSession();
+  ~CompareSession();
+  CompareSession(const CompareSession&) = delete;
+  CompareSession& operator=(const CompareSession&) = delete;
+
+  struct Update {
+    std::shared_ptr<const CompareResult> result;
+    bool reloaded = false;            ///< the input was read and analysed again
+    std::size_t blocksRegenerated = 0;  ///< block entries subdivided by this update
+    std::size_t blocksTotal = 0;
+    double seconds = 0;
+  };
+
+  /// Brings the result up to date with `request`. Throws as compare(); on
+  /// Error(Cancelled) (progress returned false) the blocks finished so far are
+  /// kept for the next update and current() is unchanged.
+  Update update(const CompareRequest& request, const ProgressFn& progress = {});
+
+  /// The last result (null before the first update).
+  std::shared_ptr<const CompareResult> current() const;
+
+private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+/// The request as a session file holds it: {"parcelscope_session": 1, "input":
+/// {path, layer, where, crs}, "style", "metric", "parameters": {the explicit
+/// ones}, "overrides": [{"block_id", "style", "parameters"}]}.
+Json sessionJson(const CompareRequest& request);
+
+/// Reads a session file (or the "session" member of a compare run.json).
+/// Relative input paths are taken relative to the file's folder. Throws
+/// Error(Input) naming the file and the member that is wrong.
+CompareRequest readSession(const std::string& path);
+
+}  // namespace parcelscope::viz

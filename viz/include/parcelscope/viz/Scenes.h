@@ -1,0 +1,65 @@
+#pragma once
+// Interactive VTK scene pieces for the GUI's views, drawn by the same code as
+// the exported figures (Figures.h), so a view and its export look alike. Only
+// forward declarations of VTK types appear here; the caller owns the renderers.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "parcelscope/core/Geometry.h"
+#include "parcelscope/viz/Figures.h"
+
+class vtkChartXY;
+class vtkRenderer;
+class vtkScalarBarActor;
+
+namespace parcelscope::viz {
+
+/// Filled shapes coloured by value through a colour scale, with grey outlines.
+class MapLayer {
+public:
+  MapLayer();
+  ~MapLayer();
+  MapLayer(const MapLayer&) = delete;
+  MapLayer& operator=(const MapLayer&) = delete;
+  /// Replaces the shapes (local metres; holes left open) and their values.
+  /// Throws Error(Usage) when the counts differ.
+  void setShapes(const std::vector<const Polygon*>& shapes, const std::vector<double>& values);
+  /// Replaces only the values (same shapes as the last setShapes), without
+  /// triangulating again.
+  void setValues(const std::vector<double>& values);
+  void setScale(const ColourScale& scale);
+  void addTo(vtkRenderer* renderer);
+  /// The scale's colour bar (horizontal), for the caller to place.
+  vtkScalarBarActor* colourBar();
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Thick outlines drawn above a MapLayer (the selected block).
+class OutlineLayer {
+public:
+  OutlineLayer();
+  ~OutlineLayer();
+  OutlineLayer(const OutlineLayer&) = delete;
+  OutlineLayer& operator=(const OutlineLayer&) = delete;
+  void setShapes(const std::vector<const Polygon*>& shapes);
+  void addTo(vtkRenderer* renderer);
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Points the renderer's (parallel-projection) camera at `extent` with a margin.
+void fitCamera(vtkRenderer* renderer, const Box& extent, double viewAspect);
+
+/// Fills `chart` with overlaid histograms as renderHistogram draws them; font
+/// sizes follow `height` (pixels).
+void fillHistogramChart(vtkChartXY* chart, const std::string& title, const std::string& xTitle,
+                        const std::string& yTitle, const std::vector<double>& edges,
+                        const std::vector<HistogramSeries>& series, int height);
+
+}  // namespace parcelscope::viz

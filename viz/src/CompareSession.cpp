@@ -1,0 +1,264 @@
+#include "parcelscope/viz/CompareSession.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+
+#include "CompareStages.h"
+#include "parcelscope/core/Error.h"
+#include "parcelscope/core/Parallel.h"
+#include "parcelscope/io/Writers.h"
+
+namespace parcelscope::viz {
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+bool sameInput(const io::ReadOptions& a, const io::ReadOptions& b) {
+  return a.path == b.path && a.layer == b.layer && a.where == b.where && a.crsOverride == b.crsOverride;
+}
+
+// Analysis parameters that shape the blocks (all but k, which only moves the bounds).
+bool sameBlocks(const CompareRequest& a, const CompareRequest& b) {
+  for (const auto& d : analysis::analysisParameters()) {
+    if (d.name != "k" && compareValue(a, d.name) != compareValue(b, d.name)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+struct CompareSession::State {
+  CompareRequest request;  // of the last completed update
+  std::shared_ptr<const analysis::ObservedData> observed;
+  generation::BlockInputs inputs;
+  std::vector<generation::BlockPlan> plans;  // one per entry; outcomes[k] was made with plans[k]
+  std::vector<std::shared_ptr<const generation::BlockOutcome>> outcomes;
+  std::shared_ptr<const CompareResult> current;
+};
+
+CompareSession::CompareSession() : state_(std::make_unique<State>()) {}
+CompareSession::~CompareSession() = default;
+
+std::shared_ptr<const CompareResult> CompareSession::current() const { return state_->current; }
+
+CompareSession::Update CompareSession::update(const CompareRequest& request, const ProgressFn& progress) {
+  const auto started = std::chrono::steady_clock::now();
+  detail::checkRequest(request);
+  State& s = *state_;
+  Update u;
+
+  // Observed data: read and analysed again only when the blocks would differ.
+  const bool reload = !s.observed || !sameInput(s.request.input, request.input) || !sameBlocks(s.request, request);
+  const double k = compareValue(request, "k");
+  const bool rederive = !reload && compareValue(s.request, "k") != k;
+  std::shared_ptr<const analysis::ObservedData> observed = s.observed;
+  double readSeconds = 0, blockSeconds = 0;
+  if (reload) {
+    auto loaded = std::make_shared<analysis::ObservedData>(
+        analysis::loadObserved(request.input, request.parameters, scaledProgress(progress, 0.0, 0.5)));
+    detail::requireBlocks(request, *loaded);
+    for (const auto& stage : loaded->layer.timings.stages()) readSeconds += stage.second;
+    for (const auto& stage : loaded->analysis.timings.stages()) blockSeconds += stage.second;
+    observed = std::move(loaded);
+  } else if (rederive) {
+    auto copy = std::make_shared<analysis::ObservedData>(*observed);
+    analysis::rederiveBlockBounds(copy->analysis, k);
+    observed = std::move(copy);
+  }
+  generation::BlockInputs fresh;
+  const bool newInputs = reload || rederive;
+  if (newInputs) fresh = generation::prepareBlocks(detail::generateRequest(request, observed.get()));
+  generation::BlockInputs& inputs = newInputs ? fresh : s.inputs;
+  if (newInputs && !reload) inputs.widths = s.inputs.widths;  // same blocks, same streets
+
+  // Plans, and the entries whose plan changed.
+  const auto generateStart = std::chrono::steady_clock::now();
+  const generation::GenerateRequest g = detail::generateRequest(request, observed.get());
+  std::int64_t clamped = 0;
+  const std::vector<generation::BlockPlan> plans = generation::planBlocks(g, inputs, &clamped);
+  if (std::any_of(plans.begin(), plans.end(), [](const auto& p) { return p.style != "obb"; })) {
+    generation::streetWidthsOf(inputs);
+  }
+  std::vector<std::shared_ptr<const generation::BlockOutcome>> outcomes =
+      reload ? std::vector<std::shared_ptr<const generation::BlockOutcome>>(plans.size()) : s.outcomes;
+  std::vector<generation::BlockPlan> done = reload ? std::vector<generation::BlockPlan>(plans.size()) : s.plans;
+  std::vector<std::size_t> todo;
+  for (std::size_t k2 = 0; k2 < plans.size(); ++k2) {
+    if (!outcomes[k2] || done[k2] != plans[k2]) todo.push_back(k2);
+  }
+  const double minFrontage = compareValue(request, "min-frontage");
+  std::vector<std::shared_ptr<const generation::BlockOutcome>> made(todo.size());
+  const ProgressFn sub = scaledProgress(progress, reload ? 0.5 : 0.0, 0.95);
+  auto keepFinished = [&] {
+    for (std::size_t t = 0; t < todo.size(); ++t) {
+      if (!made[t]) continue;
+      outcomes[todo[t]] = made[t];
+      done[todo[t]] = plans[todo[t]];
+    }
+  };
+  try {
+    reportProgress(sub, 0.0, "subdividing");
+    // A few blocks run without the progress tick, whose polling would only add latency.
+    const bool tick = todo.size() > 32;
+    parallelFor(
+        todo.size(),
+        [&](std::size_t t) {
+          made[t] = std::make_shared<const generation::BlockOutcome>(
+              generation::runBlock(inputs, todo[t], plans[todo[t]], minFrontage));
+        },
+        tick ? std::function<void(std::size_t)>([&](std::size_t n) {
+          reportProgress(sub, static_cast<double>(n) / static_cast<double>(todo.size()), "subdividing");
+        })
+             : std::function<void(std::size_t)>());
+  } catch (const Error& e) {
+    if (e.kind() == Error::Kind::Cancelled && !reload && !newInputs) {
+      keepFinished();
+      s.outcomes = std::move(outcomes);
+      s.plans = std::move(done);
+    }
+    throw;
+  }
+  keepFinished();
+
+  // The result: every block's parcels, measured; per-block comparisons kept
+  // where neither side changed.
+  CompareResult r;
+  r.observed = observed;
+  std::vector<const generation::BlockOutcome*> pointers;
+  for (const auto& o : outcomes) pointers.push_back(o.get());
+  const auto seedIt = request.parameters.find("seed");
+  r.generated = generation::assembleParcels(inputs, plans, pointers,
+                                            seedIt == request.parameters.end() ? 1 : static_cast<std::uint64_t>(seedIt->second));
+  r.generated.clampedBounds = clamped;
+  const double generateSeconds = secondsSince(generateStart);
+
+  const auto compareStart = std::chrono::steady_clock::now();
+  std::vector<char> keep;
+  const bool sameBins = s.current && compareValue(s.request, "bins") == compareValue(request, "bins") &&
+                        compareValue(s.request, "histogram-quantile") == compareValue(request, "histogram-quantile");
+  if (!reload && sameBins) {
+    keep.assign(observed->analysis.blocks.size(), 1);
+    for (std::size_t t : todo) keep[static_cast<std::size_t>(inputs.entries[t].blockId)] = 0;
+    r.blocks = s.current->blocks;
+    r.observedLots = s.current->observedLots;
+  }
+  detail::compareStage(r, request, keep.empty() ? nullptr : &keep);
+  r.seconds = {{"read", readSeconds},
+               {"blocks", blockSeconds},
+               {"generate", generateSeconds},
+               {"metrics", secondsSince(compareStart)}};
+
+  // Commit.
+  if (newInputs) s.inputs = std::move(fresh);
+  s.observed = observed;
+  s.plans = std::move(done);
+  s.outcomes = std::move(outcomes);
+  s.request = request;
+  s.current = std::make_shared<const CompareResult>(std::move(r));
+  reportProgress(progress, 1.0, "done");
+
+  u.result = s.current;
+  u.reloaded = reload;
+  u.blocksRegenerated = todo.size();
+  u.blocksTotal = plans.size();
+  u.seconds = secondsSince(started);
+  return u;
+}
+
+Json sessionJson(const CompareRequest& request) {
+  Json parameters = Json::object();
+  for (const auto& name : request.explicitParameters) {
+    const auto it = request.parameters.find(name);
+    if (it != request.parameters.end()) parameters.set(name, it->second);
+  }
+  Json overrides = Json::array();
+  for (const auto& [id, o] : request.overrides) {
+    Json values = Json::object();
+    for (const auto& [name, v] : o.parameters) values.set(name, v);
+    overrides.push(Json::object().set("block_id", static_cast<std::int64_t>(id)).set("style", o.style).set(
+        "parameters", values));
+  }
+  return Json::object()
+      .set("parcelscope_session", 1)
+      .set("input", Json::object()
+                        .set("path", request.input.path)
+                        .set("layer", request.input.layer)
+                        .set("where", request.input.where)
+                        .set("crs", request.input.crsOverride))
+      .set("style", request.style)
+      .set("metric", request.metric)
+      .set("parameters", parameters)
+      .set("overrides", overrides);
+}
+
+CompareRequest readSession(const std::string& path) {
+  Json root = io::readJson(path);
+  if (!root.find("parcelscope_session")) {
+    if (const Json* inner = root.find("session")) root = *inner;  // a compare run.json
+  }
+  auto bad = [&](const std::string& what) { return inputError(path + ": session " + what); };
+  if (!root.isObject() || !root.find("parcelscope_session")) {
+    throw bad("file expected (no parcelscope_session member)");
+  }
+  auto text = [&](const Json& object, const char* key, const std::string& where) -> std::string {
+    const Json* v = object.find(key);
+    if (!v || v->isNull()) return "";
+    if (!v->isString()) throw bad("member " + where + key + " is not a string");
+    return v->string();
+  };
+  CompareRequest request;
+  const Json* input = root.find("input");
+  if (!input || !input->isObject()) throw bad("has no input object");
+  request.input.path = text(*input, "path", "input.");
+  if (request.input.path.empty()) throw bad("member input.path is missing");
+  const std::filesystem::path given(request.input.path);
+  if (given.is_relative()) {
+    request.input.path = (std::filesystem::path(path).parent_path() / given).lexically_normal().string();
+  }
+  request.input.layer = text(*input, "layer", "input.");
+  request.input.where = text(*input, "where", "input.");
+  request.input.crsOverride = text(*input, "crs", "input.");
+  if (const std::string style = text(root, "style", ""); !style.empty()) request.style = style;
+  if (const std::string metric = text(root, "metric", ""); !metric.empty()) request.metric = metric;
+
+  const std::vector<ParameterDescription> descriptions = compareParameters();
+  request.parameters = defaultValues(descriptions);
+  auto readValues = [&](const Json& object, const std::string& where, ParameterValues& into,
+                        std::set<std::string>* names) {
+    for (const auto& [name, v] : object.members()) {
+      if (!v.isNumber()) throw bad("member " + where + name + " is not a number");
+      const bool known = std::any_of(descriptions.begin(), descriptions.end(),
+                                     [&](const ParameterDescription& d) { return d.name == name; });
+      if (!known) throw bad("member " + where + name + " is not a parameter of compare");
+      into[name] = v.number();
+      if (names) names->insert(name);
+    }
+  };
+  if (const Json* p = root.find("parameters")) {
+    if (!p->isObject()) throw bad("member parameters is not an object");
+    readValues(*p, "parameters.", request.parameters, &request.explicitParameters);
+  }
+  if (const Json* o = root.find("overrides")) {
+    if (!o->isArray()) throw bad("member overrides is not an array");
+    std::size_t index = 0;
+    for (const Json& item : o->elements()) {
+      const std::string where = "overrides[" + std::to_string(index++) + "].";
+      const Json* id = item.find("block_id");
+      if (!id || !id->isNumber()) throw bad("member " + where + "block_id is missing or not a number");
+      generation::BlockOverride override;
+      override.style = text(item, "style", where);
+      if (const Json* p = item.find("parameters")) {
+        if (!p->isObject()) throw bad("member " + where + "parameters is not an object");
+        readValues(*p, where + "parameters.", override.parameters, nullptr);
+      }
+      request.overrides[static_cast<std::int64_t>(id->number())] = std::move(override);
+    }
+  }
+  return request;
+}
+
+}  // namespace parcelscope::viz

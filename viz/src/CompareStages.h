@@ -1,0 +1,24 @@
+#pragma once
+// The comparison stage shared by compare() and CompareSession.
+#include <vector>
+
+#include "parcelscope/viz/CompareJob.h"
+
+namespace parcelscope::viz::detail {
+
+/// Fills r.observedLots (when empty), r.blocks, r.city and r.histograms from
+/// r.observed and r.generated. Where `keep` (one flag per observed block) is
+/// set and r.blocks already holds that block, its comparison is kept as it is.
+void compareStage(CompareResult& r, const CompareRequest& request, const std::vector<char>* keep = nullptr);
+
+/// The generation request of a compare request over observed data already read.
+generation::GenerateRequest generateRequest(const CompareRequest& request, const analysis::ObservedData* observed);
+
+/// Throws Error(Input) when `observed` has no block to compare.
+void requireBlocks(const CompareRequest& request, const analysis::ObservedData& observed);
+
+/// Throws Error(Usage) when a value of `request` is outside its parameter's
+/// range, or its metric is not a parcel quantity.
+void checkRequest(const CompareRequest& request);
+
+}  // namespace parcelscope::viz::detail
