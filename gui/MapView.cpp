@@ -143,6 +143,16 @@ void MapView::fit(const Box& extent) {
   camera_->SetClippingRange(1, 1000);
 }
 
+QPoint MapView::widgetPoint(const Point& p) {
+  renderer_->SetWorldPoint(p.x, p.y, 0, 1);
+  renderer_->WorldToDisplay();
+  double d[3];
+  renderer_->GetDisplayPoint(d);
+  const double ratio = widget_->devicePixelRatioF();
+  return QPoint(static_cast<int>(std::lround(d[0] / ratio)),
+                static_cast<int>(std::lround(widget_->height() - d[1] / ratio)));
+}
+
 void MapView::render() {
   renderPending_ = false;
   window_->Render();

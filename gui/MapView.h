@@ -34,6 +34,8 @@ public:
   /// Renders now.
   void render();
   QVTKOpenGLNativeWidget* vtkWidget() { return widget_; }
+  /// Where the world point `p` (local metres) appears in vtkWidget(), in widget coordinates.
+  QPoint widgetPoint(const Point& p);
 
 signals:
   void clicked(double x, double y);  ///< local metres

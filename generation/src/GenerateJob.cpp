@@ -155,12 +155,14 @@ std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInp
                                   std::int64_t* clampedBounds) {
   checkStyle(request.style, true);
   const std::vector<ParameterDescription> descriptions = generationParameterDescriptions();
-  auto check = [&](const ParameterValues& values, const std::string& where) {
+  // The run's values also hold analysis and comparison parameters; an
+  // override holds generator parameters only (strict).
+  auto check = [&](const ParameterValues& values, const std::string& where, bool strict) {
     for (const auto& [name, v] : values) {
       const auto d = std::find_if(descriptions.begin(), descriptions.end(),
                                   [&](const ParameterDescription& x) { return x.name == name; });
       if (d == descriptions.end()) {
-        if (where.empty()) continue;  // the run's values also hold analysis and comparison parameters
+        if (!strict) continue;
         throw usageError(where + ": no generator parameter named '" + name + "'");
       }
       checkValue(*d, v);
@@ -169,7 +171,7 @@ std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInp
     if (p.aMin > p.aMax) throw usageError((where.empty() ? "" : where + ": ") + "--a-min must not exceed --a-max");
     if (p.wMin > p.wMax) throw usageError((where.empty() ? "" : where + ": ") + "--w-min must not exceed --w-max");
   };
-  check(request.parameters, "");
+  check(request.parameters, "", false);
   std::set<std::int64_t> ids;
   for (const auto& e : inputs.entries) ids.insert(e.blockId);
   for (const auto& [id, o] : request.overrides) {
@@ -178,8 +180,8 @@ std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInp
     if (!o.style.empty()) checkStyle(o.style, true);
     ParameterValues merged = request.parameters;
     for (const auto& [name, v] : o.parameters) merged[name] = v;
-    check(o.parameters, where);
-    check(merged, where);
+    check(o.parameters, where, true);
+    check(merged, where, false);
   }
 
   // Per-block bounds (derived from observed parcels or read from the input) are

@@ -323,3 +323,56 @@ TEST(CompareCommand, CtrlCLeavesNoOutputAndNoStagingFolder) {
 
 }  // namespace
 }  // namespace parcelscope
+
+namespace parcelscope {
+namespace {
+
+// What the GUI does to data, the command line does too: a saved session (or a
+// compare run.json) reruns with its overrides, and --metric draws the quantity
+// the GUI colours by.
+TEST(CompareCommand, SessionFileRerunsWithItsOverrides) {
+  TempDir dir;
+  const std::string session = dir.write(
+      "session.json", R"({"parcelscope_session": 1, "input": {"path": ")" + kSample +
+                          R"(", "where": "use <> 'ROW'"}, "style": "obb", "parameters": {"seed": 5},
+      "overrides": [{"block_id": 3, "style": "skeleton", "parameters": {"w-max": 14}}]})");
+  const std::string a = dir.file("a"), b = dir.file("b");
+  CliRun r = runCli("compare --session '" + session + "' --figures 0 --out '" + a + "' --quiet");
+  ASSERT_EQ(r.code, 0) << r.output;
+  CPLJSONDocument run;
+  ASSERT_TRUE(run.Load(a + "/run.json"));
+  EXPECT_EQ(run.GetRoot().GetLong("seed"), 5);
+  EXPECT_EQ(run.GetRoot().GetObj("session").GetArray("overrides").Size(), 1);
+  // The run record is itself a session: the same parcels again.
+  r = runCli("compare --session '" + a + "/run.json' --figures 0 --out '" + b + "' --quiet");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(test::slurp(a + "/generated_parcels.csv"), test::slurp(b + "/generated_parcels.csv"));
+  // Without the override, block 3 differs.
+  const std::string c = dir.file("c");
+  r = compareSample(c, "--seed 5 --figures 0");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(test::slurp(a + "/generated_parcels.csv"), test::slurp(c + "/generated_parcels.csv"));
+}
+
+TEST(CompareCommand, MetricDrawsItsMapAndHistogram) {
+  TempDir dir;
+  const std::string out = dir.file("out");
+  const CliRun r = compareSample(out, "--metric p_angle --figure-width 800 --figure-height 400");
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* name : {"map_p_angle.png", "hist_p_angle.png", "hist_p_angle.svg"}) {
+    const test::Image image = test::readPng(out + "/figures/" + name);
+    if (std::string(name).find(".png") != std::string::npos) {
+      EXPECT_EQ(image.width, 800) << name;
+      EXPECT_GT(test::ink(image).share, 0.02) << name;
+    } else {
+      EXPECT_NE(test::slurp(out + "/figures/" + name).find("<svg"), std::string::npos) << name;
+    }
+  }
+  const CliRun bad = compareSample(dir.file("bad"), "--metric colour --figures 0");
+  EXPECT_EQ(bad.code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("no parcel quantity 'colour'"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(dir.file("bad")));
+}
+
+}  // namespace
+}  // namespace parcelscope

@@ -1,0 +1,238 @@
+// CompareSession: the incremental compare behind the GUI gives what compare()
+// gives for the same request, regenerating only the blocks whose plan changed;
+// session files round-trip.
+#include "parcelscope/viz/CompareSession.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <random>
+
+#include "TestUtil.h"
+#include "parcelscope/core/Error.h"
+#include "parcelscope/io/Writers.h"
+
+namespace parcelscope::viz {
+namespace {
+
+using test::TempDir;
+
+const std::string kSample = std::string(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_town.geojson";
+
+CompareRequest sampleRequest(const std::string& style = "obb") {
+  CompareRequest r;
+  r.input.path = kSample;
+  r.input.where = "use <> 'ROW'";
+  r.style = style;
+  r.parameters = defaultValues(compareParameters());
+  r.parameters["figures"] = 0;
+  return r;
+}
+
+// Same parcels (areas and centroids, in order), same metrics and distances.
+void expectSameResult(const CompareResult& a, const CompareResult& b) {
+  ASSERT_EQ(a.generated.parcels.size(), b.generated.parcels.size());
+  for (std::size_t i = 0; i < a.generated.parcels.size(); ++i) {
+    EXPECT_NEAR(area(a.generated.parcels[i]), area(b.generated.parcels[i]), 1e-9) << "parcel " << i;
+    EXPECT_NEAR(centroid(a.generated.parcels[i]).x, centroid(b.generated.parcels[i]).x, 1e-9) << "parcel " << i;
+    EXPECT_EQ(a.generated.metrics[i].neighbours, b.generated.metrics[i].neighbours) << "parcel " << i;
+    EXPECT_EQ(a.generated.metrics[i].streetAccess, b.generated.metrics[i].streetAccess) << "parcel " << i;
+  }
+  EXPECT_EQ(a.generated.blockStyles, b.generated.blockStyles);
+  EXPECT_DOUBLE_EQ(a.city.area.ks, b.city.area.ks);
+  EXPECT_DOUBLE_EQ(a.city.width.wasserstein, b.city.width.wasserstein);
+  ASSERT_EQ(a.blocks.size(), b.blocks.size());
+  for (std::size_t k = 0; k < a.blocks.size(); ++k) {
+    EXPECT_EQ(a.blocks[k].comparison.generated.parcels, b.blocks[k].comparison.generated.parcels) << "block " << k;
+    const double ka = a.blocks[k].comparison.area.ks, kb = b.blocks[k].comparison.area.ks;
+    EXPECT_TRUE((std::isnan(ka) && std::isnan(kb)) || ka == kb) << "block " << k;
+  }
+}
+
+// Generated parcels of each observed block sum to its area.
+void expectBlocksTiled(const CompareResult& r) {
+  std::vector<double> sums(r.observed->analysis.blocks.size(), 0.0);
+  for (std::size_t k = 0; k < r.generated.blocks.size(); ++k) {
+    for (int i : r.generated.blocks[k].parcels) sums[r.generated.blockIds[k]] += area(r.generated.parcels[i]);
+  }
+  for (std::size_t b = 0; b < sums.size(); ++b) {
+    EXPECT_NEAR(sums[b], r.observed->analysis.statistics[b].blockArea, 1e-6 * sums[b]) << "block " << b;
+  }
+}
+
+TEST(CompareSession, FirstUpdateEqualsCompare) {
+  for (const char* style : {"obb", "skeleton", "auto"}) {
+    SCOPED_TRACE(style);
+    const CompareRequest request = sampleRequest(style);
+    CompareSession session;
+    const auto u = session.update(request);
+    EXPECT_TRUE(u.reloaded);
+    EXPECT_EQ(u.blocksRegenerated, u.blocksTotal);
+    EXPECT_EQ(u.blocksTotal, 10u);
+    expectSameResult(*u.result, compare(request));
+    expectBlocksTiled(*u.result);
+  }
+}
+
+TEST(CompareSession, RegeneratesOnlyTheBlocksAnEditTouches) {
+  CompareSession session;
+  CompareRequest request = sampleRequest();
+  session.update(request);
+
+  const auto same = session.update(request);
+  EXPECT_FALSE(same.reloaded);
+  EXPECT_EQ(same.blocksRegenerated, 0u);
+
+  // One block's own bounds: that block alone.
+  request.overrides[3].parameters = {{"a-max", 300.0}, {"a-min", 100.0}};
+  const auto one = session.update(request);
+  EXPECT_FALSE(one.reloaded);
+  EXPECT_EQ(one.blocksRegenerated, 1u);
+  expectSameResult(*one.result, compare(request));
+  EXPECT_GT(one.result->blocks[3].comparison.generated.parcels, same.result->blocks[3].comparison.generated.parcels);
+  EXPECT_EQ(one.result->blocks[4].comparison.generated.parcels, same.result->blocks[4].comparison.generated.parcels);
+
+  // A global generator value: every block.
+  request.parameters["omega"] = 0.6;
+  request.explicitParameters.insert("omega");
+  const auto all = session.update(request);
+  EXPECT_EQ(all.blocksRegenerated, 10u);
+  expectSameResult(*all.result, compare(request));
+
+  // A skeleton-only parameter does not touch OBB blocks.
+  request.parameters["street-angle"] = 40;
+  EXPECT_EQ(session.update(request).blocksRegenerated, 0u);
+
+  // k moves the per-block bounds without reading again; the block tolerance reads again.
+  request.parameters["k"] = 1.0;
+  const auto k = session.update(request);
+  EXPECT_FALSE(k.reloaded);
+  expectSameResult(*k.result, compare(request));
+  request.parameters["block-tolerance"] = 2.0;
+  const auto tolerance = session.update(request);
+  EXPECT_TRUE(tolerance.reloaded);
+  expectSameResult(*tolerance.result, compare(request));
+}
+
+// Random edit sequences (style, overrides, bounds, seed) end where a fresh
+// compare of the final request ends.
+TEST(CompareSession, RandomEditSequencesMatchAFreshCompare) {
+  const unsigned seed = std::random_device{}();
+  std::printf("seed %u\n", seed);
+  std::mt19937 rng(seed);
+  CompareSession session;
+  CompareRequest request = sampleRequest();
+  const char* styles[] = {"obb", "skeleton", "offset", "auto"};
+  for (int step = 0; step < 12; ++step) {
+    SCOPED_TRACE("seed " + std::to_string(seed) + ", step " + std::to_string(step));
+    switch (rng() % 5) {
+      case 0: request.style = styles[rng() % 4]; break;
+      case 1: request.overrides[static_cast<std::int64_t>(rng() % 10)].style = styles[rng() % 3]; break;
+      case 2:
+        request.overrides[static_cast<std::int64_t>(rng() % 10)].parameters["w-max"] =
+            12.0 + static_cast<double>(rng() % 20);
+        break;
+      case 3: request.overrides.erase(static_cast<std::int64_t>(rng() % 10)); break;
+      case 4:
+        request.parameters["seed"] = static_cast<double>(rng() % 5);
+        request.explicitParameters.insert("seed");
+        break;
+    }
+    const auto u = session.update(request);
+    expectBlocksTiled(*u.result);
+  }
+  expectSameResult(*session.current(), compare(request));
+}
+
+TEST(CompareSession, CancelledUpdateLeavesTheLastResult) {
+  CompareSession session;
+  CompareRequest request = sampleRequest();
+  const auto first = session.update(request);
+  request.parameters["omega"] = 0.9;
+  const ProgressFn stop = [](double, const std::string&) { return false; };
+  try {
+    session.update(request, stop);
+    FAIL() << "expected Error(Cancelled)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::Cancelled);
+  }
+  EXPECT_EQ(session.current(), first.result);
+  expectSameResult(*session.update(request).result, compare(request));
+}
+
+TEST(CompareSession, OverrideOfAMissingBlockIsAUsageError) {
+  CompareSession session;
+  CompareRequest request = sampleRequest();
+  request.overrides[99].style = "skeleton";
+  try {
+    session.update(request);
+    FAIL() << "expected Error(Usage)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::Usage);
+    EXPECT_NE(std::string(e.what()).find("block 99"), std::string::npos) << e.what();
+  }
+  request.overrides.clear();
+  request.overrides[2].parameters["a-min"] = 900;
+  request.overrides[2].parameters["a-max"] = 100;
+  EXPECT_THROW(session.update(request), Error);
+}
+
+TEST(SessionFile, RoundTripsInputParametersOverridesAndSeed) {
+  TempDir dir;
+  CompareRequest request = sampleRequest("skeleton");
+  request.metric = "p_area";
+  request.parameters["seed"] = 7;
+  request.parameters["w-max"] = 21.5;
+  request.explicitParameters = {"seed", "w-max"};
+  request.overrides[4] = {"obb", {{"a-max", 420.0}}};
+  exportSession(request, dir.file("s.json"));
+  const CompareRequest back = readSession(dir.file("s.json"));
+  EXPECT_EQ(back.input.path, request.input.path);
+  EXPECT_EQ(back.input.where, request.input.where);
+  EXPECT_EQ(back.style, "skeleton");
+  EXPECT_EQ(back.metric, "p_area");
+  EXPECT_EQ(back.explicitParameters, request.explicitParameters);
+  EXPECT_EQ(back.parameters.at("seed"), 7);
+  EXPECT_EQ(back.parameters.at("w-max"), 21.5);
+  EXPECT_EQ(back.parameters.at("omega"), 0.3);  // defaults for the rest
+  ASSERT_EQ(back.overrides.count(4), 1u);
+  EXPECT_EQ(back.overrides.at(4).style, "obb");
+  EXPECT_EQ(back.overrides.at(4).parameters.at("a-max"), 420.0);
+  CompareRequest ours = back;
+  ours.parameters["figures"] = 0;
+  expectSameResult(compare(ours), compare(request));
+}
+
+TEST(SessionFile, RelativeInputIsTakenFromTheSessionFolder) {
+  TempDir dir;
+  const std::string path =
+      dir.write("s.json", R"({"parcelscope_session": 1, "input": {"path": "data/parcels.gpkg"}, "style": "obb"})");
+  EXPECT_EQ(readSession(path).input.path, (dir.path() / "data/parcels.gpkg").string());
+}
+
+TEST(SessionFile, BadMembersAreNamed) {
+  TempDir dir;
+  auto message = [&](const std::string& text) {
+    const std::string path = dir.write("bad.json", text);
+    try {
+      readSession(path);
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), Error::Kind::Input);
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("{not json").find("not valid JSON"), std::string::npos);
+  EXPECT_NE(message(R"({"a": 1})").find("parcelscope_session"), std::string::npos);
+  EXPECT_NE(message(R"({"parcelscope_session": 1, "input": {"path": "x"}, "parameters": {"omgea": 1}})")
+                .find("parameters.omgea"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"parcelscope_session": 1, "input": {"path": "x"}, "overrides": [{"style": "obb"}]})")
+                .find("overrides[0].block_id"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace parcelscope::viz
