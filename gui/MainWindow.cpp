@@ -484,7 +484,7 @@ void MainWindow::setColourBy(const QString& quantity) {
   if (!result_) return;
   QElapsedTimer t;
   t.start();
-  recolour();
+  recolour(false);
   drawHistogram();
   observedView_->render();
   proceduralView_->render();
@@ -494,6 +494,7 @@ void MainWindow::setColourBy(const QString& quantity) {
 
 void MainWindow::selectBlock(int block) {
   selected_ = block;
+  selectionChanged_ = true;
   showBlock();
   observedView_->render();
   proceduralView_->render();
@@ -554,7 +555,8 @@ void MainWindow::showReport(const UpdateReport& report) {
     }
     proceduralView_->layer().setShapes(shapes, values);
   }
-  recolour();
+  const bool observedChanged = recolour(first || selectionChanged_);
+  selectionChanged_ = false;
   if (first) {
     Box extent{1e300, 1e300, -1e300, -1e300};
     for (const Block& b : a.blocks) {
@@ -569,7 +571,7 @@ void MainWindow::showReport(const UpdateReport& report) {
   drawHistogram();
   fillNumbers();
   showBlock();
-  observedView_->render();
+  if (observedChanged || first) observedView_->render();
   proceduralView_->render();
 
   const auto it = started_.find(report.serial);
@@ -591,25 +593,38 @@ void MainWindow::showReport(const UpdateReport& report) {
   emit viewsUpdated(report.serial);
 }
 
-void MainWindow::recolour() {
-  if (!result_) return;
+bool MainWindow::recolour(bool observedChanged) {
+  if (!result_) return false;
   const viz::CompareResult& r = *result_;
   const analysis::ParcelQuantity& q = analysis::parcelQuantity(request_.metric);
-  std::vector<double> observed, generated;
-  for (std::size_t i = 0; i < r.observed->layer.parcels.size(); ++i) {
-    if (r.observed->analysis.blockOf[i] >= 0) observed.push_back(q.value(r.observed->analysis.metrics[i]));
+  // The observed view changes only with its data, the quantity or the scale.
+  observedChanged = observedChanged || q.name != shownQuantity_;
+  if (observedChanged) {
+    std::vector<double> observed;
+    for (std::size_t i = 0; i < r.observed->layer.parcels.size(); ++i) {
+      if (r.observed->analysis.blockOf[i] >= 0) observed.push_back(q.value(r.observed->analysis.metrics[i]));
+    }
+    observedView_->layer().setValues(observed);
+    shownQuantity_ = q.name;
   }
+  std::vector<double> generated;
+  generated.reserve(r.generated.metrics.size());
   for (const auto& m : r.generated.metrics) generated.push_back(q.value(m));
-  observedView_->layer().setValues(observed);
   proceduralView_->layer().setValues(generated);
   const viz::ColourScale scale = viz::quantityScale(r, request_, request_.metric);
-  observedView_->layer().setScale(scale);
-  proceduralView_->layer().setScale(scale);
-  observedView_->setTitle(QString("Observed: %1 parcels").arg(observed.size()));
+  if (observedChanged || scale.minimum != shownScale_.minimum || scale.maximum != shownScale_.maximum ||
+      scale.kind != shownScale_.kind || scale.title != shownScale_.title) {
+    observedView_->layer().setScale(scale);
+    proceduralView_->layer().setScale(scale);
+    shownScale_ = scale;
+    observedChanged = true;
+  }
+  observedView_->setTitle(QString("Observed: %1 parcels").arg(r.observedLots.size()));
   proceduralView_->setTitle(QString("Procedural (%1, seed %2): %3 parcels")
                                 .arg(QString::fromStdString(request_.style))
                                 .arg(r.generated.seed)
                                 .arg(generated.size()));
+  return observedChanged;
 }
 
 void MainWindow::drawHistogram() {

@@ -96,7 +96,9 @@ private:
   void submit();
   void showReport(const UpdateReport& report);
   void showError(const QString& message);
-  void recolour();
+  /// Recolours the views; returns whether the observed view changed (it is
+  /// drawn again only then). `observedChanged`: its data changed.
+  bool recolour(bool observedChanged);
   void drawHistogram();
   void fillNumbers();
   void showBlock();
@@ -115,6 +117,9 @@ private:
   double lastLatencyMs_ = 0;
   int selected_ = -1;
   std::vector<std::vector<int>> histogramCounts_;
+  std::string shownQuantity_;
+  viz::ColourScale shownScale_;
+  bool selectionChanged_ = false;
 
   MapView* observedView_;
   MapView* proceduralView_;

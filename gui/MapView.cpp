@@ -70,6 +70,9 @@ MapView::MapView(const QString& title, bool withColourBar, QWidget* parent) : QW
   layout->addWidget(title_);
   widget_ = new QVTKOpenGLNativeWidget(this);
   widget_->setMinimumSize(240, 200);
+  // No multisampling: with a software OpenGL (Xvfb, remote desktops) it makes
+  // every frame several times slower; the maps are flat fills and thin lines.
+  window_->SetMultiSamples(0);
   widget_->setRenderWindow(window_);
   layout->addWidget(widget_, 1);
 

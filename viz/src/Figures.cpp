@@ -21,7 +21,9 @@
 #include <vtkPlotArea.h>
 #include <vtkPlotLine.h>
 #include <vtkPoints.h>
+#include <vtkIdList.h>
 #include <vtkPolyData.h>
+#include <vtkPolygon.h>
 #include <vtkPolyDataMapper.h>
 #include <vtkProperty.h>
 #include <vtkRenderWindow.h>
@@ -164,6 +166,28 @@ struct PanelGeometry {
   vtkNew<vtkPolyData> rings;
 };
 
+// Every turn of the ring goes the same way; turns below about 0.01 degrees
+// (collinear vertices and rounding noise) are ignored, which a fan draws
+// without visible error.
+bool isConvex(const Ring& ring) {
+  const std::size_t n = ring.size();
+  if (n < 3) return false;
+  int sign = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point& a = ring[i];
+    const Point& b = ring[(i + 1) % n];
+    const Point& c = ring[(i + 2) % n];
+    const double ux = b.x - a.x, uy = b.y - a.y, vx = c.x - b.x, vy = c.y - b.y;
+    const double cross = ux * vy - uy * vx;
+    const double tolerance = 2e-4 * std::sqrt((ux * ux + uy * uy) * (vx * vx + vy * vy));
+    const int s = cross > tolerance ? 1 : cross < -tolerance ? -1 : 0;
+    if (s == 0) continue;
+    if (sign == 0) sign = s;
+    if (s != sign) return false;
+  }
+  return sign != 0;
+}
+
 void buildPanel(const MapPanel& panel, PanelGeometry& g, std::vector<vtkIdType>* trianglesPerShape = nullptr) {
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
@@ -171,42 +195,82 @@ void buildPanel(const MapPanel& panel, PanelGeometry& g, std::vector<vtkIdType>*
   vtkNew<vtkDoubleArray> values;
   values->SetName("value");
   const double up[3] = {0, 0, 1};
-  // Each shape is triangulated on its own small contour set (the triangulator's
-  // cost grows with the whole input), then its triangles join the panel's.
+  vtkNew<vtkPolygon> earCut;
+  vtkNew<vtkIdList> earIds;
+  // A convex shape without holes (most parcels) is a triangle fan; any other is
+  // triangulated on its own small contour set (the triangulator's cost grows
+  // with the whole input), then its triangles join the panel's.
   for (std::size_t k = 0; k < panel.shapes.size(); ++k) {
     const Polygon& shape = *panel.shapes[k];
     const vtkIdType offset = points->GetNumberOfPoints();
-    vtkNew<vtkPolyData> contours;
-    vtkNew<vtkPoints> shapePoints;
-    vtkNew<vtkCellArray> shapeLines, shapeTriangles;
     auto addRing = [&](const Ring& ring) {
-      const vtkIdType first = shapePoints->GetNumberOfPoints();
-      for (const Point& p : ring) {
-        shapePoints->InsertNextPoint(p.x, p.y, 0.0);
-        points->InsertNextPoint(p.x, p.y, 0.0);
-      }
+      const vtkIdType first = points->GetNumberOfPoints();
+      for (const Point& p : ring) points->InsertNextPoint(p.x, p.y, 0.0);
       lines->InsertNextCell(static_cast<int>(ring.size() + 1));
-      shapeLines->InsertNextCell(static_cast<int>(ring.size() + 1));
-      for (std::size_t v = 0; v < ring.size(); ++v) {
-        lines->InsertCellPoint(offset + first + static_cast<vtkIdType>(v));
-        shapeLines->InsertCellPoint(first + static_cast<vtkIdType>(v));
-      }
-      lines->InsertCellPoint(offset + first);
-      shapeLines->InsertCellPoint(first);
+      for (std::size_t v = 0; v < ring.size(); ++v) lines->InsertCellPoint(first + static_cast<vtkIdType>(v));
+      lines->InsertCellPoint(first);
     };
     addRing(shape.outer);
     for (const Ring& hole : shape.holes) addRing(hole);
-    contours->SetPoints(shapePoints);
-    contours->SetLines(shapeLines);
-    vtkContourTriangulator::TriangulateContours(contours, 0, shapeLines->GetNumberOfCells(), shapeTriangles, up);
     vtkIdType count = 0;
-    const vtkIdType* ids = nullptr;
-    if (trianglesPerShape) trianglesPerShape->push_back(shapeTriangles->GetNumberOfCells());
-    for (shapeTriangles->InitTraversal(); shapeTriangles->GetNextCell(count, ids);) {
-      triangles->InsertNextCell(static_cast<int>(count));
-      for (vtkIdType i = 0; i < count; ++i) triangles->InsertCellPoint(offset + ids[i]);
-      values->InsertNextValue(panel.values[k]);
+    const auto n = static_cast<vtkIdType>(shape.outer.size());
+    bool done = false;
+    if (shape.holes.empty() && isConvex(shape.outer)) {
+      for (vtkIdType i = 1; i + 1 < n; ++i) {
+        const vtkIdType tri[3] = {offset, offset + i, offset + i + 1};
+        triangles->InsertNextCell(3, tri);
+        values->InsertNextValue(panel.values[k]);
+      }
+      count = std::max<vtkIdType>(0, n - 2);
+      done = true;
+    } else if (shape.holes.empty()) {
+      // Ear cutting of one simple ring (vtkPolygon), reusing its buffers.
+      earCut->GetPoints()->SetNumberOfPoints(n);
+      earCut->GetPointIds()->SetNumberOfIds(n);
+      for (vtkIdType i = 0; i < n; ++i) {
+        earCut->GetPoints()->SetPoint(i, shape.outer[i].x, shape.outer[i].y, 0.0);
+        earCut->GetPointIds()->SetId(i, i);
+      }
+      earIds->Reset();
+      if (earCut->Triangulate(earIds) && earIds->GetNumberOfIds() == 3 * (n - 2)) {
+        for (vtkIdType t = 0; t < earIds->GetNumberOfIds(); t += 3) {
+          const vtkIdType tri[3] = {offset + earIds->GetId(t), offset + earIds->GetId(t + 1),
+                                    offset + earIds->GetId(t + 2)};
+          triangles->InsertNextCell(3, tri);
+          values->InsertNextValue(panel.values[k]);
+        }
+        count = n - 2;
+        done = true;
+      }
     }
+    if (!done) {
+      vtkNew<vtkPolyData> contours;
+      vtkNew<vtkPoints> shapePoints;
+      vtkNew<vtkCellArray> shapeLines, shapeTriangles;
+      const vtkIdType total = points->GetNumberOfPoints() - offset;
+      for (vtkIdType i = 0; i < total; ++i) shapePoints->InsertNextPoint(points->GetPoint(offset + i));
+      vtkIdType start = 0;
+      auto addShapeRing = [&](const Ring& ring) {
+        shapeLines->InsertNextCell(static_cast<int>(ring.size() + 1));
+        for (std::size_t v = 0; v < ring.size(); ++v) shapeLines->InsertCellPoint(start + static_cast<vtkIdType>(v));
+        shapeLines->InsertCellPoint(start);
+        start += static_cast<vtkIdType>(ring.size());
+      };
+      addShapeRing(shape.outer);
+      for (const Ring& hole : shape.holes) addShapeRing(hole);
+      contours->SetPoints(shapePoints);
+      contours->SetLines(shapeLines);
+      vtkContourTriangulator::TriangulateContours(contours, 0, shapeLines->GetNumberOfCells(), shapeTriangles, up);
+      vtkIdType size = 0;
+      const vtkIdType* ids = nullptr;
+      for (shapeTriangles->InitTraversal(); shapeTriangles->GetNextCell(size, ids);) {
+        triangles->InsertNextCell(static_cast<int>(size));
+        for (vtkIdType i = 0; i < size; ++i) triangles->InsertCellPoint(offset + ids[i]);
+        values->InsertNextValue(panel.values[k]);
+      }
+      count = shapeTriangles->GetNumberOfCells();
+    }
+    if (trianglesPerShape) trianglesPerShape->push_back(count);
   }
   g.rings->SetPoints(points);
   g.rings->SetLines(lines);

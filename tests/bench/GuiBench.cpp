@@ -1,0 +1,106 @@
+// Time from a change in parcelscope-gui (a slider, a block override, the
+// colouring) to views, histograms and numbers drawn, on cambridge_ma (743
+// blocks, 13,128 observed parcels). Run under Xvfb:
+//   scripts/with-xvfb.sh build/release/tests/bench/parcelscope_gui_bench [repeats]
+// Prints the median, 90th percentile and largest latency of each kind of change.
+#include <QApplication>
+#include <QElapsedTimer>
+#include <QSurfaceFormat>
+#include <QTest>
+#include <QVTKOpenGLNativeWidget.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "MainWindow.h"
+
+using parcelscope::gui::MainWindow;
+
+namespace {
+
+bool settle(MainWindow& w) {
+  QElapsedTimer t;
+  t.start();
+  while (w.busy() && t.elapsed() < 600000) QTest::qWait(1);
+  return !w.busy() && w.lastError().isEmpty();
+}
+
+struct Row {
+  std::string change;
+  std::vector<double> ms;
+  double regenerated = 0;
+};
+
+void print(const Row& r) {
+  std::vector<double> v = r.ms;
+  std::sort(v.begin(), v.end());
+  const auto at = [&](double q) { return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5)]; };
+  std::printf("%-58s n=%2zu  median %8.1f ms  p90 %8.1f ms  max %8.1f ms\n", r.change.c_str(), v.size(), at(0.5),
+              at(0.9), v.back());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
+  QApplication app(argc, argv);
+  const std::string input =
+      std::string(PARCELSCOPE_SHARED_DATASETS) + "/cambridge_ma/ASSESSING_ParcelsFY2014.topojson";
+  if (!std::filesystem::exists(input)) {
+    std::printf("skipped: %s not found (shared datasets absent)\n", input.c_str());
+    return 0;
+  }
+  const int repeats = argc > 1 ? std::max(3, std::atoi(argv[1])) : 10;
+  MainWindow w;
+  w.resize(1600, 1000);
+  w.show();
+  if (!QTest::qWaitForWindowExposed(&w)) return 1;
+  QElapsedTimer load;
+  load.start();
+  w.openFile(QString::fromStdString(input), {}, "ML <> 'ROAD'");
+  if (!settle(w)) {
+    std::printf("load failed: %s\n", qPrintable(w.lastError()));
+    return 1;
+  }
+  std::printf("cambridge_ma: %zu blocks, %zu observed, %zu procedural parcels; load %.0f ms\n",
+              w.result()->observed->analysis.blocks.size(), w.result()->observedLots.size(),
+              w.result()->generated.parcels.size(), static_cast<double>(load.elapsed()));
+
+  auto measure = [&](const std::string& name, int n, const std::function<void(int)>& change) {
+    Row row{name, {}, 0};
+    for (int i = 0; i < n; ++i) {
+      change(i);
+      if (!settle(w)) {
+        std::printf("%s failed: %s\n", name.c_str(), qPrintable(w.lastError()));
+        std::exit(1);
+      }
+      row.ms.push_back(w.lastLatencyMs());
+    }
+    print(row);
+  };
+  for (const char* style : {"obb", "skeleton"}) {
+    w.setStyle(style);
+    settle(w);
+    std::printf("style %s\n", style);
+    // A block picked by the user: its own A_max, alternating.
+    w.selectBlock(100);
+    measure("  block override (1 block regenerated)", repeats, [&](int i) {
+      w.overrideSelectedBlock({}, {{"a-max", i % 2 ? 400.0 : 600.0}, {"a-min", 100.0}});
+    });
+    w.clearSelectedOverride();
+    settle(w);
+    measure("  colour by another quantity (no regeneration)", repeats, [&](int i) {
+      w.setColourBy(i % 2 ? "area" : "aspect_ratio");
+    });
+    measure("  omega slider (every block regenerated)", std::max(3, repeats / 3), [&](int i) {
+      w.setParameter("omega", 0.2 + 0.05 * (i % 4));
+    });
+    measure("  skeleton-only street-angle slider (obb: none regenerated)", std::max(3, repeats / 3),
+            [&](int i) { w.setParameter("street-angle", 20.0 + i); });
+  }
+  return 0;
+}
