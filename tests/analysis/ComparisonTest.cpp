@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "parcelscope/analysis/Comparison.h"
@@ -184,6 +185,34 @@ TEST(ComparisonTables, PerBlockRowsFollowThePapersTable) {
   const Table s = summaryTable(b.comparison);
   EXPECT_EQ(std::get<std::string>(s.rows[0][0]), "parcels");
   EXPECT_DOUBLE_EQ(std::get<double>(s.rows[0][s.column("generated")]), 2.0);
+}
+
+TEST(ParcelQuantity, NamesValuesAndFiniteSamples) {
+  ParcelMetrics m;
+  m.area = 420;
+  m.width = 12;
+  m.aspectRatio = std::numeric_limits<double>::infinity();
+  m.neighbours = 3;
+  m.streetAccess = true;
+  m.pAngle = 4;
+  m.pArea = 1.1;
+  EXPECT_EQ(parcelQuantities().front().name, "aspect_ratio");
+  EXPECT_EQ(parcelQuantity("area").value(m), 420);
+  EXPECT_EQ(parcelQuantity("width").value(m), 12);
+  EXPECT_EQ(parcelQuantity("neighbours").value(m), 3);
+  EXPECT_EQ(parcelQuantity("street_access").value(m), 1);
+  EXPECT_EQ(parcelQuantity("p_angle").value(m), 4);
+  EXPECT_EQ(parcelQuantity("p_area").value(m), 1.1);
+  ParcelMetrics n = m;
+  n.aspectRatio = 2;
+  EXPECT_EQ(quantitySample({m, n}, parcelQuantity("aspect_ratio")), std::vector<double>{2});
+  try {
+    parcelQuantity("colour");
+    FAIL() << "expected Error(Usage)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::Usage);
+    EXPECT_NE(std::string(e.what()).find("p_area"), std::string::npos) << "lists the names";
+  }
 }
 
 }  // namespace

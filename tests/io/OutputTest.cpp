@@ -76,6 +76,77 @@ TEST(OutputDirectory, NeverOverwritesAnInput) {
   EXPECT_THROW(out.stage("parcels.csv"), Error);
 }
 
+TEST(StagedFile, AppearsOnlyOnCommitAndNeverOverwritesAnInput) {
+  TempDir dir;
+  const std::string target = dir.file("figure.png");
+  {
+    StagedFile f(target, {});
+    EXPECT_EQ(fs::path(f.path()).extension(), ".png");
+    EXPECT_EQ(fs::path(f.path()).parent_path(), dir.path());
+    std::ofstream(f.path()) << "half";
+    EXPECT_FALSE(fs::exists(target));
+  }  // not committed: nothing left behind
+  EXPECT_FALSE(fs::exists(target));
+  EXPECT_TRUE(fs::is_empty(dir.path()));
+  {
+    StagedFile f(target, {});
+    std::ofstream(f.path()) << "whole";
+    f.commit();
+  }
+  EXPECT_EQ(test::slurpFile(target), "whole");
+  const std::string input = dir.write("input.geojson", "{}");
+  EXPECT_THROW(StagedFile(input, {input}), Error);
+  EXPECT_THROW(StagedFile(dir.path().string(), {}), Error);
+  EXPECT_THROW(StagedFile(dir.file("missing/x.png"), {}), Error);
+}
+
+TEST(Writers, ReadJsonKeepsTypesAndOrderAndNamesTheFileOnError) {
+  TempDir dir;
+  const std::string path =
+      dir.write("a.json", R"({"b": 1, "a": [2.5, "x", true, null], "c": {"d": -3}})");
+  const Json j = readJson(path);
+  const auto members = j.members();
+  ASSERT_EQ(members.size(), 3u);
+  EXPECT_EQ(members[0].first, "b");
+  EXPECT_EQ(j.find("b")->number(), 1);
+  const auto a = j.find("a")->elements();
+  ASSERT_EQ(a.size(), 4u);
+  EXPECT_EQ(a[0].number(), 2.5);
+  EXPECT_EQ(a[1].string(), "x");
+  EXPECT_TRUE(a[2].boolean());
+  EXPECT_TRUE(a[3].isNull());
+  EXPECT_EQ(j.find("c")->find("d")->number(), -3);
+  EXPECT_EQ(j.find("z"), nullptr);
+  const std::string bad = dir.write("bad.json", "{\"a\": ");
+  try {
+    readJson(bad);
+    FAIL() << "expected Error(Input)";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::Input);
+    EXPECT_NE(std::string(e.what()).find(bad), std::string::npos);
+  }
+  EXPECT_THROW(readJson(dir.file("none.json")), Error);
+}
+
+TEST(Writers, PolygonLayerAsGeoJson) {
+  TempDir dir;
+  const LocalFrame frame = LocalFrame::geographic(2.35, 48.85);
+  CrsInfo crs;
+  crs.assumedLonLat = true;
+  Table attrs;
+  attrs.columns = {{"block_id", Column::Type::Integer, ""}};
+  attrs.rows = {{std::int64_t(3)}, {std::int64_t(4)}};
+  const std::string path = dir.file("parcels.geojson");
+  writePolygonLayer(path, "parcels", {{rect(0, 0, 10, 10)}, {rect(10, 0, 20, 10)}}, attrs, frame, crs);
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR));
+  ASSERT_TRUE(ds);
+  EXPECT_STREQ(ds->GetDriver()->GetDescription(), "GeoJSON");
+  OGRLayer* layer = ds->GetLayer(0);
+  ASSERT_EQ(layer->GetFeatureCount(), 2);
+  auto f = std::unique_ptr<OGRFeature>(layer->GetNextFeature());
+  EXPECT_EQ(f->GetFieldAsInteger64("block_id"), 3);
+}
+
 TEST(Writers, PolygonLayerGoesBackToTheInputCrs) {
   TempDir dir;
   const LocalFrame frame = LocalFrame::geographic(2.35, 48.85);

@@ -88,6 +88,27 @@ TEST(RenderMaps, HolesStayOpen) {
   EXPECT_NE(image.rgb(300 - 120, cy), 0xffffffu) << "the ring is not drawn";
 }
 
+// A concave shape (ear cutting) fills its own area and leaves its notch empty.
+TEST(RenderMaps, ConcaveShapesFillOnlyThemselves) {
+  TempDir dir;
+  // A U: 100 x 100 with a 40 m wide notch from the top down to y = 30.
+  Polygon u = test::poly({{0, 0}, {100, 0}, {100, 100}, {70, 100}, {70, 30}, {30, 30}, {30, 100}, {0, 100}});
+  MapPanel panel{"U", {&u}, {1.0}};
+  ColourScale scale;
+  scale.title = "value";
+  const FigureOutput out = output(dir, "u", 600, 600);
+  renderMaps("a U", {panel}, scale, out);
+  const test::Image image = test::readPng(out.png);
+  ASSERT_EQ(image.width, 600);
+  // Map band from 13 % to 85 % of the height; the U spans it vertically with a margin.
+  const int top = static_cast<int>(600 * (1 - 0.87)), bottom = static_cast<int>(600 * (1 - 0.15));
+  const int notchY = top + (bottom - top) / 4;      // y = 75 in the U
+  const int baseY = top + 7 * (bottom - top) / 8;   // y = 12
+  EXPECT_EQ(image.rgb(300, notchY), 0xffffffu) << "the notch is filled";
+  EXPECT_NE(image.rgb(300, baseY), 0xffffffu) << "the base of the U is empty";
+  EXPECT_NE(image.rgb(300 - 200, notchY), 0xffffffu) << "the left arm is empty";
+}
+
 TEST(RenderMaps, RefusesMismatchedValuesAndEmptyMaps) {
   TempDir dir;
   const Polygon square = rect(0, 0, 1, 1);
