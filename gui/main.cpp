@@ -1,5 +1,5 @@
 // parcelscope-gui [INPUT] [--layer L] [--where SQL] [--crs EPSG:N] [--session FILE] [--sample]
-//                 [--screenshot PNG]
+//                 [--subdivision-style STYLE] [--screenshot PNG]
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QSurfaceFormat>
@@ -23,13 +23,15 @@ int main(int argc, char** argv) {
   const QCommandLineOption crs("crs", "CRS of the input, replacing a missing or wrong one", "CRS");
   const QCommandLineOption session("session", "session file to restore", "FILE");
   const QCommandLineOption sample("sample", "open the bundled sample");
+  const QCommandLineOption style("subdivision-style", "subdivision style: obb, skeleton, offset or auto (Qt takes --style for its widget style)", "STYLE");
   const QCommandLineOption screenshot("screenshot", "save the window as PNG once it shows its first result, then quit",
                                       "PNG");
-  parser.addOptions({layer, where, crs, session, sample, screenshot});
+  parser.addOptions({layer, where, crs, session, sample, style, screenshot});
   parser.process(app);
 
   parcelscope::gui::MainWindow window;
   window.show();
+  if (parser.isSet(style)) window.setStyle(parser.value(style));
   if (parser.isSet(screenshot)) {
     const QString path = parser.value(screenshot);
     QObject::connect(&window, &parcelscope::gui::MainWindow::viewsUpdated, &window, [&window, path] {
