@@ -22,6 +22,8 @@
 #include <QScrollArea>
 #include <QSettings>
 #include <QSplitter>
+#include <QStandardPaths>
+#include <QTimer>
 #include <QStatusBar>
 #include <QTableWidget>
 #include <QToolBar>
@@ -109,7 +111,12 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
     if (serial == pendingSerial_) failedOrCancelled_ = true;
     progress_->setVisible(false);
     cancel_->setVisible(false);
-    showError(message);
+    // A CRS the reader cannot use: say so, and offer to give one.
+    const bool crsProblem = message.contains("CRS");
+    showError(crsProblem ? message + "  (File > Set input CRS gives the input another CRS)" : message);
+    if (crsProblem && serial == pendingSerial_ && !QStandardPaths::isTestModeEnabled()) {
+      QTimer::singleShot(0, this, [this] { askForCrs(); });
+    }
   });
   connect(worker_, &SessionWorker::cancelled, this, [this](qint64 serial) {
     if (serial == pendingSerial_) {
@@ -304,13 +311,7 @@ void MainWindow::buildMenus() {
   file->addAction("Open &sample", this, [this] { openSample(); });
   recentMenu_ = file->addMenu("Open &recent");
   refreshRecent();
-  file->addAction("Set input &CRS...", this, [this] {
-    bool ok = false;
-    const QString crs = QInputDialog::getText(this, "Input CRS", "CRS of the input (e.g. EPSG:2249), empty: as declared",
-                                              QLineEdit::Normal, QString::fromStdString(request_.input.crsOverride), &ok);
-    if (ok && loaded_) openFile(QString::fromStdString(request_.input.path), QString::fromStdString(request_.input.layer),
-                                QString::fromStdString(request_.input.where), crs);
-  });
+  file->addAction("Set input &CRS...", this, [this] { askForCrs(); });
   file->addSeparator();
   file->addAction("Open session...", this, [this] {
     const QString path = QFileDialog::getOpenFileName(this, "Open session", {}, "ParcelScope session (*.json)");
@@ -337,6 +338,18 @@ void MainWindow::buildMenus() {
   QToolBar* bar = addToolBar("Main");
   bar->setObjectName("mainToolBar");
   bar->addAction("Open sample", this, [this] { openSample(); });
+}
+
+void MainWindow::askForCrs() {
+  if (!loaded_) return showError("open a dataset first");
+  bool ok = false;
+  const QString crs =
+      QInputDialog::getText(this, "Input CRS", "CRS of the input (e.g. EPSG:2249); empty: as the file declares it",
+                            QLineEdit::Normal, QString::fromStdString(request_.input.crsOverride), &ok);
+  if (ok) {
+    openFile(QString::fromStdString(request_.input.path), QString::fromStdString(request_.input.layer),
+             QString::fromStdString(request_.input.where), crs.trimmed());
+  }
 }
 
 void MainWindow::openFile(const QString& path, const QString& layer, const QString& where, const QString& crs) {

@@ -105,6 +105,7 @@ private:
   void rememberRecent(const QString& path);
   void refreshRecent();
   void exportFigureDialog();
+  void askForCrs();
 
   QThread thread_;
   SessionWorker* worker_;
