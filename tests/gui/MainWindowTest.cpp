@@ -6,6 +6,9 @@
 #include <QDoubleSpinBox>
 #include <QDir>
 #include <QLabel>
+#include <QMimeData>
+#include <QUrl>
+#include <QDragEnterEvent>
 #include <QSignalSpy>
 #include <QSlider>
 #include <QStandardPaths>
@@ -81,6 +84,26 @@ private slots:
     QCOMPARE(static_cast<int>(window_->result()->generated.parcels.size()), libraryParcelCount());
     QCOMPARE(window_->histogramCounts().size(), std::size_t(2));
     QVERIFY(window_->numbers()->rowCount() > 10);
+    // Linked views: one camera, so a zoom in one is a zoom in the other.
+    QCOMPARE(window_->observedView()->camera(), window_->proceduralView()->camera());
+  }
+
+  void droppingAFileOpensIt() {
+    QMimeData data;
+    data.setUrls({QUrl::fromLocalFile(QString(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_town.geojson")});
+    QDragEnterEvent enter(QPoint(10, 10), Qt::CopyAction, &data, Qt::LeftButton, Qt::NoModifier);
+    QApplication::sendEvent(window_, &enter);
+    QVERIFY(enter.isAccepted());
+    QDropEvent drop(QPointF(10, 10), Qt::CopyAction, &data, Qt::LeftButton, Qt::NoModifier);
+    QApplication::sendEvent(window_, &drop);
+    QVERIFY(settle());
+    // Opened as dropped: without the sample's right-of-way filter, so its street
+    // features are read too.
+    QCOMPARE(window_->request().input.where, std::string());
+    QVERIFY(window_->lastError().isEmpty());
+    QVERIFY(window_->result()->observed->layer.parcels.size() > 168);
+    window_->openSample();
+    QVERIFY(settle());
   }
 
   void movingASliderRegeneratesLikeTheLibrary() {
