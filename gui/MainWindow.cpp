@@ -502,6 +502,7 @@ void MainWindow::setColourBy(const QString& quantity) {
   observedView_->render();
   proceduralView_->render();
   lastLatencyMs_ = static_cast<double>(t.nsecsElapsed()) / 1e6;
+  lastFirstViewMs_ = lastLatencyMs_;
   emit viewsUpdated(shownSerial_);
 }
 
@@ -534,15 +535,19 @@ void MainWindow::submit() {
   failedOrCancelled_ = false;
   pendingSerial_ = worker_->submit(request_);
   started_[pendingSerial_].start();
+  firstViewMs_ = -1;
   status_->setText("updating...");
 }
 
 void MainWindow::showReport(const UpdateReport& report) {
+  if (report.partial && report.serial != pendingSerial_) return;  // superseded already
   const bool first = !result_ || report.reloaded;
   result_ = report.result;
-  shownSerial_ = report.serial;
-  progress_->setVisible(false);
-  cancel_->setVisible(false);
+  if (!report.partial) {
+    shownSerial_ = report.serial;
+    progress_->setVisible(false);
+    cancel_->setVisible(false);
+  }
   const viz::CompareResult& r = *result_;
   if (first) selected_ = -1;
 
@@ -588,10 +593,20 @@ void MainWindow::showReport(const UpdateReport& report) {
   proceduralView_->render();
 
   const auto it = started_.find(report.serial);
+  if (report.partial) {
+    if (it != started_.end() && firstViewMs_ < 0) firstViewMs_ = static_cast<double>(it->second.nsecsElapsed()) / 1e6;
+    status_->setText(QString("regenerating: %1 of %2 block parts done, the others shown as before")
+                         .arg(report.blocksRegenerated)
+                         .arg(report.blocksTotal));
+    emit partialShown(report.serial);
+    return;
+  }
   if (it != started_.end()) {
     lastLatencyMs_ = static_cast<double>(it->second.nsecsElapsed()) / 1e6;
+    lastFirstViewMs_ = firstViewMs_ < 0 ? lastLatencyMs_ : firstViewMs_;
     started_.erase(started_.begin(), std::next(it));
   }
+  firstViewMs_ = -1;
   status_->setText(QString("%1 blocks, %2 observed and %3 procedural parcels; %4 of %5 block parts regenerated; %6 ms")
                        .arg(a.blocks.size())
                        .arg(r.observedLots.size())

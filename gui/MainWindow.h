@@ -78,6 +78,9 @@ public:
   QString lastError() const;
   /// Milliseconds from the last submitted change to views and histograms drawn.
   double lastLatencyMs() const { return lastLatencyMs_; }
+  /// Milliseconds from the last completed change to the first views drawn for
+  /// it (a result in between, while many blocks are regenerated, or the final one).
+  double lastFirstViewMs() const { return lastFirstViewMs_; }
   /// True while an update is queued or under way.
   bool busy() const { return pendingSerial_ != shownSerial_ && !failedOrCancelled_; }
 
@@ -85,6 +88,8 @@ signals:
   /// Views, histograms and numbers show the result of request serial `serial`.
   void viewsUpdated(qint64 serial);
   void errorShown(const QString& message);
+  /// A result in between is shown (see viz::CompareSession::PartialFn).
+  void partialShown(qint64 serial);
 
 protected:
   void dragEnterEvent(QDragEnterEvent* event) override;
@@ -116,6 +121,7 @@ private:
   bool failedOrCancelled_ = false;
   std::map<qint64, QElapsedTimer> started_;
   double lastLatencyMs_ = 0;
+  double firstViewMs_ = -1, lastFirstViewMs_ = 0;
   int selected_ = -1;
   std::vector<std::vector<int>> histogramCounts_;
   std::string shownQuantity_;

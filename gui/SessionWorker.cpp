@@ -49,7 +49,19 @@ void SessionWorker::process() {
       return latest_.load() == serial;
     };
     try {
-      const viz::CompareSession::Update u = session_.update(request, progress);
+      const auto partial = [&](std::shared_ptr<const viz::CompareResult> result, std::size_t done,
+                               std::size_t total) {
+        if (latest_.load() != serial) return;  // a newer request is waiting: no point drawing this one
+        UpdateReport report;
+        report.result = std::move(result);
+        report.request = request;
+        report.serial = serial;
+        report.blocksRegenerated = static_cast<int>(done);
+        report.blocksTotal = static_cast<int>(total);
+        report.partial = true;
+        emit updated(report);
+      };
+      const viz::CompareSession::Update u = session_.update(request, progress, partial);
       UpdateReport report;
       report.result = u.result;
       report.request = request;

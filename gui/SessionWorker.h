@@ -23,6 +23,9 @@ struct UpdateReport {
   int blocksRegenerated = 0;
   int blocksTotal = 0;
   double seconds = 0;
+  /// A result in between: `blocksRegenerated` of `blocksTotal` block parts are
+  /// new, the others as before; the final report follows.
+  bool partial = false;
 };
 
 class SessionWorker : public QObject {

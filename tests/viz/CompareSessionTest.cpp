@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <random>
 
@@ -143,6 +144,57 @@ TEST(CompareSession, RandomEditSequencesMatchAFreshCompare) {
     expectBlocksTiled(*u.result);
   }
   expectSameResult(*session.current(), compare(request));
+}
+
+// 48 blocks of four 20 x 40 m parcels each, 10 m streets, in UTM 31N.
+std::string gridOfBlocks(const TempDir& dir) {
+  std::string features;
+  for (int bx = 0; bx < 8; ++bx) {
+    for (int by = 0; by < 6; ++by) {
+      for (int p = 0; p < 4; ++p) {
+        const double x0 = 500000 + bx * 90 + (p % 2) * 40, y0 = 5000000 + by * 90 + (p / 2) * 40;
+        char f[512];
+        std::snprintf(f, sizeof f,
+                      R"(%s{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[%.1f,%.1f],[%.1f,%.1f],[%.1f,%.1f],[%.1f,%.1f],[%.1f,%.1f]]]}})",
+                      features.empty() ? "" : ",", x0, y0, x0 + 40, y0, x0 + 40, y0 + 40, x0, y0 + 40, x0, y0);
+        features += f;
+      }
+    }
+  }
+  return dir.write("grid.geojson", R"({"type":"FeatureCollection","crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::32631"}},"features":[)" +
+                                        features + "]}");
+}
+
+// While many blocks are regenerated, results in between mix new and old
+// blocks, each block still tiled; the final result equals compare().
+TEST(CompareSession, ResultsInBetweenTileEveryBlock) {
+  TempDir dir;
+  CompareRequest request = sampleRequest();
+  request.input = {};
+  request.input.path = gridOfBlocks(dir);
+  request.parameters["a-max"] = 300;
+  request.parameters["w-max"] = 12;
+  request.explicitParameters = {"a-max", "w-max"};
+  CompareSession session;
+  const auto first = session.update(request);
+  ASSERT_EQ(first.blocksTotal, 48u);
+  request.style = "skeleton";
+  std::size_t calls = 0, lastDone = 0;
+  const auto u = session.update(
+      request, {},
+      [&](std::shared_ptr<const CompareResult> r, std::size_t done, std::size_t total) {
+        ++calls;
+        EXPECT_EQ(total, 48u);
+        EXPECT_GT(done, lastDone);
+        EXPECT_LT(done, total);
+        lastDone = done;
+        expectBlocksTiled(*r);
+      },
+      0.0);
+  EXPECT_EQ(u.blocksRegenerated, 48u);
+  std::printf("%zu results in between\n", calls);
+  EXPECT_GT(calls, 0u);
+  expectSameResult(*u.result, compare(request));
 }
 
 TEST(CompareSession, CancelledUpdateLeavesTheLastResult) {

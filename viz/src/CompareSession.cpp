@@ -1,6 +1,7 @@
 #include "parcelscope/viz/CompareSession.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 
@@ -45,7 +46,8 @@ CompareSession::~CompareSession() = default;
 
 std::shared_ptr<const CompareResult> CompareSession::current() const { return state_->current; }
 
-CompareSession::Update CompareSession::update(const CompareRequest& request, const ProgressFn& progress) {
+CompareSession::Update CompareSession::update(const CompareRequest& request, const ProgressFn& progress,
+                                              const PartialFn& partial, double partialSeconds) {
   const auto started = std::chrono::steady_clock::now();
   detail::checkRequest(request);
   State& s = *state_;
@@ -92,6 +94,42 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   }
   const double minFrontage = compareValue(request, "min-frontage");
   std::vector<std::shared_ptr<const generation::BlockOutcome>> made(todo.size());
+  // Set (release) once made[t] is written, so the progress tick may read it.
+  std::unique_ptr<std::atomic<bool>[]> ready(new std::atomic<bool>[todo.size()]);
+  for (std::size_t t = 0; t < todo.size(); ++t) ready[t] = false;
+  const bool partials = partial && !newInputs &&
+                        std::all_of(outcomes.begin(), outcomes.end(), [](const auto& o) { return o != nullptr; });
+  // The first result in between comes after a fifth of the interval, so that
+  // an edit shows something soon; then one per interval.
+  auto lastPartial = std::chrono::steady_clock::now() -
+                     std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                         std::chrono::duration<double>(0.8 * partialSeconds));
+  std::size_t partialDone = 0;
+  auto emitPartial = [&] {
+    std::vector<const generation::BlockOutcome*> pointers;
+    std::vector<generation::BlockPlan> mixed = done;
+    for (const auto& o : outcomes) pointers.push_back(o.get());
+    std::size_t n = 0;
+    std::vector<char> keep(observed->analysis.blocks.size(), 1);
+    for (std::size_t t = 0; t < todo.size(); ++t) {
+      if (!ready[t].load(std::memory_order_acquire)) continue;
+      pointers[todo[t]] = made[t].get();
+      mixed[todo[t]] = plans[todo[t]];
+      keep[static_cast<std::size_t>(inputs.entries[todo[t]].blockId)] = 0;
+      ++n;
+    }
+    if (n == partialDone) return;
+    partialDone = n;
+    CompareResult r;
+    r.observed = observed;
+    const auto seedIt = request.parameters.find("seed");
+    r.generated = generation::assembleParcels(
+        inputs, mixed, pointers, seedIt == request.parameters.end() ? 1 : static_cast<std::uint64_t>(seedIt->second));
+    r.blocks = s.current->blocks;
+    r.observedLots = s.current->observedLots;
+    detail::compareStage(r, request, &keep);
+    partial(std::make_shared<const CompareResult>(std::move(r)), n, todo.size());
+  };
   const ProgressFn sub = scaledProgress(progress, reload ? 0.5 : 0.0, 0.95);
   auto keepFinished = [&] {
     for (std::size_t t = 0; t < todo.size(); ++t) {
@@ -109,9 +147,14 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
         [&](std::size_t t) {
           made[t] = std::make_shared<const generation::BlockOutcome>(
               generation::runBlock(inputs, todo[t], plans[todo[t]], minFrontage));
+          ready[t].store(true, std::memory_order_release);
         },
         tick ? std::function<void(std::size_t)>([&](std::size_t n) {
           reportProgress(sub, static_cast<double>(n) / static_cast<double>(todo.size()), "subdividing");
+          if (partials && secondsSince(lastPartial) >= partialSeconds && n < todo.size()) {
+            emitPartial();
+            lastPartial = std::chrono::steady_clock::now();
+          }
         })
              : std::function<void(std::size_t)>());
   } catch (const Error& e) {

@@ -11,6 +11,7 @@
 // per-block overrides, seed and figure quantity. `parcelscope compare --session
 // FILE` runs one; the GUI saves and restores them.
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -34,10 +35,21 @@ public:
     double seconds = 0;
   };
 
+  /// A result in between, while many blocks are regenerated: the blocks done
+  /// so far with their new parcels, every other block as it was (each block a
+  /// complete subdivision, so the whole still tiles every block), measured and
+  /// compared. `done` of `total` block parts are new.
+  using PartialFn =
+      std::function<void(std::shared_ptr<const CompareResult> result, std::size_t done, std::size_t total)>;
+
   /// Brings the result up to date with `request`. Throws as compare(); on
   /// Error(Cancelled) (progress returned false) the blocks finished so far are
-  /// kept for the next update and current() is unchanged.
-  Update update(const CompareRequest& request, const ProgressFn& progress = {});
+  /// kept for the next update and current() is unchanged. When `partial` is
+  /// set and the update regenerates blocks that all had a result before, it is
+  /// called (on this thread) with a result in between, the first after
+  /// partialSeconds / 5, then at most every `partialSeconds`.
+  Update update(const CompareRequest& request, const ProgressFn& progress = {}, const PartialFn& partial = {},
+                double partialSeconds = 0.5);
 
   /// The last result (null before the first update).
   std::shared_ptr<const CompareResult> current() const;
