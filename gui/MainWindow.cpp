@@ -424,6 +424,11 @@ void MainWindow::saveSession(const QString& path) {
 
 void MainWindow::exportFigure(const QString& name, const QString& path, int width, int height) {
   if (!result_) return showError("nothing to export yet: open a dataset first");
+  // Rendering a figure of a whole city takes a few seconds; say so.
+  QApplication::setOverrideCursor(Qt::WaitCursor);
+  struct RestoreCursor {
+    ~RestoreCursor() { QApplication::restoreOverrideCursor(); }
+  } restore;
   try {
     viz::exportFigure(*result_, request_, name.toStdString(), path.toStdString(), width, height);
     status_->setText(name + " exported to " + path);
