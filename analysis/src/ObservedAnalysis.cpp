@@ -155,11 +155,15 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
 
   out.timings.start("metrics");
   // 1. Shape metrics.
+  // Boxes of every ring grown by half the contact tolerance: their pairs are
+  // the candidates for contacts, and include every pair of parcels where one
+  // can lie inside the other (it lies inside the other's box).
+  const double contactTolerance = std::max(tol, 1e-6);
   std::vector<Box> boxes(n);
   std::vector<Point> inside(n);
   parallelFor(n, [&](std::size_t i) {
     static_cast<ShapeMetrics&>(out.metrics[i]) = shapeMetrics(parcels[i].shape);
-    boxes[i] = bounds(parcels[i].shape).expanded(0.5 * tol);
+    boxes[i] = detail::contactBox(parcels[i].shape, contactTolerance);
     inside[i] = interiorPoint(parcels[i].shape);
   });
   reportProgress(progress, 0.1, "metrics");
@@ -168,11 +172,11 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
   // 2. Shared boundaries (neighbours) and closeness, edge by edge.
   std::vector<const Polygon*> shapes(n);
   for (std::size_t i = 0; i < n; ++i) shapes[i] = &parcels[i].shape;
-  const auto touching = detail::contacts(shapes, std::max(tol, 1e-6), sharedTolerance(tol));
+  // Overlapping boxes also find parcels lying inside others without touching them.
+  const auto pairs = detail::intersectingPairs(boxes);
+  const auto touching = detail::contacts(shapes, pairs, contactTolerance, sharedTolerance(tol));
   countNeighbours(touching, out.metrics);
   reportProgress(progress, 0.3, "neighbours");
-  // Overlapping boxes find parcels lying inside others without touching them.
-  const auto pairs = detail::intersectingPairs(boxes);
 
   out.timings.start("right_of_way");
   // 3. Right-of-way parcels.

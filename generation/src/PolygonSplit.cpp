@@ -7,6 +7,8 @@
 
 #include "Exact.h"
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
 namespace parcelscope::generation::detail {
 
 P2 toExact(const Ring& ring) {
@@ -226,6 +228,14 @@ bool isValidExact(const PWH& p) {
 
 bool isValidForSplit(const Polygon& polygon) {
   if (polygon.outer.size() < 3) return false;
+  if (polygon.holes.empty()) {
+    // A strictly simple ring is valid (toExact orients it). Epick's test is
+    // exact on double coordinates and far cheaper than the Boolean-operations
+    // validation, which still judges everything else (touching rings, holes).
+    CGAL::Polygon_2<CGAL::Exact_predicates_inexact_constructions_kernel> ring;
+    for (const Point& v : polygon.outer) ring.push_back({v.x, v.y});
+    if (ring.is_simple()) return true;
+  }
   return isValidExact(toExact(polygon));
 }
 
@@ -244,6 +254,95 @@ SplitPieces splitByLine(const Polygon& polygon, const Point& pivot, const Point&
     }
   }
   return out;
+}
+
+}  // namespace parcelscope::generation::detail
+
+namespace parcelscope::generation::detail {
+
+namespace {
+// Side of q relative to the directed line through `pivot` along `dir`: 1 left,
+// -1 right, 0 on it; exact. The floating-point value decides when its sign is
+// certain: each of the two products carries one rounded difference, and 1e-15
+// of their magnitudes bounds the rounding error of the whole expression with a
+// wide margin (3.4e-16 would do). Otherwise the exact kernel decides.
+int sideOf(const Point& q, const Point& pivot, const Point& dir) {
+  if (q.x == pivot.x && q.y == pivot.y) return 0;
+  const double a = dir.x * (q.y - pivot.y), b = dir.y * (q.x - pivot.x);
+  const double det = a - b;
+  if (std::fabs(det) > 1e-15 * (std::fabs(a) + std::fabs(b))) return det > 0 ? 1 : -1;
+  const K::Point_2 through(pivot.x, pivot.y);
+  const CGAL::Orientation o = CGAL::orientation(through, through + K::Vector_2(dir.x, dir.y), K::Point_2(q.x, q.y));
+  return o == CGAL::LEFT_TURN ? 1 : o == CGAL::RIGHT_TURN ? -1 : 0;
+}
+}  // namespace
+
+bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& dir, SplitPieces& out) {
+  if (!polygon.holes.empty()) return false;
+  const Ring& r = polygon.outer;
+  const std::size_t n = r.size();
+  if (n < 3) return false;
+  std::vector<signed char> side(n);
+  std::size_t left = 0, right = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    side[i] = static_cast<signed char>(sideOf(r[i], pivot, dir));
+    left += side[i] > 0;
+    right += side[i] < 0;
+  }
+  if (left == 0 || right == 0) {
+    // Nothing on one side. (A ring touching the line along an edge is left to
+    // the exact split, which knows what to do with it.)
+    if (left + right + 1 < n) return false;
+    SplitPieces whole;
+    (left ? whole.left : whole.right).push_back(polygon);
+    out = std::move(whole);
+    return true;
+  }
+  // The line must cross the boundary exactly twice: at edges whose ends lie on
+  // opposite sides, or at vertices on the line between opposite sides. Any
+  // vertex on the line that is not such a crossing (a touch, or an edge along
+  // the line) is left to the exact split.
+  std::size_t crossings = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const int s = side[i], next = side[(i + 1) % n], prev = side[(i + n - 1) % n];
+    if (s == 0) {
+      if (prev * next >= 0) return false;
+      ++crossings;
+    } else {
+      crossings += s * next < 0;
+    }
+  }
+  if (crossings != 2) return false;
+  Polygon pieces[2];  // left, right
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point& a = r[i];
+    const Point& b = r[(i + 1) % n];
+    if (side[i] >= 0) pieces[0].outer.push_back(a);
+    if (side[i] <= 0) pieces[1].outer.push_back(a);
+    if (side[i] * side[(i + 1) % n] >= 0) continue;
+    // The crossing, from the segment taken in x-then-y order, clamped to it.
+    const bool forward = a.x < b.x || (a.x == b.x && a.y < b.y);
+    const Point& s = forward ? a : b;
+    const Point& e = forward ? b : a;
+    const double sex = e.x - s.x, sey = e.y - s.y;
+    double t = ((pivot.x - s.x) * dir.y - (pivot.y - s.y) * dir.x) / (sex * dir.y - sey * dir.x);
+    t = std::clamp(t, 0.0, 1.0);
+    const Point x = t == 1.0 ? e : Point{s.x + sex * t, s.y + sey * t};
+    pieces[0].outer.push_back(x);
+    pieces[1].outer.push_back(x);
+  }
+  SplitPieces result;
+  for (int k = 0; k < 2; ++k) {
+    Ring& ring = pieces[k].outer;
+    // Start at the lowest vertex in x-then-y order.
+    const auto first = std::min_element(ring.begin(), ring.end(), [](const Point& p, const Point& q) {
+      return p.x < q.x || (p.x == q.x && p.y < q.y);
+    });
+    std::rotate(ring.begin(), first, ring.end());
+    if (normalise(pieces[k])) (k == 0 ? result.left : result.right).push_back(std::move(pieces[k]));
+  }
+  out = std::move(result);
+  return true;
 }
 
 }  // namespace parcelscope::generation::detail
