@@ -298,48 +298,88 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
     out = std::move(whole);
     return true;
   }
-  // The line must cross the boundary exactly twice: at edges whose ends lie on
-  // opposite sides, or at vertices on the line between opposite sides. Any
-  // vertex on the line that is not such a crossing (a touch, or an edge along
-  // the line) is left to the exact split.
-  std::size_t crossings = 0;
+  // The ring with its crossings: vertices, and points inserted on edges whose
+  // ends lie on opposite sides. Every vertex on the line must be a crossing
+  // too (between opposite sides); a touch or an edge along the line is left to
+  // the exact split.
+  struct Node {
+    Point p;
+    int side;         // of the vertex; 0 on the line
+    int partner = -1; // on the line: the other end of its cut
+    double along = 0; // on the line: position along it
+  };
+  std::vector<Node> nodes;
+  nodes.reserve(n + 8);
   for (std::size_t i = 0; i < n; ++i) {
-    const int s = side[i], next = side[(i + 1) % n], prev = side[(i + n - 1) % n];
-    if (s == 0) {
-      if (prev * next >= 0) return false;
-      ++crossings;
-    } else {
-      crossings += s * next < 0;
-    }
-  }
-  if (crossings != 2) return false;
-  Polygon pieces[2];  // left, right
-  for (std::size_t i = 0; i < n; ++i) {
+    const int s = side[i], next = side[(i + 1) % n];
+    if (s == 0 && side[(i + n - 1) % n] * next >= 0) return false;
+    nodes.push_back({r[i], s});
+    if (s * next >= 0) continue;
+    // The crossing, from the segment taken in x-then-y order, clamped to it.
     const Point& a = r[i];
     const Point& b = r[(i + 1) % n];
-    if (side[i] >= 0) pieces[0].outer.push_back(a);
-    if (side[i] <= 0) pieces[1].outer.push_back(a);
-    if (side[i] * side[(i + 1) % n] >= 0) continue;
-    // The crossing, from the segment taken in x-then-y order, clamped to it.
     const bool forward = a.x < b.x || (a.x == b.x && a.y < b.y);
-    const Point& s = forward ? a : b;
-    const Point& e = forward ? b : a;
-    const double sex = e.x - s.x, sey = e.y - s.y;
-    double t = ((pivot.x - s.x) * dir.y - (pivot.y - s.y) * dir.x) / (sex * dir.y - sey * dir.x);
-    t = std::clamp(t, 0.0, 1.0);
-    const Point x = t == 1.0 ? e : Point{s.x + sex * t, s.y + sey * t};
-    pieces[0].outer.push_back(x);
-    pieces[1].outer.push_back(x);
+    const Point& from = forward ? a : b;
+    const Point& to = forward ? b : a;
+    const double dx = to.x - from.x, dy = to.y - from.y;
+    const double t = std::clamp(((pivot.x - from.x) * dir.y - (pivot.y - from.y) * dir.x) / (dx * dir.y - dy * dir.x),
+                                0.0, 1.0);
+    nodes.push_back({t == 1.0 ? to : Point{from.x + dx * t, from.y + dy * t}, 0});
   }
+  const std::size_t m = nodes.size();
+  auto sideBefore = [&](std::size_t k) { return nodes[(k + m - 1) % m].side; };
+  auto sideAfter = [&](std::size_t k) { return nodes[(k + 1) % m].side; };
+  // Cuts: the crossings in order along the line, paired first with second,
+  // third with fourth, and so on; each pair must join a crossing where the ring
+  // leaves the left side to one where it comes back. Crossings too close
+  // along the line to be ordered with certainty are left to the exact split.
+  std::vector<std::size_t> crossings;
+  for (std::size_t k = 0; k < m; ++k) {
+    if (nodes[k].side != 0) continue;
+    nodes[k].along = (nodes[k].p.x - pivot.x) * dir.x + (nodes[k].p.y - pivot.y) * dir.y;
+    crossings.push_back(k);
+  }
+  if (crossings.size() % 2 != 0) return false;
+  std::sort(crossings.begin(), crossings.end(),
+            [&](std::size_t x, std::size_t y) { return nodes[x].along < nodes[y].along; });
+  const Box b = bounds(r);
+  const double separation = 1e-9 * (b.width() + b.height());
+  for (std::size_t c = 0; c + 1 < crossings.size(); ++c) {
+    if (!(nodes[crossings[c + 1]].along - nodes[crossings[c]].along > separation)) return false;
+  }
+  for (std::size_t c = 0; c < crossings.size(); c += 2) {
+    const std::size_t x = crossings[c], y = crossings[c + 1];
+    if (sideBefore(x) == sideBefore(y)) return false;
+    nodes[x].partner = static_cast<int>(y);
+    nodes[y].partner = static_cast<int>(x);
+  }
+  // Each piece: along the ring on its side; where the ring leaves that side,
+  // across the cut to its other end, and on along the ring from there.
   SplitPieces result;
-  for (int k = 0; k < 2; ++k) {
-    Ring& ring = pieces[k].outer;
-    // Start at the lowest vertex in x-then-y order.
-    const auto first = std::min_element(ring.begin(), ring.end(), [](const Point& p, const Point& q) {
-      return p.x < q.x || (p.x == q.x && p.y < q.y);
-    });
-    std::rotate(ring.begin(), first, ring.end());
-    if (normalise(pieces[k])) (k == 0 ? result.left : result.right).push_back(std::move(pieces[k]));
+  std::vector<char> visited(m, 0);
+  for (const int s : {1, -1}) {
+    for (std::size_t start = 0; start < m; ++start) {
+      if (nodes[start].side != s || visited[start]) continue;
+      Polygon piece;
+      std::size_t k = start;
+      for (std::size_t steps = 0;; ++steps) {
+        if (steps > 2 * m) return false;  // not a closed walk: leave it to the exact split
+        piece.outer.push_back(nodes[k].p);
+        visited[k] = 1;
+        if (nodes[k].side == 0 && sideAfter(k) == -s) {
+          k = static_cast<std::size_t>(nodes[k].partner);
+          piece.outer.push_back(nodes[k].p);
+        }
+        k = (k + 1) % m;
+        if (k == start) break;
+      }
+      // Start at the lowest vertex in x-then-y order.
+      Ring& ring = piece.outer;
+      std::rotate(ring.begin(), std::min_element(ring.begin(), ring.end(), [](const Point& p, const Point& q) {
+                    return p.x < q.x || (p.x == q.x && p.y < q.y);
+                  }), ring.end());
+      if (normalise(piece)) (s > 0 ? result.left : result.right).push_back(std::move(piece));
+    }
   }
   out = std::move(result);
   return true;

@@ -20,12 +20,13 @@ struct SplitPieces {
 };
 SplitPieces splitByLine(const Polygon& polygon, const Point& pivot, const Point& dir);
 
-/// The same split in floating point, for the common case only: a polygon
-/// without holes that the line crosses exactly twice, every vertex clearly on
-/// one side (the sign of its offset from the line is certain despite rounding).
-/// The two crossing points are computed once and shared by both pieces.
-/// False, with `out` untouched, when the case is not that one: then the exact
-/// `splitByLine` must be used.
+/// The same split in floating point, for a polygon without holes whose
+/// vertices on the line (exactly: the side of every vertex is certain) are
+/// crossings between opposite sides: the crossing points are computed once and
+/// shared by the pieces on both sides, and paired into cuts in their order
+/// along the line. False, with `out` untouched, for anything else (holes, a
+/// touch, an edge along the line, crossings too close along the line to order):
+/// then the exact `splitByLine` must be used.
 bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& dir, SplitPieces& out);
 
 }  // namespace parcelscope::generation::detail
