@@ -258,9 +258,10 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
                        "blocks");
       });
   out.timings.start("frontage_and_statistics");
-  for (std::size_t b = 0; b < out.blocks.size(); ++b) {
+  // Blocks in parallel: each writes only its own parcels' frontage.
+  out.statistics.resize(out.blocks.size());
+  parallelFor(out.blocks.size(), [&](std::size_t b) {
     const Block& block = out.blocks[b];
-    if (block.parts.size() > 1) ++out.multipartBlocks;
     const int withAccess = measureFrontage(block, shapes, tol, options.minFrontage, out.metrics);
     std::vector<double> areas, widths;
     for (int i : block.parcels) {
@@ -271,9 +272,12 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
     s.blockId = block.id;
     for (const Polygon& part : block.parts) s.blockArea += area(part);
     s.streetAccessShare = static_cast<double>(withAccess) / static_cast<double>(block.parcels.size());
-    out.clampedAMin += s.aMinClamped;
-    out.clampedWMin += s.wMinClamped;
-    out.statistics.push_back(s);
+    out.statistics[b] = s;
+  });
+  for (std::size_t b = 0; b < out.blocks.size(); ++b) {
+    if (out.blocks[b].parts.size() > 1) ++out.multipartBlocks;
+    out.clampedAMin += out.statistics[b].aMinClamped;
+    out.clampedWMin += out.statistics[b].wMinClamped;
   }
   reportProgress(progress, 1.0, "blocks");
   out.timings.stop();
@@ -289,7 +293,7 @@ std::vector<ParcelMetrics> measureParcels(const std::vector<Polygon>& shapes, co
   std::vector<const Polygon*> all;
   for (const Polygon& s : shapes) all.push_back(&s);
   countNeighbours(detail::contacts(all, std::max(tolerance, 1e-6), sharedTolerance(tolerance)), metrics);
-  for (const Block& block : blocks) measureFrontage(block, all, tolerance, minFrontage, metrics);
+  parallelFor(blocks.size(), [&](std::size_t b) { measureFrontage(blocks[b], all, tolerance, minFrontage, metrics); });
   return metrics;
 }
 
