@@ -141,9 +141,13 @@ private:
       if (area(part) < p_.aMin || minimumAreaBox(part.outer).width < p_.wMin) return Verdict::TooSmall;
     }
     for (const Polygon& part : parts) {
-      // GEOS validity, skipped for rings the conservative test already proves simple.
       if (!cutIsClean(part, through, dir)) return Verdict::Unclean;
-      if (!(part.holes.empty() && isClearlySimple(part.outer)) && !io::isValid(part)) return Verdict::Unclean;
+      // GEOS validity, skipped for rings proven simple (a ring with no holes
+      // and non-zero area is valid when simple): the quadratic conservative
+      // test for short rings, the exact sweep for long ones.
+      const bool simple = part.holes.empty() && (part.outer.size() <= 16 ? isClearlySimple(part.outer)
+                                                                          : detail::isStrictlySimple(part.outer));
+      if (!simple && !io::isValid(part)) return Verdict::Unclean;
     }
     return Verdict::Admissible;
   }

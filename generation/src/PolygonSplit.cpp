@@ -226,16 +226,18 @@ bool isValidExact(const PWH& p) {
   return CGAL::is_valid_polygon_with_holes(p, traits);
 }
 
+bool isStrictlySimple(const Ring& ring) {
+  CGAL::Polygon_2<CGAL::Exact_predicates_inexact_constructions_kernel> p;
+  for (const Point& v : ring) p.push_back({v.x, v.y});
+  return p.size() >= 3 && p.is_simple();
+}
+
 bool isValidForSplit(const Polygon& polygon) {
   if (polygon.outer.size() < 3) return false;
-  if (polygon.holes.empty()) {
-    // A strictly simple ring is valid (toExact orients it). Epick's test is
-    // exact on double coordinates and far cheaper than the Boolean-operations
-    // validation, which still judges everything else (touching rings, holes).
-    CGAL::Polygon_2<CGAL::Exact_predicates_inexact_constructions_kernel> ring;
-    for (const Point& v : polygon.outer) ring.push_back({v.x, v.y});
-    if (ring.is_simple()) return true;
-  }
+  // A strictly simple ring is valid (toExact orients it). This test is far
+  // cheaper than the Boolean-operations validation, which still judges
+  // everything else (touching rings, holes).
+  if (polygon.holes.empty() && isStrictlySimple(polygon.outer)) return true;
   return isValidExact(toExact(polygon));
 }
 

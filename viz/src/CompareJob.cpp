@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <future>
 #include <numeric>
 
 #include "parcelscope/core/Error.h"
@@ -267,6 +268,15 @@ analysis::JobOutcome runCompare(const CompareRequest& request, const std::string
 
   reportProgress(progress, 0.8, "writing");
   const auto writeStart = std::chrono::steady_clock::now();
+  // The block table and layer are written on a second thread meanwhile.
+  const Table blocks = analysis::blockComparisonTable(r.blocks);
+  std::vector<std::vector<Polygon>> outlines;
+  for (const Block& b : a.blocks) outlines.push_back(b.parts);
+  const std::string blocksCsv = out.stage("blocks.csv"), blocksGpkg = out.stage("blocks.gpkg");
+  std::future<void> blockWriting = std::async(std::launch::async, [&] {
+    io::writeCsv(blocksCsv, blocks);
+    io::writePolygonLayer(blocksGpkg, "blocks", outlines, blocks, r.observed.layer.frame, r.observed.layer.crs);
+  });
   Table observedTable = analysis::parcelTable(r.observed.layer.parcels, a);
   addUndesirable(observedTable, a.metrics);
   io::writeCsv(out.stage("observed_parcels.csv"), observedTable);
@@ -276,12 +286,7 @@ analysis::JobOutcome runCompare(const CompareRequest& request, const std::string
   io::writeCsv(out.stage("generated_parcels.csv"), generatedTable);
   io::writePolygonLayer(out.stage("parcels.gpkg"), "parcels", geometries, generatedTable,
                         r.observed.layer.frame, r.observed.layer.crs);
-  const Table blocks = analysis::blockComparisonTable(r.blocks);
-  io::writeCsv(out.stage("blocks.csv"), blocks);
-  std::vector<std::vector<Polygon>> outlines;
-  for (const Block& b : a.blocks) outlines.push_back(b.parts);
-  io::writePolygonLayer(out.stage("blocks.gpkg"), "blocks", outlines, blocks, r.observed.layer.frame,
-                        r.observed.layer.crs);
+  blockWriting.get();
   io::writeCsv(out.stage("summary.csv"), analysis::summaryTable(r.city));
   io::writeCsv(out.stage("distances.csv"), analysis::distanceTable(r.city));
   const double writeSeconds = secondsSince(writeStart);
