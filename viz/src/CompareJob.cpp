@@ -268,24 +268,29 @@ analysis::JobOutcome runCompare(const CompareRequest& request, const std::string
 
   reportProgress(progress, 0.8, "writing");
   const auto writeStart = std::chrono::steady_clock::now();
-  // The block table and layer are written on a second thread meanwhile.
+  // The two layers (SQLite inserts, one thread each) are written while this
+  // thread formats and writes the tables.
   const Table blocks = analysis::blockComparisonTable(r.blocks);
   std::vector<std::vector<Polygon>> outlines;
   for (const Block& b : a.blocks) outlines.push_back(b.parts);
   const std::string blocksCsv = out.stage("blocks.csv"), blocksGpkg = out.stage("blocks.gpkg");
   std::future<void> blockWriting = std::async(std::launch::async, [&] {
-    io::writeCsv(blocksCsv, blocks);
     io::writePolygonLayer(blocksGpkg, "blocks", outlines, blocks, r.observed.layer.frame, r.observed.layer.crs);
   });
-  Table observedTable = analysis::parcelTable(r.observed.layer.parcels, a);
-  addUndesirable(observedTable, a.metrics);
-  io::writeCsv(out.stage("observed_parcels.csv"), observedTable);
   std::vector<std::vector<Polygon>> geometries;
   Table generatedTable = generation::generatedParcelTable(r.generated, &geometries);
   addUndesirable(generatedTable, r.generated.metrics);
+  const std::string parcelsGpkg = out.stage("parcels.gpkg");
+  std::future<void> parcelWriting = std::async(std::launch::async, [&] {
+    io::writePolygonLayer(parcelsGpkg, "parcels", geometries, generatedTable, r.observed.layer.frame,
+                          r.observed.layer.crs);
+  });
+  io::writeCsv(blocksCsv, blocks);
   io::writeCsv(out.stage("generated_parcels.csv"), generatedTable);
-  io::writePolygonLayer(out.stage("parcels.gpkg"), "parcels", geometries, generatedTable,
-                        r.observed.layer.frame, r.observed.layer.crs);
+  Table observedTable = analysis::parcelTable(r.observed.layer.parcels, a);
+  addUndesirable(observedTable, a.metrics);
+  io::writeCsv(out.stage("observed_parcels.csv"), observedTable);
+  parcelWriting.get();
   blockWriting.get();
   io::writeCsv(out.stage("summary.csv"), analysis::summaryTable(r.city));
   io::writeCsv(out.stage("distances.csv"), analysis::distanceTable(r.city));
