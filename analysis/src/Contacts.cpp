@@ -1,5 +1,7 @@
 #include "Contacts.h"
 
+#include "BoxPairs.h"
+
 #include "parcelscope/core/Parallel.h"
 
 #include <CGAL/box_intersection_d.h>
@@ -112,89 +114,143 @@ double unionLength(std::vector<std::pair<double, double>>& intervals) {
   return total + (hi - lo);
 }
 
+namespace {
+
+struct NearEdge {
+  const Point* p;
+  const Point* q;
+  double lo[2], hi[2];
+};
+
+}  // namespace
+
+Box contactBox(const Polygon& polygon, double tolerance) {
+  Box b = bounds(polygon.outer);
+  for (const Ring& h : polygon.holes) {
+    const Box hb = bounds(h);
+    b = {std::min(b.minX, hb.minX), std::min(b.minY, hb.minY), std::max(b.maxX, hb.maxX), std::max(b.maxY, hb.maxY)};
+  }
+  return b.expanded(0.5 * tolerance);
+}
+
+namespace {
+
+// The edges of `polygon`, in ring order (outer ring, then holes), whose boxes
+// grown by `grow` meet `box` (closed boxes).
+void edgesNear(const Polygon& polygon, double grow, const Box& box, std::vector<NearEdge>& out) {
+  out.clear();
+  auto ring = [&](const Ring& r) {
+    for (std::size_t i = 0, n = r.size(); i < n; ++i) {
+      const Point& p = r[i];
+      const Point& q = r[(i + 1) % n];
+      const NearEdge e{&p,
+                       &q,
+                       {std::min(p.x, q.x) - grow, std::min(p.y, q.y) - grow},
+                       {std::max(p.x, q.x) + grow, std::max(p.y, q.y) + grow}};
+      if (e.lo[0] <= box.maxX && box.minX <= e.hi[0] && e.lo[1] <= box.maxY && box.minY <= e.hi[1]) {
+        out.push_back(e);
+      }
+    }
+  };
+  ring(polygon.outer);
+  for (const Ring& h : polygon.holes) ring(h);
+}
+
+struct PairMeasure {
+  bool close = false;
+  double sharedA = 0, sharedB = 0;  // boundary of a along b, of b along a
+};
+
+// One pair of polygons, edge pair by edge pair: edges whose boxes (grown by
+// half the close tolerance) meet and that come within the close tolerance;
+// covered intervals within the shared tolerance, united per edge and summed in
+// ring order. `boxA` and `boxB` are the polygons' bounds grown the same way:
+// only edges meeting the other polygon's box can pair.
+PairMeasure measurePair(const Polygon& a, const Polygon& b, const Box& boxA, const Box& boxB, double closeTolerance,
+                        double sharedTolerance) {
+  thread_local std::vector<NearEdge> ea, eb;
+  thread_local std::vector<std::pair<double, double>> intervals;
+  thread_local std::vector<Cover> coversB;
+  const double grow = 0.5 * closeTolerance;
+  edgesNear(a, grow, boxB, ea);
+  edgesNear(b, grow, boxA, eb);
+  coversB.clear();
+  PairMeasure m;
+  for (const NearEdge& e : ea) {
+    intervals.clear();
+    for (std::size_t j = 0; j < eb.size(); ++j) {
+      const NearEdge& f = eb[j];
+      if (!(e.lo[0] <= f.hi[0] && f.lo[0] <= e.hi[0] && e.lo[1] <= f.hi[1] && f.lo[1] <= e.hi[1])) continue;
+      if (segmentDistance(*e.p, *e.q, *f.p, *f.q) > closeTolerance) continue;
+      m.close = true;
+      double lo = 0, hi = 0;
+      if (coveredInterval(*e.p, *e.q, *f.p, *f.q, sharedTolerance, lo, hi)) intervals.emplace_back(lo, hi);
+      if (coveredInterval(*f.p, *f.q, *e.p, *e.q, sharedTolerance, lo, hi)) coversB.push_back({j, 0, lo, hi});
+    }
+    if (!intervals.empty()) m.sharedA += unionLength(intervals);
+  }
+  std::sort(coversB.begin(), coversB.end());
+  for (std::size_t i = 0; i < coversB.size();) {
+    std::size_t j = i;
+    intervals.clear();
+    for (; j < coversB.size() && coversB[j].edge == coversB[i].edge; ++j) {
+      intervals.emplace_back(coversB[j].lo, coversB[j].hi);
+    }
+    m.sharedB += unionLength(intervals);
+    i = j;
+  }
+  return m;
+}
+
+}  // namespace
+
 std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons, double tolerance,
                               double sharedTolerance) {
+  std::vector<Box> boxes(polygons.size());
+  for (std::size_t i = 0; i < polygons.size(); ++i) boxes[i] = contactBox(*polygons[i], tolerance);
+  return contacts(polygons, intersectingPairs(boxes), tolerance, sharedTolerance);
+}
+
+std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons,
+                              const std::vector<std::pair<int, int>>& candidates, double tolerance,
+                              double sharedTolerance) {
   if (sharedTolerance < 0 || sharedTolerance > tolerance) sharedTolerance = tolerance;
-  std::vector<EdgeInfo> edges;
-  std::vector<EdgeBox> boxes;
-  for (std::size_t i = 0; i < polygons.size(); ++i) {
-    addEdges(*polygons[i], static_cast<int>(i), 0.5 * tolerance, edges, boxes);
-  }
-  // Two halves split at the median x, searched in parallel. A box crossing the
-  // split goes to both halves; a pair is kept only in the half that holds the
-  // larger of the two boxes' minimum x, so no pair is found twice.
-  std::vector<double> xs;
-  // Small inputs (one block, one parcel pair) stay on the calling thread.
-  const bool parallel = boxes.size() >= 20000;
-  double split = std::numeric_limits<double>::infinity();
-  if (parallel) {
-    xs.reserve(boxes.size());
-    for (const EdgeBox& b : boxes) xs.push_back(0.5 * (b.min_coord(0) + b.max_coord(0)));
-    std::nth_element(xs.begin(), xs.begin() + static_cast<long>(xs.size() / 2), xs.end());
-    split = xs[xs.size() / 2];
-  }
-  struct Half {
-    std::vector<EdgeBox> boxes;
-    std::vector<Cover> covers;
-    std::vector<std::pair<int, int>> closePairs;
-  };
-  Half halves[2];
-  for (const EdgeBox& b : boxes) {
-    if (b.min_coord(0) < split) halves[0].boxes.push_back(b);
-    if (b.max_coord(0) >= split) halves[1].boxes.push_back(b);
-  }
-  auto search = [&](std::size_t h) {
-    Half& half = halves[h];
-    CGAL::box_self_intersection_d(half.boxes.begin(), half.boxes.end(), [&](const EdgeBox& x, const EdgeBox& y) {
-      const bool upper = std::max(x.min_coord(0), y.min_coord(0)) >= split;
-      if (upper != (h == 1)) return;
-      const EdgeInfo& e = edges[x.info()];
-      const EdgeInfo& f = edges[y.info()];
-      if (e.polygon == f.polygon) return;
-      if (segmentDistance(*e.p, *e.q, *f.p, *f.q) > tolerance) return;
-      half.closePairs.emplace_back(std::min(e.polygon, f.polygon), std::max(e.polygon, f.polygon));
-      double lo = 0, hi = 0;
-      if (coveredInterval(*e.p, *e.q, *f.p, *f.q, sharedTolerance, lo, hi)) {
-        half.covers.push_back({x.info(), f.polygon, lo, hi});
-      }
-      if (coveredInterval(*f.p, *f.q, *e.p, *e.q, sharedTolerance, lo, hi)) {
-        half.covers.push_back({y.info(), e.polygon, lo, hi});
-      }
-    });
-  };
-  if (parallel) {
-    parallelFor(2, search);
-  } else {
-    search(0);
-  }
-  std::vector<Cover> covers = std::move(halves[0].covers);
-  covers.insert(covers.end(), halves[1].covers.begin(), halves[1].covers.end());
-  std::vector<std::pair<int, int>> closePairs = std::move(halves[0].closePairs);
-  closePairs.insert(closePairs.end(), halves[1].closePairs.begin(), halves[1].closePairs.end());
-  std::sort(closePairs.begin(), closePairs.end());
-  closePairs.erase(std::unique(closePairs.begin(), closePairs.end()), closePairs.end());
-  std::vector<Contact> out(closePairs.size());
-  std::vector<double> sharedBack(closePairs.size(), 0.0);
-  for (std::size_t k = 0; k < closePairs.size(); ++k) {
-    out[k].a = closePairs[k].first;
-    out[k].b = closePairs[k].second;
-    out[k].close = true;
-  }
-  auto find = [&](int a, int b) {
-    const auto it = std::lower_bound(closePairs.begin(), closePairs.end(), std::make_pair(a, b));
-    return static_cast<std::size_t>(it - closePairs.begin());
-  };
-  sumCovers(covers, edges, [&](int measured, int other, double length) {
-    if (measured < other) {
-      out[find(measured, other)].shared += length;
-    } else {
-      sharedBack[find(other, measured)] += length;
+  std::vector<Box> boxes(polygons.size());
+  for (std::size_t i = 0; i < polygons.size(); ++i) boxes[i] = contactBox(*polygons[i], tolerance);
+  std::vector<PairMeasure> measured(candidates.size());
+  auto measureRange = [&](std::size_t from, std::size_t to) {
+    for (std::size_t k = from; k < to; ++k) {
+      const auto [i, j] = candidates[k];
+      measured[k] = measurePair(*polygons[i], *polygons[j], boxes[i], boxes[j], tolerance, sharedTolerance);
     }
-  });
-  // Both sides measure the same shared stretch; take the smaller (digitising
-  // differences can make one side's edges overlap the other's twice).
-  for (std::size_t k = 0; k < out.size(); ++k) out[k].shared = std::min(out[k].shared, sharedBack[k]);
+  };
+  // Small inputs (one block, one parcel pair) stay on the calling thread.
+  constexpr std::size_t kChunk = 2048;
+  if (candidates.size() < 4 * kChunk) {
+    measureRange(0, candidates.size());
+  } else {
+    parallelFor((candidates.size() + kChunk - 1) / kChunk, [&](std::size_t c) {
+      measureRange(c * kChunk, std::min(candidates.size(), (c + 1) * kChunk));
+    });
+  }
+  std::vector<Contact> out;
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    if (!measured[k].close) continue;
+    Contact c;
+    c.a = candidates[k].first;
+    c.b = candidates[k].second;
+    c.close = true;
+    // Both sides measure the same shared stretch; take the smaller (digitising
+    // differences can make one side's edges overlap the other's twice).
+    c.shared = std::min(measured[k].sharedA, measured[k].sharedB);
+    out.push_back(c);
+  }
   return out;
+}
+
+double sharedLength(const Polygon& a, const Polygon& b, double tolerance) {
+  const PairMeasure m = measurePair(a, b, contactBox(a, tolerance), contactBox(b, tolerance), tolerance, tolerance);
+  return m.close ? std::min(m.sharedA, m.sharedB) : 0.0;
 }
 
 std::vector<double> lengthAlong(const std::vector<const Polygon*>& polygons, const std::vector<Ring>& rings,

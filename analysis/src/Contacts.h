@@ -1,8 +1,9 @@
 #pragma once
-// Where parcel boundaries meet, computed edge by edge with CGAL's
-// box_intersection_d so that cost grows with the number of nearby edge pairs,
-// not with the product of polygon sizes (a street network stored as one
-// parcel has tens of thousands of edges).
+// Where parcel boundaries meet: candidate polygon pairs from their boxes
+// (CGAL's box_intersection_d), then edge by edge within each pair, only over
+// the edges that reach the other polygon's box, so that cost grows with the
+// number of nearby edge pairs, not with the product of polygon sizes (a street
+// network stored as one parcel has tens of thousands of edges).
 #include <vector>
 
 #include "parcelscope/core/Geometry.h"
@@ -15,11 +16,28 @@ struct Contact {
   bool close = false;   ///< some pair of edges lies within the tolerance
 };
 
+/// The bounds of all of `polygon`'s rings grown by half of `tolerance`: two
+/// polygons can be in contact only when these meet.
+Box contactBox(const Polygon& polygon, double tolerance);
+
 /// Contacts between every pair of `polygons` whose boundaries come within
 /// `closeTolerance` m, sorted by (a, b). Shared lengths count edges within
 /// `sharedTolerance` (<= closeTolerance; negative means the same).
 std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons, double closeTolerance,
                               double sharedTolerance = -1);
+/// The same, given the candidate pairs: every pair (i, j), i < j, sorted,
+/// whose contact boxes meet, at least (intersectingPairs of the contactBox
+/// of each polygon); pairs are measured in parallel.
+std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons,
+                              const std::vector<std::pair<int, int>>& candidates, double closeTolerance,
+                              double sharedTolerance = -1);
+
+/// The shared length `contacts({&a, &b}, tolerance)` gives for the pair (0
+/// when it finds none), computed directly: the same edge pairs (boxes grown by
+/// half the tolerance, then segment distance), the same intervals, summed in
+/// the same order, without building the general search. For the many small
+/// pieces measured against one block outline.
+double sharedLength(const Polygon& a, const Polygon& b, double tolerance);
 
 /// For each polygon, the length in m of its boundary running along `rings`
 /// (within `tolerance`, parallel within 10 degrees).

@@ -50,9 +50,7 @@ ShapeMetrics shapeMetrics(const Polygon& polygon) {
 
 double sharedBoundaryLength(const Polygon& a, const Polygon& b, double tolerance) {
   if (!bounds(a).expanded(tolerance).intersects(bounds(b))) return 0.0;
-  const Polygon* pa = &a;
-  auto one = detail::contacts({pa, &b}, tolerance);
-  return one.empty() ? 0.0 : one.front().shared;
+  return detail::sharedLength(a, b, tolerance);
 }
 
 }  // namespace parcelscope::analysis

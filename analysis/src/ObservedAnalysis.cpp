@@ -155,11 +155,15 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
 
   out.timings.start("metrics");
   // 1. Shape metrics.
+  // Boxes of every ring grown by half the contact tolerance: their pairs are
+  // the candidates for contacts, and include every pair of parcels where one
+  // can lie inside the other (it lies inside the other's box).
+  const double contactTolerance = std::max(tol, 1e-6);
   std::vector<Box> boxes(n);
   std::vector<Point> inside(n);
   parallelFor(n, [&](std::size_t i) {
     static_cast<ShapeMetrics&>(out.metrics[i]) = shapeMetrics(parcels[i].shape);
-    boxes[i] = bounds(parcels[i].shape).expanded(0.5 * tol);
+    boxes[i] = detail::contactBox(parcels[i].shape, contactTolerance);
     inside[i] = interiorPoint(parcels[i].shape);
   });
   reportProgress(progress, 0.1, "metrics");
@@ -168,11 +172,11 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
   // 2. Shared boundaries (neighbours) and closeness, edge by edge.
   std::vector<const Polygon*> shapes(n);
   for (std::size_t i = 0; i < n; ++i) shapes[i] = &parcels[i].shape;
-  const auto touching = detail::contacts(shapes, std::max(tol, 1e-6), sharedTolerance(tol));
+  // Overlapping boxes also find parcels lying inside others without touching them.
+  const auto pairs = detail::intersectingPairs(boxes);
+  const auto touching = detail::contacts(shapes, pairs, contactTolerance, sharedTolerance(tol));
   countNeighbours(touching, out.metrics);
   reportProgress(progress, 0.3, "neighbours");
-  // Overlapping boxes find parcels lying inside others without touching them.
-  const auto pairs = detail::intersectingPairs(boxes);
 
   out.timings.start("right_of_way");
   // 3. Right-of-way parcels.
@@ -254,9 +258,10 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
                        "blocks");
       });
   out.timings.start("frontage_and_statistics");
-  for (std::size_t b = 0; b < out.blocks.size(); ++b) {
+  // Blocks in parallel: each writes only its own parcels' frontage.
+  out.statistics.resize(out.blocks.size());
+  parallelFor(out.blocks.size(), [&](std::size_t b) {
     const Block& block = out.blocks[b];
-    if (block.parts.size() > 1) ++out.multipartBlocks;
     const int withAccess = measureFrontage(block, shapes, tol, options.minFrontage, out.metrics);
     std::vector<double> areas, widths;
     for (int i : block.parcels) {
@@ -267,9 +272,12 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
     s.blockId = block.id;
     for (const Polygon& part : block.parts) s.blockArea += area(part);
     s.streetAccessShare = static_cast<double>(withAccess) / static_cast<double>(block.parcels.size());
-    out.clampedAMin += s.aMinClamped;
-    out.clampedWMin += s.wMinClamped;
-    out.statistics.push_back(s);
+    out.statistics[b] = s;
+  });
+  for (std::size_t b = 0; b < out.blocks.size(); ++b) {
+    if (out.blocks[b].parts.size() > 1) ++out.multipartBlocks;
+    out.clampedAMin += out.statistics[b].aMinClamped;
+    out.clampedWMin += out.statistics[b].wMinClamped;
   }
   reportProgress(progress, 1.0, "blocks");
   out.timings.stop();
@@ -304,7 +312,7 @@ std::vector<ParcelMetrics> measureParcels(const std::vector<Polygon>& shapes, co
   std::vector<const Polygon*> all;
   for (const Polygon& s : shapes) all.push_back(&s);
   countNeighbours(detail::contacts(all, std::max(tolerance, 1e-6), sharedTolerance(tolerance)), metrics);
-  for (const Block& block : blocks) measureFrontage(block, all, tolerance, minFrontage, metrics);
+  parallelFor(blocks.size(), [&](std::size_t b) { measureFrontage(blocks[b], all, tolerance, minFrontage, metrics); });
   return metrics;
 }
 

@@ -203,11 +203,20 @@ bool isClearlySimple(const Ring& r) {
     const double dot = (q.x - p.x) * (s.x - q.x) + (q.y - p.y) * (s.y - q.y);
     if (dot < 0 && std::fabs(cr) <= eps * norm(q.x - p.x, q.y - p.y)) return false;
   }
+  // Edge boxes grown by eps: edges whose boxes do not meet are farther apart
+  // than eps, and need no distance computed.
+  Box boxes[64];
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point& p = r[i];
+    const Point& q = r[(i + 1) % n];
+    boxes[i] = Box{std::min(p.x, q.x), std::min(p.y, q.y), std::max(p.x, q.x), std::max(p.y, q.y)}.expanded(eps);
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const Point& a = r[i];
     const Point& a2 = r[(i + 1) % n];
     for (std::size_t j = i + 2; j < n; ++j) {
       if (i == 0 && j == n - 1) continue;  // adjacent through the closing vertex
+      if (!boxes[i].intersects(boxes[j])) continue;
       if (segmentDistance(a, a2, r[j], r[(j + 1) % n]) <= eps) return false;
     }
   }

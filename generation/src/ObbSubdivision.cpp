@@ -106,19 +106,50 @@ private:
 
   // The pieces of `piece` cut by the line through `through` along `dir`, or
   // nothing when the line misses, a piece is below A_min or W_min, or a piece
-  // is not a valid polygon once rounded to doubles.
+  // is not a valid polygon once rounded to doubles. The split is first made in
+  // floating point (splitByLineFast) and kept when its pieces keep the piece's
+  // area and pass the checks; when they fail the cleanliness or validity
+  // check, and whenever the fast path does not apply, the exact split decides.
   std::vector<Polygon> admissibleSplit(const Polygon& piece, const Point& through, const Point& dir) const {
-    const detail::SplitPieces split = detail::splitByLine(piece, through, dir);
+    detail::SplitPieces split;
+    if (detail::splitByLineFast(piece, through, dir, split)) {
+      if (split.left.empty() || split.right.empty()) return {};
+      std::vector<Polygon> parts = joined(split);
+      double sum = 0;
+      for (const Polygon& part : parts) sum += area(part);
+      if (std::fabs(sum - area(piece)) <= 1e-9 * area(piece)) {
+        const Verdict v = judge(parts, through, dir);
+        if (v == Verdict::Admissible) return parts;
+        if (v == Verdict::TooSmall) return {};
+      }
+    }
+    split = detail::splitByLine(piece, through, dir);
     if (split.left.empty() || split.right.empty()) return {};
+    std::vector<Polygon> parts = joined(split);
+    return judge(parts, through, dir) == Verdict::Admissible ? parts : std::vector<Polygon>{};
+  }
+
+  static std::vector<Polygon> joined(const detail::SplitPieces& split) {
     std::vector<Polygon> parts = split.left;
     parts.insert(parts.end(), split.right.begin(), split.right.end());
-    for (const Polygon& part : parts) {
-      if (area(part) < p_.aMin || minimumAreaBox(part.outer).width < p_.wMin) return {};
-    }
-    for (const Polygon& part : parts) {
-      if (!cutIsClean(part, through, dir) || !io::isValid(part)) return {};
-    }
     return parts;
+  }
+
+  enum class Verdict { Admissible, TooSmall, Unclean };
+  Verdict judge(const std::vector<Polygon>& parts, const Point& through, const Point& dir) const {
+    for (const Polygon& part : parts) {
+      if (area(part) < p_.aMin || minimumAreaBox(part.outer).width < p_.wMin) return Verdict::TooSmall;
+    }
+    for (const Polygon& part : parts) {
+      if (!cutIsClean(part, through, dir)) return Verdict::Unclean;
+      // GEOS validity, skipped for rings proven simple (a ring with no holes
+      // and non-zero area is valid when simple): the quadratic conservative
+      // test for short rings, the exact sweep for long ones.
+      const bool simple = part.holes.empty() && (part.outer.size() <= 16 ? isClearlySimple(part.outer)
+                                                                          : detail::isStrictlySimple(part.outer));
+      if (!simple && !io::isValid(part)) return Verdict::Unclean;
+    }
+    return Verdict::Admissible;
   }
 
   // True when the edges a cut created (those on the cut line) keep a clear

@@ -7,6 +7,8 @@
 
 #include "Exact.h"
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
 namespace parcelscope::generation::detail {
 
 P2 toExact(const Ring& ring) {
@@ -224,8 +226,18 @@ bool isValidExact(const PWH& p) {
   return CGAL::is_valid_polygon_with_holes(p, traits);
 }
 
+bool isStrictlySimple(const Ring& ring) {
+  CGAL::Polygon_2<CGAL::Exact_predicates_inexact_constructions_kernel> p;
+  for (const Point& v : ring) p.push_back({v.x, v.y});
+  return p.size() >= 3 && p.is_simple();
+}
+
 bool isValidForSplit(const Polygon& polygon) {
   if (polygon.outer.size() < 3) return false;
+  // A strictly simple ring is valid (toExact orients it). This test is far
+  // cheaper than the Boolean-operations validation, which still judges
+  // everything else (touching rings, holes).
+  if (polygon.holes.empty() && isStrictlySimple(polygon.outer)) return true;
   return isValidExact(toExact(polygon));
 }
 
@@ -244,6 +256,135 @@ SplitPieces splitByLine(const Polygon& polygon, const Point& pivot, const Point&
     }
   }
   return out;
+}
+
+}  // namespace parcelscope::generation::detail
+
+namespace parcelscope::generation::detail {
+
+namespace {
+// Side of q relative to the directed line through `pivot` along `dir`: 1 left,
+// -1 right, 0 on it; exact. The floating-point value decides when its sign is
+// certain: each of the two products carries one rounded difference, and 1e-15
+// of their magnitudes bounds the rounding error of the whole expression with a
+// wide margin (3.4e-16 would do). Otherwise the exact kernel decides.
+int sideOf(const Point& q, const Point& pivot, const Point& dir) {
+  if (q.x == pivot.x && q.y == pivot.y) return 0;
+  const double a = dir.x * (q.y - pivot.y), b = dir.y * (q.x - pivot.x);
+  const double det = a - b;
+  if (std::fabs(det) > 1e-15 * (std::fabs(a) + std::fabs(b))) return det > 0 ? 1 : -1;
+  const K::Point_2 through(pivot.x, pivot.y);
+  const CGAL::Orientation o = CGAL::orientation(through, through + K::Vector_2(dir.x, dir.y), K::Point_2(q.x, q.y));
+  return o == CGAL::LEFT_TURN ? 1 : o == CGAL::RIGHT_TURN ? -1 : 0;
+}
+}  // namespace
+
+bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& dir, SplitPieces& out) {
+  if (!polygon.holes.empty()) return false;
+  const Ring& r = polygon.outer;
+  const std::size_t n = r.size();
+  if (n < 3) return false;
+  std::vector<signed char> side(n);
+  std::size_t left = 0, right = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    side[i] = static_cast<signed char>(sideOf(r[i], pivot, dir));
+    left += side[i] > 0;
+    right += side[i] < 0;
+  }
+  if (left == 0 || right == 0) {
+    // Nothing on one side. (A ring touching the line along an edge is left to
+    // the exact split, which knows what to do with it.)
+    if (left + right + 1 < n) return false;
+    SplitPieces whole;
+    (left ? whole.left : whole.right).push_back(polygon);
+    out = std::move(whole);
+    return true;
+  }
+  // The ring with its crossings: vertices, and points inserted on edges whose
+  // ends lie on opposite sides. Every vertex on the line must be a crossing
+  // too (between opposite sides); a touch or an edge along the line is left to
+  // the exact split.
+  struct Node {
+    Point p;
+    int side;         // of the vertex; 0 on the line
+    int partner = -1; // on the line: the other end of its cut
+    double along = 0; // on the line: position along it
+  };
+  std::vector<Node> nodes;
+  nodes.reserve(n + 8);
+  for (std::size_t i = 0; i < n; ++i) {
+    const int s = side[i], next = side[(i + 1) % n];
+    if (s == 0 && side[(i + n - 1) % n] * next >= 0) return false;
+    nodes.push_back({r[i], s});
+    if (s * next >= 0) continue;
+    // The crossing, from the segment taken in x-then-y order, clamped to it.
+    const Point& a = r[i];
+    const Point& b = r[(i + 1) % n];
+    const bool forward = a.x < b.x || (a.x == b.x && a.y < b.y);
+    const Point& from = forward ? a : b;
+    const Point& to = forward ? b : a;
+    const double dx = to.x - from.x, dy = to.y - from.y;
+    const double t = std::clamp(((pivot.x - from.x) * dir.y - (pivot.y - from.y) * dir.x) / (dx * dir.y - dy * dir.x),
+                                0.0, 1.0);
+    nodes.push_back({t == 1.0 ? to : Point{from.x + dx * t, from.y + dy * t}, 0});
+  }
+  const std::size_t m = nodes.size();
+  auto sideBefore = [&](std::size_t k) { return nodes[(k + m - 1) % m].side; };
+  auto sideAfter = [&](std::size_t k) { return nodes[(k + 1) % m].side; };
+  // Cuts: the crossings in order along the line, paired first with second,
+  // third with fourth, and so on; each pair must join a crossing where the ring
+  // leaves the left side to one where it comes back. Crossings too close
+  // along the line to be ordered with certainty are left to the exact split.
+  std::vector<std::size_t> crossings;
+  for (std::size_t k = 0; k < m; ++k) {
+    if (nodes[k].side != 0) continue;
+    nodes[k].along = (nodes[k].p.x - pivot.x) * dir.x + (nodes[k].p.y - pivot.y) * dir.y;
+    crossings.push_back(k);
+  }
+  if (crossings.size() % 2 != 0) return false;
+  std::sort(crossings.begin(), crossings.end(),
+            [&](std::size_t x, std::size_t y) { return nodes[x].along < nodes[y].along; });
+  const Box b = bounds(r);
+  const double separation = 1e-9 * (b.width() + b.height());
+  for (std::size_t c = 0; c + 1 < crossings.size(); ++c) {
+    if (!(nodes[crossings[c + 1]].along - nodes[crossings[c]].along > separation)) return false;
+  }
+  for (std::size_t c = 0; c < crossings.size(); c += 2) {
+    const std::size_t x = crossings[c], y = crossings[c + 1];
+    if (sideBefore(x) == sideBefore(y)) return false;
+    nodes[x].partner = static_cast<int>(y);
+    nodes[y].partner = static_cast<int>(x);
+  }
+  // Each piece: along the ring on its side; where the ring leaves that side,
+  // across the cut to its other end, and on along the ring from there.
+  SplitPieces result;
+  std::vector<char> visited(m, 0);
+  for (const int s : {1, -1}) {
+    for (std::size_t start = 0; start < m; ++start) {
+      if (nodes[start].side != s || visited[start]) continue;
+      Polygon piece;
+      std::size_t k = start;
+      for (std::size_t steps = 0;; ++steps) {
+        if (steps > 2 * m) return false;  // not a closed walk: leave it to the exact split
+        piece.outer.push_back(nodes[k].p);
+        visited[k] = 1;
+        if (nodes[k].side == 0 && sideAfter(k) == -s) {
+          k = static_cast<std::size_t>(nodes[k].partner);
+          piece.outer.push_back(nodes[k].p);
+        }
+        k = (k + 1) % m;
+        if (k == start) break;
+      }
+      // Start at the lowest vertex in x-then-y order.
+      Ring& ring = piece.outer;
+      std::rotate(ring.begin(), std::min_element(ring.begin(), ring.end(), [](const Point& p, const Point& q) {
+                    return p.x < q.x || (p.x == q.x && p.y < q.y);
+                  }), ring.end());
+      if (normalise(piece)) (s > 0 ? result.left : result.right).push_back(std::move(piece));
+    }
+  }
+  out = std::move(result);
+  return true;
 }
 
 }  // namespace parcelscope::generation::detail

@@ -5,57 +5,76 @@
 #include <ogr_spatialref.h>
 #include <ogrsf_frmts.h>
 
-#include <cstdio>
+#include <algorithm>
+#include <charconv>
 #include <fstream>
+#include <future>
 
 #include "OgrConvert.h"
 #include "parcelscope/core/Error.h"
+#include "parcelscope/core/Parallel.h"
 
 namespace parcelscope::io {
 
 namespace {
-std::string csvField(const Value& v) {
-  if (const auto* i = std::get_if<std::int64_t>(&v)) return std::to_string(*i);
+// A CSV field: integers and %.10g reals (std::to_chars gives what printf gives),
+// strings quoted when they hold a separator, quote or line break.
+void appendCsvField(std::string& out, const Value& v) {
+  char buf[64];
+  if (const auto* i = std::get_if<std::int64_t>(&v)) {
+    out.append(buf, std::to_chars(buf, buf + sizeof buf, *i).ptr);
+    return;
+  }
   if (const auto* d = std::get_if<double>(&v)) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.10g", *d);
-    return buf;
+    out.append(buf, std::to_chars(buf, buf + sizeof buf, *d, std::chars_format::general, 10).ptr);
+    return;
   }
   const std::string& s = std::get<std::string>(v);
-  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) {
-    if (c == '"') q += '"';
-    q += c;
+  if (s.find_first_of(",\"\n\r") == std::string::npos) {
+    out += s;
+    return;
   }
-  return q + "\"";
+  out += '"';
+  for (char c : s) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  out += '"';
 }
 
-void writeText(const std::string& path, const std::string& text) {
+void writeText(const std::string& path, const std::vector<std::string>& chunks) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
+  for (const std::string& chunk : chunks) out.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
   out.close();
   if (!out) throw ioError(path + ": cannot write");
 }
 }  // namespace
 
 void writeCsv(const std::string& path, const Table& table) {
-  std::string text;
+  // Rows formatted in parallel, in chunks written in order.
+  constexpr std::size_t kRowsPerChunk = 4096;
+  const std::size_t chunks = (table.rows.size() + kRowsPerChunk - 1) / kRowsPerChunk;
+  std::vector<std::string> text(chunks + 1);
   for (std::size_t c = 0; c < table.columns.size(); ++c) {
-    text += (c ? "," : "") + csvField(table.columns[c].name);
+    if (c) text[0] += ',';
+    appendCsvField(text[0], table.columns[c].name);
   }
-  text += '\n';
-  for (const auto& row : table.rows) {
-    for (std::size_t c = 0; c < row.size(); ++c) {
-      if (c) text += ',';
-      text += csvField(row[c]);
+  text[0] += '\n';
+  parallelFor(chunks, [&](std::size_t k) {
+    std::string& out = text[k + 1];
+    for (std::size_t r = k * kRowsPerChunk, end = std::min(table.rows.size(), r + kRowsPerChunk); r < end; ++r) {
+      const auto& row = table.rows[r];
+      for (std::size_t c = 0; c < row.size(); ++c) {
+        if (c) out += ',';
+        appendCsvField(out, row[c]);
+      }
+      out += '\n';
     }
-    text += '\n';
-  }
+  });
   writeText(path, text);
 }
 
-void writeJson(const std::string& path, const Json& json) { writeText(path, json.dump() + "\n"); }
+void writeJson(const std::string& path, const Json& json) { writeText(path, {json.dump() + "\n"}); }
 
 namespace {
 Json fromCpl(const CPLJSONObject& o) {
@@ -131,31 +150,47 @@ void writePolygonLayer(const std::string& path, const std::string& layerName,
     if (layer->CreateField(&field) != OGRERR_NONE) throw fail("cannot create field " + c.name);
   }
   if (!geojson && ds->StartTransaction() != OGRERR_NONE) throw fail("cannot start transaction");
-  for (std::size_t i = 0; i < geometries.size(); ++i) {
-    OGRFeature feature(layer->GetLayerDefn());
-    for (std::size_t c = 0; c < attributes.columns.size(); ++c) {
-      const Value& v = attributes.rows[i][c];
-      const int idx = static_cast<int>(c);
-      if (const auto* n = std::get_if<std::int64_t>(&v)) {
-        feature.SetField(idx, static_cast<GIntBig>(*n));
-      } else if (const auto* d = std::get_if<double>(&v)) {
-        feature.SetField(idx, *d);
-      } else {
-        feature.SetField(idx, std::get<std::string>(v).c_str());
+  // Geometries are converted and taken back to the source CRS in batches on a
+  // second thread while this one inserts the batch before.
+  constexpr std::size_t kBatch = 4096;
+  using Batch = std::vector<std::unique_ptr<OGRMultiPolygon>>;
+  auto prepare = [&](std::size_t from) {
+    Batch batch;
+    const std::size_t to = std::min(geometries.size(), from + kBatch);
+    batch.reserve(to - from);
+    for (std::size_t i = from; i < to; ++i) {
+      std::vector<Polygon> parts = geometries[i];
+      for (Polygon& p : parts) {
+        for (Point& q : p.outer) q = frame.toSource(q);
+        for (Ring& h : p.holes)
+          for (Point& q : h) q = frame.toSource(q);
       }
+      batch.push_back(detail::toOgr(parts));
     }
-    auto multi = detail::toOgr(geometries[i]);
-    for (OGRPolygon* p : *multi) {
-      for (OGRLinearRing* ring : *p) {
-        for (int k = 0, n = ring->getNumPoints(); k < n; ++k) {
-          const Point s = frame.toSource({ring->getX(k), ring->getY(k)});
-          ring->setPoint(k, s.x, s.y);
+    return batch;
+  };
+  std::future<Batch> next = std::async(std::launch::async, prepare, 0);
+  for (std::size_t from = 0; from < geometries.size(); from += kBatch) {
+    Batch batch = next.get();
+    if (from + kBatch < geometries.size()) next = std::async(std::launch::async, prepare, from + kBatch);
+    for (std::size_t k = 0; k < batch.size(); ++k) {
+      const std::size_t i = from + k;
+      OGRFeature feature(layer->GetLayerDefn());
+      for (std::size_t c = 0; c < attributes.columns.size(); ++c) {
+        const Value& v = attributes.rows[i][c];
+        const int idx = static_cast<int>(c);
+        if (const auto* n = std::get_if<std::int64_t>(&v)) {
+          feature.SetField(idx, static_cast<GIntBig>(*n));
+        } else if (const auto* d = std::get_if<double>(&v)) {
+          feature.SetField(idx, *d);
+        } else {
+          feature.SetField(idx, std::get<std::string>(v).c_str());
         }
       }
-    }
-    feature.SetGeometryDirectly(multi.release());
-    if (layer->CreateFeature(&feature) != OGRERR_NONE) {
-      throw fail("cannot write feature " + std::to_string(i));
+      feature.SetGeometryDirectly(batch[k].release());
+      if (layer->CreateFeature(&feature) != OGRERR_NONE) {
+        throw fail("cannot write feature " + std::to_string(i));
+      }
     }
   }
   if (!geojson && ds->CommitTransaction() != OGRERR_NONE) throw fail("cannot commit");

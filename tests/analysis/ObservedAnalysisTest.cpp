@@ -137,5 +137,39 @@ TEST(ObservedAnalysis, TablesHaveOneRowPerParcelAndBlock) {
   EXPECT_EQ(std::get<std::int64_t>(b.rows[0][b.column("parcel_count")]), 2);
 }
 
+TEST(MeasureParcels, LargeGridsCountNeighboursAndFrontageExactly) {
+  // Four blocks of 60 x 60 squares of 10 m, far apart: enough candidate pairs
+  // for contacts to measure them in parallel chunks, and frontage block by
+  // block in parallel. Every count is known.
+  constexpr int kSide = 60;
+  std::vector<Polygon> shapes;
+  std::vector<Block> blocks;
+  for (int b = 0; b < 4; ++b) {
+    Block block;
+    block.id = b;
+    const double ox = 1000.0 * b;
+    block.parts = {rect(ox, 0, ox + 10 * kSide, 10 * kSide)};
+    for (int i = 0; i < kSide; ++i) {
+      for (int j = 0; j < kSide; ++j) {
+        block.parcels.push_back(static_cast<int>(shapes.size()));
+        shapes.push_back(rect(ox + 10 * i, 10 * j, ox + 10 * (i + 1), 10 * (j + 1)));
+      }
+    }
+    blocks.push_back(block);
+  }
+  const auto metrics = measureParcels(shapes, blocks, 0.05, 1.0);
+  for (int b = 0; b < 4; ++b) {
+    for (int i = 0; i < kSide; ++i) {
+      for (int j = 0; j < kSide; ++j) {
+        const ParcelMetrics& m = metrics[static_cast<std::size_t>(b * kSide * kSide + i * kSide + j)];
+        const int borders = (i == 0) + (i == kSide - 1) + (j == 0) + (j == kSide - 1);
+        ASSERT_EQ(m.neighbours, 4 - borders) << b << " " << i << " " << j;
+        ASSERT_NEAR(m.frontage, 10.0 * borders, 1e-9) << b << " " << i << " " << j;
+        ASSERT_EQ(m.streetAccess, borders > 0);
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace parcelscope::analysis

@@ -310,7 +310,12 @@ TEST(CompareCommand, CtrlCLeavesNoOutputAndNoStagingFolder) {
   pid_t pid = 0;
   ASSERT_EQ(posix_spawn(&pid, PARCELSCOPE_CLI, &files, nullptr, argv.data(), environ), 0);
   posix_spawn_file_actions_destroy(&files);
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // cambridge_ma takes several seconds
+  // Interrupt as soon as the job has made its staging folder: it is then
+  // reading or computing, well before it could finish (about a second).
+  for (int waited = 0; waited < 10000 && fs::is_empty(dir.path()); waited += 5) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_FALSE(fs::is_empty(dir.path())) << "the job made no staging folder within 10 s";
   ASSERT_EQ(::kill(pid, SIGINT), 0);
   int status = 0;
   ASSERT_EQ(::waitpid(pid, &status, 0), pid);

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <future>
 #include <numeric>
 #include <optional>
 
@@ -185,6 +186,20 @@ void addUndesirable(Table& table, const std::vector<ParcelMetrics>& metrics) {
   }
 }
 
+// observed_parcels.csv and generated_parcels.csv (the latter also the
+// attributes of parcels.gpkg, whose geometries go to `geometries`).
+Table observedTableOf(const CompareResult& r) {
+  Table t = analysis::parcelTable(r.observed->layer.parcels, r.observed->analysis);
+  addUndesirable(t, r.observed->analysis.metrics);
+  return t;
+}
+
+Table generatedTableOf(const CompareResult& r, std::vector<std::vector<Polygon>>* geometries = nullptr) {
+  Table t = generation::generatedParcelTable(r.generated, geometries);
+  addUndesirable(t, r.generated.metrics);
+  return t;
+}
+
 Json summaryJson(const analysis::SetSummary& s) {
   return Json::object()
       .set("parcels", s.parcels)
@@ -349,12 +364,8 @@ void renderBlocksMap(const CompareResult& r, const CompareRequest& request, cons
 
 std::vector<std::pair<std::string, Table>> comparisonTables(const CompareResult& r) {
   std::vector<std::pair<std::string, Table>> tables;
-  Table observed = analysis::parcelTable(r.observed->layer.parcels, r.observed->analysis);
-  addUndesirable(observed, r.observed->analysis.metrics);
-  tables.emplace_back("observed_parcels.csv", std::move(observed));
-  Table generated = generation::generatedParcelTable(r.generated);
-  addUndesirable(generated, r.generated.metrics);
-  tables.emplace_back("generated_parcels.csv", std::move(generated));
+  tables.emplace_back("observed_parcels.csv", observedTableOf(r));
+  tables.emplace_back("generated_parcels.csv", generatedTableOf(r));
   tables.emplace_back("blocks.csv", analysis::blockComparisonTable(r.blocks));
   tables.emplace_back("summary.csv", analysis::summaryTable(r.city));
   tables.emplace_back("distances.csv", analysis::distanceTable(r.city));
@@ -406,8 +417,7 @@ void exportFigure(const CompareResult& r, const CompareRequest& request, const s
 void exportParcels(const CompareResult& r, const std::string& path, const std::vector<std::string>& inputs) {
   io::StagedFile file(path, inputs);
   std::vector<std::vector<Polygon>> geometries;
-  Table table = generation::generatedParcelTable(r.generated, &geometries);
-  addUndesirable(table, r.generated.metrics);
+  const Table table = generatedTableOf(r, &geometries);
   io::writePolygonLayer(file.path(), "parcels", geometries, table, r.observed->layer.frame, r.observed->layer.crs);
   file.commit();
 }
@@ -464,23 +474,32 @@ analysis::JobOutcome runCompare(const CompareRequest& request, const std::string
 
   reportProgress(progress, 0.8, "writing");
   const auto writeStart = std::chrono::steady_clock::now();
-  std::vector<std::string> outputs = {"parcels.gpkg", "blocks.gpkg"};
-  const auto tables = comparisonTables(r);
-  for (const auto& [name, table] : tables) {
-    io::writeCsv(out.stage(name), table);
-    outputs.push_back(name);
-  }
-  std::vector<std::vector<Polygon>> geometries;
-  const Table generatedTable = tables[1].second;
-  for (std::size_t b = 0; b < r.generated.blocks.size(); ++b) {
-    for (int i : r.generated.blocks[b].parcels) geometries.push_back({r.generated.parcels[i]});
-  }
-  io::writePolygonLayer(out.stage("parcels.gpkg"), "parcels", geometries, generatedTable, r.observed->layer.frame,
-                        r.observed->layer.crs);
+  std::vector<std::string> outputs = {"parcels.gpkg",          "blocks.gpkg", "observed_parcels.csv",
+                                      "generated_parcels.csv", "blocks.csv",  "summary.csv",
+                                      "distances.csv"};
+  // The two layers (SQLite inserts, one thread each) are written while this
+  // thread formats and writes the tables.
+  const Table blocks = analysis::blockComparisonTable(r.blocks);
   std::vector<std::vector<Polygon>> outlines;
   for (const Block& b : a.blocks) outlines.push_back(b.parts);
-  io::writePolygonLayer(out.stage("blocks.gpkg"), "blocks", outlines, tables[2].second, r.observed->layer.frame,
-                        r.observed->layer.crs);
+  const std::string blocksCsv = out.stage("blocks.csv"), blocksGpkg = out.stage("blocks.gpkg");
+  std::future<void> blockWriting = std::async(std::launch::async, [&] {
+    io::writePolygonLayer(blocksGpkg, "blocks", outlines, blocks, r.observed->layer.frame, r.observed->layer.crs);
+  });
+  std::vector<std::vector<Polygon>> geometries;
+  const Table generatedTable = generatedTableOf(r, &geometries);
+  const std::string parcelsGpkg = out.stage("parcels.gpkg");
+  std::future<void> parcelWriting = std::async(std::launch::async, [&] {
+    io::writePolygonLayer(parcelsGpkg, "parcels", geometries, generatedTable, r.observed->layer.frame,
+                          r.observed->layer.crs);
+  });
+  io::writeCsv(blocksCsv, blocks);
+  io::writeCsv(out.stage("generated_parcels.csv"), generatedTable);
+  io::writeCsv(out.stage("observed_parcels.csv"), observedTableOf(r));
+  parcelWriting.get();
+  blockWriting.get();
+  io::writeCsv(out.stage("summary.csv"), analysis::summaryTable(r.city));
+  io::writeCsv(out.stage("distances.csv"), analysis::distanceTable(r.city));
   const double writeSeconds = secondsSince(writeStart);
 
   double figureSeconds = 0;

@@ -1,0 +1,153 @@
+// The floating-point split of the OBB style against the exact one: where the
+// fast path applies, both give the same pieces (up to the rounding of the
+// crossing points and the ring's first vertex); where it does not, it says so
+// and the exact split is the one used.
+#include "PolygonSplit.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "TestUtil.h"
+#include "generation/RandomShapes.h"
+
+namespace parcelscope::generation::detail {
+namespace {
+
+using test::poly;
+using test::rect;
+
+// Same ring up to the first vertex, each vertex within `tolerance`.
+bool sameRing(const Ring& a, const Ring& b, double tolerance) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t shift = 0; shift < a.size(); ++shift) {
+    bool same = true;
+    for (std::size_t i = 0; same && i < a.size(); ++i) {
+      const Point& p = a[i];
+      const Point& q = b[(i + shift) % b.size()];
+      same = std::fabs(p.x - q.x) <= tolerance && std::fabs(p.y - q.y) <= tolerance;
+    }
+    if (same) return true;
+  }
+  return false;
+}
+
+// The same pieces in any order.
+bool samePieces(const std::vector<Polygon>& a, const std::vector<Polygon>& b, double tolerance) {
+  if (a.size() != b.size()) return false;
+  std::vector<char> used(b.size(), 0);
+  for (const Polygon& p : a) {
+    bool found = false;
+    for (std::size_t j = 0; !found && j < b.size(); ++j) {
+      found = !used[j] && p.holes.empty() && b[j].holes.empty() && sameRing(p.outer, b[j].outer, tolerance);
+      if (found) used[j] = 1;
+    }
+    if (!found) return false;
+  }
+  return true;
+}
+
+double totalArea(const SplitPieces& s) {
+  double sum = 0;
+  for (const auto* side : {&s.left, &s.right})
+    for (const Polygon& p : *side) sum += area(p);
+  return sum;
+}
+
+TEST(PolygonSplit, FastSplitMatchesExactSplitOnRandomShapes) {
+  const std::uint64_t seed = 5;
+  std::printf("random shapes seed %llu\n", static_cast<unsigned long long>(seed));
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  int fast = 0, declined = 0, multiple = 0;
+  for (int i = 0; i < 2000 / test::kSanitizerDivisor; ++i) {
+    Polygon block = test::randomShape(rng, i % test::kShapeKinds);
+    if (!normalise(block)) continue;
+    const Box b = bounds(block);
+    const double angle = u(rng) * kPi;
+    const Point dir{std::cos(angle), std::sin(angle)};
+    // Every third line runs through a vertex of the ring, as snapped lines do.
+    std::uniform_int_distribution<std::size_t> vertex(0, block.outer.size() - 1);
+    const Point pivot = i % 3 == 0 ? block.outer[vertex(rng)]
+                                   : Point{b.minX + u(rng) * b.width(), b.minY + u(rng) * b.height()};
+    SplitPieces f;
+    if (!splitByLineFast(block, pivot, dir, f)) {
+      ++declined;
+      continue;
+    }
+    ++fast;
+    const SplitPieces e = splitByLine(block, pivot, dir);
+    const std::string what = "shape " + std::to_string(i);
+    const double tolerance = 1e-9 * (b.width() + b.height()) + 1e-12 * (std::fabs(b.minX) + std::fabs(b.minY));
+    EXPECT_TRUE(samePieces(f.left, e.left, tolerance)) << what;
+    EXPECT_TRUE(samePieces(f.right, e.right, tolerance)) << what;
+    EXPECT_NEAR(totalArea(f), area(block), 1e-9 * area(block)) << what;
+    // The two sides share their crossing points exactly: two per cut.
+    int shared = 0;
+    for (const Polygon& l : f.left)
+      for (const Polygon& r : f.right)
+        for (const Point& p : l.outer)
+          for (const Point& q : r.outer) shared += p.x == q.x && p.y == q.y;
+    EXPECT_EQ(shared % 2, 0) << what;
+    if (!f.left.empty() && !f.right.empty()) {
+      EXPECT_GE(shared, 2) << what;
+    }
+    if (f.left.size() + f.right.size() > 2) ++multiple;
+  }
+  std::printf("%d split in floating point (%d into more than two pieces), %d left to the exact split\n", fast,
+              multiple, declined);
+  EXPECT_GT(multiple, 0);
+  EXPECT_GT(fast, 1000 / test::kSanitizerDivisor);
+  EXPECT_GT(declined, 0);
+}
+
+TEST(PolygonSplit, LineThroughVertexSplitsThere) {
+  const Polygon square = rect(0, 0, 10, 10);
+  SplitPieces s;
+  ASSERT_TRUE(splitByLineFast(square, {0, 0}, {std::sqrt(0.5), std::sqrt(0.5)}, s));  // the diagonal
+  ASSERT_EQ(s.left.size(), 1u);
+  ASSERT_EQ(s.right.size(), 1u);
+  EXPECT_EQ(s.left[0].outer.size(), 3u);
+  EXPECT_EQ(s.right[0].outer.size(), 3u);
+  EXPECT_DOUBLE_EQ(area(s.left[0]), 50);
+  EXPECT_DOUBLE_EQ(area(s.right[0]), 50);
+}
+
+TEST(PolygonSplit, FourCrossingsGiveThreePieces) {
+  // A U cut across both arms: two cuts, the base below and both arm ends above.
+  const Polygon u = poly({{0, 0}, {30, 0}, {30, 30}, {20, 30}, {20, 10}, {10, 10}, {10, 30}, {0, 30}});
+  SplitPieces s;
+  ASSERT_TRUE(splitByLineFast(u, {15, 20}, {1, 0}, s));
+  ASSERT_EQ(s.left.size(), 2u);
+  ASSERT_EQ(s.right.size(), 1u);
+  EXPECT_DOUBLE_EQ(area(s.left[0]) + area(s.left[1]), 200);
+  EXPECT_DOUBLE_EQ(area(s.right[0]), 500);
+  const SplitPieces e = splitByLine(u, {15, 20}, {1, 0});
+  EXPECT_TRUE(samePieces(s.left, e.left, 1e-12));
+  EXPECT_TRUE(samePieces(s.right, e.right, 1e-12));
+}
+
+TEST(PolygonSplit, FastSplitDeclinesWhatOnlyTheExactSplitHandles) {
+  SplitPieces s;
+  // A hole.
+  Polygon courtyard = rect(0, 0, 30, 30);
+  courtyard.holes.push_back({{10, 10}, {10, 20}, {20, 20}, {20, 10}});
+  normalise(courtyard);
+  EXPECT_FALSE(splitByLineFast(courtyard, {15, 15}, {1, 0}, s));
+  // A U cut across both arms through its inner corners: vertices on the line
+  // that are not crossings.
+  const Polygon u = poly({{0, 0}, {30, 0}, {30, 30}, {20, 30}, {20, 10}, {10, 10}, {10, 30}, {0, 30}});
+  EXPECT_FALSE(splitByLineFast(u, {15, 10}, {1, 0}, s));
+  // A line along an edge, and a line touching a vertex without crossing.
+  EXPECT_FALSE(splitByLineFast(rect(0, 0, 10, 10), {5, 0}, {1, 0}, s));
+  const Polygon kite = poly({{0, 0}, {10, -5}, {20, 0}, {10, 5}});
+  EXPECT_FALSE(splitByLineFast(poly({{0, 0}, {10, 0}, {10, 10}, {5, 5}, {0, 10}}), {5, 5}, {1, 0}, s));
+  // A line missing the polygon leaves it whole on one side.
+  ASSERT_TRUE(splitByLineFast(kite, {0, 10}, {1, 0}, s));
+  EXPECT_TRUE(s.left.empty());
+  EXPECT_EQ(s.right.size(), 1u);
+}
+
+}  // namespace
+}  // namespace parcelscope::generation::detail
