@@ -335,6 +335,12 @@ void MainWindow::buildMenus() {
   });
   file->addSeparator();
   file->addAction("&Quit", this, &QWidget::close, QKeySequence::Quit);
+  QMenu* view = menuBar()->addMenu("&View");
+  QAction* outlines = view->addAction("Parcel &outlines");
+  outlines->setCheckable(true);
+  outlines->setChecked(true);
+  outlines->setToolTip("Outlines cost about half of every redraw with a software OpenGL");
+  connect(outlines, &QAction::toggled, this, [this](bool on) { setOutlinesVisible(on); });
   QToolBar* bar = addToolBar("Main");
   bar->setObjectName("mainToolBar");
   bar->addAction("Open sample", this, [this] { openSample(); });
@@ -509,6 +515,13 @@ void MainWindow::setColourBy(const QString& quantity) {
   lastLatencyMs_ = static_cast<double>(t.nsecsElapsed()) / 1e6;
   lastFirstViewMs_ = lastLatencyMs_;
   emit viewsUpdated(shownSerial_);
+}
+
+void MainWindow::setOutlinesVisible(bool visible) {
+  observedView_->layer().setOutlinesVisible(visible);
+  proceduralView_->layer().setOutlinesVisible(visible);
+  observedView_->render();
+  proceduralView_->render();
 }
 
 void MainWindow::selectBlock(int block) {

@@ -58,6 +58,8 @@ public:
   void setParameter(const std::string& name, double value);
   void setStyle(const QString& style);
   void setColourBy(const QString& quantity);
+  /// Shows or hides the parcel outlines in both views (View > Parcel outlines).
+  void setOutlinesVisible(bool visible);
   /// Selects the observed block with this index (-1: none).
   void selectBlock(int block);
   /// Overrides the selected block's style and parameters, or clears its override.

@@ -85,10 +85,11 @@ int main(int argc, char** argv) {
     }
     print(row);
   };
-  for (const char* style : {"obb", "skeleton"}) {
+  for (const auto& [style, outlines] : {std::pair{"obb", true}, {"skeleton", true}, {"obb", false}}) {
     w.setStyle(style);
+    w.setOutlinesVisible(outlines);
     settle(w);
-    std::printf("style %s\n", style);
+    std::printf("style %s, parcel outlines %s\n", style, outlines ? "on" : "off");
     // A block picked by the user: its own A_max, alternating.
     w.selectBlock(100);
     measure("  block override (1 block regenerated)", repeats, [&](int i) {

@@ -629,6 +629,8 @@ void MapLayer::addTo(vtkRenderer* renderer) {
 
 vtkScalarBarActor* MapLayer::colourBar() { return impl_->bar; }
 
+void MapLayer::setOutlinesVisible(bool visible) { impl_->rings->SetVisibility(visible); }
+
 struct OutlineLayer::Impl {
   vtkNew<vtkPolyData> rings;
   vtkNew<vtkPolyDataMapper> mapper;

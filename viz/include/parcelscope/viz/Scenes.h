@@ -30,6 +30,8 @@ public:
   void setValues(const std::vector<double>& values);
   void setScale(const ColourScale& scale);
   void addTo(vtkRenderer* renderer);
+  /// Shows or hides the grey outlines (on by default).
+  void setOutlinesVisible(bool visible);
   /// The scale's colour bar (horizontal), for the caller to place.
   vtkScalarBarActor* colourBar();
 
