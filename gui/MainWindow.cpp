@@ -127,6 +127,10 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
     }
   });
   connect(worker_, &SessionWorker::progress, this, [this](double fraction, const QString& stage) {
+    // Only long updates show progress: showing the bar relays the window out
+    // and redraws every view, which would slow the short ones down.
+    const auto it = started_.find(pendingSerial_);
+    if (it != started_.end() && it->second.elapsed() < 250 && !progress_->isVisible()) return;
     progress_->setVisible(true);
     cancel_->setVisible(true);
     progress_->setValue(static_cast<int>(fraction * 100));

@@ -222,8 +222,9 @@ Distances& Comparison::distances(ComparedMetric m) {
 }
 
 Comparison compareSets(const std::vector<ParcelMetrics>& observed, const std::vector<ParcelMetrics>& generated,
-                       int bins, double upperQuantile) {
+                       int bins, double upperQuantile, std::vector<SharedHistogram>* histograms) {
   Comparison c;
+  if (histograms) histograms->clear();
   c.observed = summarizeSet(observed);
   c.generated = summarizeSet(generated);
   for (ComparedMetric m : kComparedMetrics) {
@@ -232,7 +233,9 @@ Comparison compareSets(const std::vector<ParcelMetrics>& observed, const std::ve
     Distances& out = c.distances(m);
     out.ks = d.ks;
     out.wasserstein = d.wasserstein;
-    out.intersection = histogramIntersection(sharedHistogram(a, b, bins, upperQuantile));
+    SharedHistogram h = sharedHistogram(a, b, bins, upperQuantile);
+    out.intersection = histogramIntersection(h);
+    if (histograms) histograms->push_back(std::move(h));
   }
   return c;
 }

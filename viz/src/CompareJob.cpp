@@ -140,13 +140,7 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
     c.comparison = analysis::compareSets(pick(a.metrics, a.blocks[b].parcels),
                                          pick(r.generated.metrics, generatedIn[b]), bins, quantile);
   });
-  r.city = analysis::compareSets(r.observedLots, r.generated.metrics, bins, quantile);
-  r.histograms.clear();
-  for (ComparedMetric m : analysis::kComparedMetrics) {
-    r.histograms.push_back(analysis::sharedHistogram(analysis::metricSample(r.observedLots, m),
-                                                     analysis::metricSample(r.generated.metrics, m), bins,
-                                                     quantile));
-  }
+  r.city = analysis::compareSets(r.observedLots, r.generated.metrics, bins, quantile, &r.histograms);
 }
 
 }  // namespace detail

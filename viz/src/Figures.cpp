@@ -37,6 +37,9 @@
 #include <vtkWindowToImageFilter.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <unordered_map>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -159,8 +162,6 @@ vtkSmartPointer<vtkLookupTable> lookupTable(const ColourScale& scale) {
   return lut;
 }
 
-// Triangles filling every shape (holes left open), one cell value per triangle,
-// and the shapes' rings as closed polylines.
 struct PanelGeometry {
   vtkNew<vtkPolyData> fill;
   vtkNew<vtkPolyData> rings;
@@ -188,18 +189,98 @@ bool isConvex(const Ring& ring) {
   return sign != 0;
 }
 
-void buildPanel(const MapPanel& panel, PanelGeometry& g, std::vector<vtkIdType>* trianglesPerShape = nullptr) {
+// Triangles of a shape as cells (count, point ids...) with ids relative to the
+// shape's first point, by a hash of the shape's coordinates: a map redrawn with
+// mostly the same shapes triangulates only the new ones.
+using TriangleCache = std::unordered_map<std::uint64_t, std::vector<vtkIdType>>;
+
+std::uint64_t shapeHash(const Polygon& shape) {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  auto mix = [&](std::uint64_t v) {
+    h ^= v + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+  };
+  auto ring = [&](const Ring& r) {
+    mix(r.size());
+    for (const Point& p : r) {
+      std::uint64_t x, y;
+      std::memcpy(&x, &p.x, sizeof x);
+      std::memcpy(&y, &p.y, sizeof y);
+      mix(x);
+      mix(y);
+    }
+  };
+  ring(shape.outer);
+  for (const Ring& hole : shape.holes) ring(hole);
+  return h;
+}
+
+// Triangle cells of one shape whose rings were appended from point 0 (outer
+// ring, then holes), ids relative to that point.
+std::vector<vtkIdType> triangulate(const Polygon& shape, vtkPolygon* earCut, vtkIdList* earIds) {
+  std::vector<vtkIdType> cells;
+  const auto n = static_cast<vtkIdType>(shape.outer.size());
+  // A convex shape without holes (most parcels) is a triangle fan.
+  if (shape.holes.empty() && isConvex(shape.outer)) {
+    for (vtkIdType i = 1; i + 1 < n; ++i) cells.insert(cells.end(), {3, 0, i, i + 1});
+    return cells;
+  }
+  if (shape.holes.empty()) {
+    // Ear cutting of one simple ring (vtkPolygon), reusing its buffers.
+    earCut->GetPoints()->SetNumberOfPoints(n);
+    earCut->GetPointIds()->SetNumberOfIds(n);
+    for (vtkIdType i = 0; i < n; ++i) {
+      earCut->GetPoints()->SetPoint(i, shape.outer[i].x, shape.outer[i].y, 0.0);
+      earCut->GetPointIds()->SetId(i, i);
+    }
+    earIds->Reset();
+    if (earCut->Triangulate(earIds) && earIds->GetNumberOfIds() == 3 * (n - 2)) {
+      for (vtkIdType t = 0; t < earIds->GetNumberOfIds(); t += 3) {
+        cells.insert(cells.end(), {3, earIds->GetId(t), earIds->GetId(t + 1), earIds->GetId(t + 2)});
+      }
+      return cells;
+    }
+  }
+  // Holes, or a ring ear cutting refuses: the contour triangulator on this
+  // shape's own small contour set (its cost grows with the whole input).
+  const double up[3] = {0, 0, 1};
+  vtkNew<vtkPolyData> contours;
+  vtkNew<vtkPoints> shapePoints;
+  vtkNew<vtkCellArray> shapeLines, shapeTriangles;
+  vtkIdType start = 0;
+  auto addShapeRing = [&](const Ring& ring) {
+    for (const Point& p : ring) shapePoints->InsertNextPoint(p.x, p.y, 0.0);
+    shapeLines->InsertNextCell(static_cast<int>(ring.size() + 1));
+    for (std::size_t v = 0; v < ring.size(); ++v) shapeLines->InsertCellPoint(start + static_cast<vtkIdType>(v));
+    shapeLines->InsertCellPoint(start);
+    start += static_cast<vtkIdType>(ring.size());
+  };
+  addShapeRing(shape.outer);
+  for (const Ring& hole : shape.holes) addShapeRing(hole);
+  contours->SetPoints(shapePoints);
+  contours->SetLines(shapeLines);
+  vtkContourTriangulator::TriangulateContours(contours, 0, shapeLines->GetNumberOfCells(), shapeTriangles, up);
+  vtkIdType size = 0;
+  const vtkIdType* ids = nullptr;
+  for (shapeTriangles->InitTraversal(); shapeTriangles->GetNextCell(size, ids);) {
+    cells.push_back(size);
+    cells.insert(cells.end(), ids, ids + size);
+  }
+  return cells;
+}
+
+// Triangles filling every shape (holes left open), one cell value per
+// triangle, and the shapes' rings as closed polylines. With `cache`, shapes
+// found in it are not triangulated again, and it is left holding this panel's shapes.
+void buildPanel(const MapPanel& panel, PanelGeometry& g, std::vector<vtkIdType>* trianglesPerShape = nullptr,
+                TriangleCache* cache = nullptr) {
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   vtkNew<vtkCellArray> lines, triangles;
   vtkNew<vtkDoubleArray> values;
   values->SetName("value");
-  const double up[3] = {0, 0, 1};
   vtkNew<vtkPolygon> earCut;
   vtkNew<vtkIdList> earIds;
-  // A convex shape without holes (most parcels) is a triangle fan; any other is
-  // triangulated on its own small contour set (the triangulator's cost grows
-  // with the whole input), then its triangles join the panel's.
+  TriangleCache next;
   for (std::size_t k = 0; k < panel.shapes.size(); ++k) {
     const Polygon& shape = *panel.shapes[k];
     const vtkIdType offset = points->GetNumberOfPoints();
@@ -212,66 +293,29 @@ void buildPanel(const MapPanel& panel, PanelGeometry& g, std::vector<vtkIdType>*
     };
     addRing(shape.outer);
     for (const Ring& hole : shape.holes) addRing(hole);
+    std::vector<vtkIdType> fresh;
+    const std::vector<vtkIdType>* cells = nullptr;
+    std::uint64_t hash = 0;
+    if (cache) {
+      hash = shapeHash(shape);
+      if (const auto it = cache->find(hash); it != cache->end()) cells = &it->second;
+    }
+    if (!cells) {
+      fresh = triangulate(shape, earCut, earIds);
+      cells = &fresh;
+    }
     vtkIdType count = 0;
-    const auto n = static_cast<vtkIdType>(shape.outer.size());
-    bool done = false;
-    if (shape.holes.empty() && isConvex(shape.outer)) {
-      for (vtkIdType i = 1; i + 1 < n; ++i) {
-        const vtkIdType tri[3] = {offset, offset + i, offset + i + 1};
-        triangles->InsertNextCell(3, tri);
-        values->InsertNextValue(panel.values[k]);
-      }
-      count = std::max<vtkIdType>(0, n - 2);
-      done = true;
-    } else if (shape.holes.empty()) {
-      // Ear cutting of one simple ring (vtkPolygon), reusing its buffers.
-      earCut->GetPoints()->SetNumberOfPoints(n);
-      earCut->GetPointIds()->SetNumberOfIds(n);
-      for (vtkIdType i = 0; i < n; ++i) {
-        earCut->GetPoints()->SetPoint(i, shape.outer[i].x, shape.outer[i].y, 0.0);
-        earCut->GetPointIds()->SetId(i, i);
-      }
-      earIds->Reset();
-      if (earCut->Triangulate(earIds) && earIds->GetNumberOfIds() == 3 * (n - 2)) {
-        for (vtkIdType t = 0; t < earIds->GetNumberOfIds(); t += 3) {
-          const vtkIdType tri[3] = {offset + earIds->GetId(t), offset + earIds->GetId(t + 1),
-                                    offset + earIds->GetId(t + 2)};
-          triangles->InsertNextCell(3, tri);
-          values->InsertNextValue(panel.values[k]);
-        }
-        count = n - 2;
-        done = true;
-      }
+    for (std::size_t c = 0; c < cells->size(); c += static_cast<std::size_t>((*cells)[c]) + 1) {
+      const vtkIdType size = (*cells)[c];
+      triangles->InsertNextCell(static_cast<int>(size));
+      for (vtkIdType i = 1; i <= size; ++i) triangles->InsertCellPoint(offset + (*cells)[c + i]);
+      values->InsertNextValue(panel.values[k]);
+      ++count;
     }
-    if (!done) {
-      vtkNew<vtkPolyData> contours;
-      vtkNew<vtkPoints> shapePoints;
-      vtkNew<vtkCellArray> shapeLines, shapeTriangles;
-      const vtkIdType total = points->GetNumberOfPoints() - offset;
-      for (vtkIdType i = 0; i < total; ++i) shapePoints->InsertNextPoint(points->GetPoint(offset + i));
-      vtkIdType start = 0;
-      auto addShapeRing = [&](const Ring& ring) {
-        shapeLines->InsertNextCell(static_cast<int>(ring.size() + 1));
-        for (std::size_t v = 0; v < ring.size(); ++v) shapeLines->InsertCellPoint(start + static_cast<vtkIdType>(v));
-        shapeLines->InsertCellPoint(start);
-        start += static_cast<vtkIdType>(ring.size());
-      };
-      addShapeRing(shape.outer);
-      for (const Ring& hole : shape.holes) addShapeRing(hole);
-      contours->SetPoints(shapePoints);
-      contours->SetLines(shapeLines);
-      vtkContourTriangulator::TriangulateContours(contours, 0, shapeLines->GetNumberOfCells(), shapeTriangles, up);
-      vtkIdType size = 0;
-      const vtkIdType* ids = nullptr;
-      for (shapeTriangles->InitTraversal(); shapeTriangles->GetNextCell(size, ids);) {
-        triangles->InsertNextCell(static_cast<int>(size));
-        for (vtkIdType i = 0; i < size; ++i) triangles->InsertCellPoint(offset + ids[i]);
-        values->InsertNextValue(panel.values[k]);
-      }
-      count = shapeTriangles->GetNumberOfCells();
-    }
+    if (cache) next.emplace(hash, *cells);
     if (trianglesPerShape) trianglesPerShape->push_back(count);
   }
+  if (cache) *cache = std::move(next);
   g.rings->SetPoints(points);
   g.rings->SetLines(lines);
   g.fill->SetPoints(points);
@@ -552,6 +596,7 @@ struct MapLayer::Impl {
   vtkSmartPointer<vtkLookupTable> lut = lookupTable(ColourScale{});
   vtkNew<vtkScalarBarActor> bar;
   std::vector<vtkIdType> trianglesPerShape;
+  TriangleCache triangles;
 };
 
 MapLayer::MapLayer() : impl_(std::make_unique<Impl>()) {
@@ -591,7 +636,7 @@ void MapLayer::setShapes(const std::vector<const Polygon*>& shapes, const std::v
   panel.values = values;
   PanelGeometry fresh;
   impl_->trianglesPerShape.clear();
-  buildPanel(panel, fresh, &impl_->trianglesPerShape);
+  buildPanel(panel, fresh, &impl_->trianglesPerShape, &impl_->triangles);
   impl_->geometry.fill->ShallowCopy(fresh.fill);
   impl_->geometry.rings->ShallowCopy(fresh.rings);
 }

@@ -108,9 +108,10 @@ struct Comparison {
 };
 
 /// Compares two sets of parcels. Histogram intersections use `bins` shared bins
-/// up to the pooled `upperQuantile` (see sharedHistogram).
+/// up to the pooled `upperQuantile` (see sharedHistogram); with `histograms`,
+/// those shared histograms are also returned, in the order of kComparedMetrics.
 Comparison compareSets(const std::vector<ParcelMetrics>& observed, const std::vector<ParcelMetrics>& generated,
-                       int bins, double upperQuantile);
+                       int bins, double upperQuantile, std::vector<SharedHistogram>* histograms = nullptr);
 
 struct BlockComparison {
   std::int64_t blockId = -1;
