@@ -12,13 +12,15 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// The finite values, sorted; a sample already sorted (as compareSets passes
+// them) is only copied.
 std::vector<double> finiteSorted(const std::vector<double>& v) {
   std::vector<double> out;
   out.reserve(v.size());
   for (double x : v) {
     if (std::isfinite(x)) out.push_back(x);
   }
-  std::sort(out.begin(), out.end());
+  if (!std::is_sorted(out.begin(), out.end())) std::sort(out.begin(), out.end());
   return out;
 }
 
@@ -70,10 +72,9 @@ SharedHistogram sharedHistogram(const std::vector<double>& aIn, const std::vecto
   }
   SharedHistogram h;
   const std::vector<double> a = finiteSorted(aIn), b = finiteSorted(bIn);
-  std::vector<double> pooled(a);
-  pooled.insert(pooled.end(), b.begin(), b.end());
+  std::vector<double> pooled(a.size() + b.size());
+  std::merge(a.begin(), a.end(), b.begin(), b.end(), pooled.begin());
   if (pooled.empty()) return h;
-  std::sort(pooled.begin(), pooled.end());
   const double lo = pooled.front();
   // Nearest-rank quantile; when it equals the minimum, fall back to the maximum.
   const auto rank = static_cast<std::size_t>(std::ceil(upperQuantile * static_cast<double>(pooled.size())));
@@ -228,7 +229,10 @@ Comparison compareSets(const std::vector<ParcelMetrics>& observed, const std::ve
   c.observed = summarizeSet(observed);
   c.generated = summarizeSet(generated);
   for (ComparedMetric m : kComparedMetrics) {
-    const std::vector<double> a = metricSample(observed, m), b = metricSample(generated, m);
+    // Sorted once here; the distances and the histogram then only copy them.
+    std::vector<double> a = metricSample(observed, m), b = metricSample(generated, m);
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
     const CdfDistances d = cdfDistances(a, b);
     Distances& out = c.distances(m);
     out.ks = d.ks;

@@ -23,6 +23,7 @@
 #include "parcelscope/io/Writers.h"
 #include "parcelscope/generation/GenerateJob.h"
 #include "parcelscope/viz/CompareJob.h"
+#include "parcelscope/viz/CompareSession.h"
 
 namespace {
 
@@ -252,5 +253,36 @@ void SkeletonSubdivisionPerBlock(benchmark::State& state) {
 BENCHMARK(SkeletonSubdivisionPerBlock)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
 }  // namespace
+
+// The incremental session behind the GUI on cambridge_ma: one global change
+// (omega, every block regenerated) and one block's override (one block), each
+// alternating between two values so that every iteration regenerates.
+void SessionUpdate(benchmark::State& state) {
+  if (!haveData(state)) return;
+  const bool global = state.range(0) == 1;
+  parcelscope::viz::CompareRequest request;
+  request.input.path = kCambridge;
+  request.input.where = "ML <> 'ROAD'";
+  request.style = state.range(1) == 1 ? "skeleton" : "obb";
+  request.parameters = parcelscope::defaultValues(parcelscope::viz::compareParameters());
+  request.parameters["figures"] = 0;
+  parcelscope::viz::CompareSession session;
+  session.update(request);
+  int i = 0;
+  std::size_t regenerated = 0;
+  for (auto _ : state) {
+    if (global) {
+      request.parameters["omega"] = ++i % 2 ? 0.25 : 0.35;
+      request.explicitParameters.insert("omega");
+    } else {
+      request.overrides[100].parameters["a-max"] = ++i % 2 ? 400.0 : 600.0;
+    }
+    regenerated = session.update(request).blocksRegenerated;
+  }
+  state.counters["blocks_regenerated"] = static_cast<double>(regenerated);
+  state.SetLabel(request.style + (global ? ", omega for every block" : ", one block's A_max"));
+}
+BENCHMARK(SessionUpdate)->Args({1, 0})->Args({0, 0})->Args({1, 1})->Args({0, 1})->Unit(benchmark::kMillisecond)
+    ->UseRealTime()->MinTime(3.0);
 
 BENCHMARK_MAIN();

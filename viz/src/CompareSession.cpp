@@ -99,11 +99,12 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   for (std::size_t t = 0; t < todo.size(); ++t) ready[t] = false;
   const bool partials = partial && !newInputs &&
                         std::all_of(outcomes.begin(), outcomes.end(), [](const auto& o) { return o != nullptr; });
-  // The first result in between comes after a fifth of the interval, so that
-  // an edit shows something soon; then one per interval.
+  // The first result in between comes after half the interval, so that a long
+  // edit shows something soon (and a short one is not slowed by drawing one);
+  // then one per interval.
   auto lastPartial = std::chrono::steady_clock::now() -
                      std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                         std::chrono::duration<double>(0.8 * partialSeconds));
+                         std::chrono::duration<double>(0.5 * partialSeconds));
   std::size_t partialDone = 0;
   auto emitPartial = [&] {
     std::vector<const generation::BlockOutcome*> pointers;

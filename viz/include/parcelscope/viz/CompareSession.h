@@ -47,7 +47,7 @@ public:
   /// kept for the next update and current() is unchanged. When `partial` is
   /// set and the update regenerates blocks that all had a result before, it is
   /// called (on this thread) with a result in between, the first after
-  /// partialSeconds / 5, then at most every `partialSeconds`.
+  /// partialSeconds / 2, then at most every `partialSeconds`.
   Update update(const CompareRequest& request, const ProgressFn& progress = {}, const PartialFn& partial = {},
                 double partialSeconds = 0.5);
 
