@@ -144,8 +144,11 @@ int compareCommand(const std::vector<std::string>& args) {
     for (const auto& q : analysis::parcelQuantities()) help += "\n      " + q.name + ": " + q.title;
     flags.push_back({"metric", help});
   }
+  flags.push_back({"vector", "format of the histograms' vector copy: svg (default) or pdf"});
+  flags.push_back({"parcels-format", "generated parcels as gpkg (parcels.gpkg, default) or geojson (parcels.geojson)"});
   flags.push_back({"session", "session file (saved by parcelscope-gui, or a compare run.json): input, style,\n"
-                              "      parameters, per-block overrides and seed; INPUT and options given here win"});
+                              "      parameters, per-block overrides (the only way to give those here) and seed;\n"
+                              "      INPUT and options given here win"});
   flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
   flags.push_back({"quiet", "no progress or summary on stderr", false});
   const auto params = viz::compareParameters();
@@ -186,6 +189,8 @@ int compareCommand(const std::vector<std::string>& args) {
   }
   if (auto v = a.value("style")) request.style = *v;
   if (auto v = a.value("metric")) request.metric = *v;
+  if (auto v = a.value("vector")) request.vectorFormat = *v;
+  if (auto v = a.value("parcels-format")) request.parcelsFormat = *v;
   return reportOutcome(viz::runCompare(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
 }
 

@@ -382,7 +382,7 @@ void MainWindow::openFile(const QString& path, const QString& layer, const QStri
         if (!ok) return;
         next.input.layer = chosen.toStdString();
       }
-    } catch (const Error& e) {
+    } catch (const std::exception& e) {
       showError(e.what());
       return;
     }
@@ -404,7 +404,7 @@ void MainWindow::openSession(const QString& path) {
     viz::CompareRequest next = viz::readSession(path.toStdString());
     next.parameters["figures"] = 0;
     request_ = next;
-  } catch (const Error& e) {
+  } catch (const std::exception& e) {
     showError(e.what());
     return;
   }
@@ -427,42 +427,42 @@ void MainWindow::saveSession(const QString& path) {
   try {
     viz::exportSession(request_, path.toStdString());
     status_->setText("session saved to " + path);
-  } catch (const Error& e) {
+  } catch (const std::exception& e) {
     showError(e.what());
   }
 }
 
 void MainWindow::exportFigure(const QString& name, const QString& path, int width, int height) {
-  if (!result_) return showError("nothing to export yet: open a dataset first");
+  if (!finalResult_) return showError("nothing to export yet: open a dataset first");
   // Rendering a figure of a whole city takes a few seconds; say so.
   QApplication::setOverrideCursor(Qt::WaitCursor);
   struct RestoreCursor {
     ~RestoreCursor() { QApplication::restoreOverrideCursor(); }
   } restore;
   try {
-    viz::exportFigure(*result_, request_, name.toStdString(), path.toStdString(), width, height);
+    viz::exportFigure(*finalResult_, finalRequest_, name.toStdString(), path.toStdString(), width, height);
     status_->setText(name + " exported to " + path);
-  } catch (const Error& e) {
+  } catch (const std::exception& e) {
     showError(e.what());
   }
 }
 
 void MainWindow::exportTables(const QString& folder) {
-  if (!result_) return showError("nothing to export yet: open a dataset first");
+  if (!finalResult_) return showError("nothing to export yet: open a dataset first");
   try {
-    viz::exportTables(*result_, folder.toStdString(), {request_.input.path});
+    viz::exportTables(*finalResult_, folder.toStdString(), {finalRequest_.input.path});
     status_->setText("tables exported to " + folder);
-  } catch (const Error& e) {
+  } catch (const std::exception& e) {
     showError(e.what());
   }
 }
 
 void MainWindow::exportParcels(const QString& path) {
-  if (!result_) return showError("nothing to export yet: open a dataset first");
+  if (!finalResult_) return showError("nothing to export yet: open a dataset first");
   try {
-    viz::exportParcels(*result_, path.toStdString(), {request_.input.path});
+    viz::exportParcels(*finalResult_, path.toStdString(), {finalRequest_.input.path});
     status_->setText("generated parcels exported to " + path);
-  } catch (const Error& e) {
+  } catch (const std::exception& e) {
     showError(e.what());
   }
 }
@@ -562,10 +562,22 @@ void MainWindow::submit() {
 }
 
 void MainWindow::showReport(const UpdateReport& report) {
+  // A slot: nothing may escape into Qt's event loop.
+  try {
+    drawReport(report);
+  } catch (const std::exception& e) {
+    showError(QString("cannot show the result: ") + e.what());
+  }
+}
+
+void MainWindow::drawReport(const UpdateReport& report) {
   if (report.partial && report.serial != pendingSerial_) return;  // superseded already
   const bool first = !result_ || report.reloaded;
   result_ = report.result;
+  shownRequest_ = report.request;
   if (!report.partial) {
+    finalResult_ = report.result;
+    finalRequest_ = report.request;
     shownSerial_ = report.serial;
     progress_->setVisible(false);
     cancel_->setVisible(false);
@@ -643,6 +655,12 @@ void MainWindow::showReport(const UpdateReport& report) {
   emit viewsUpdated(report.serial);
 }
 
+viz::CompareRequest MainWindow::shown() const {
+  viz::CompareRequest r = shownRequest_;
+  r.metric = request_.metric;
+  return r;
+}
+
 bool MainWindow::recolour(bool observedChanged) {
   if (!result_) return false;
   const viz::CompareResult& r = *result_;
@@ -661,7 +679,7 @@ bool MainWindow::recolour(bool observedChanged) {
   generated.reserve(r.generated.metrics.size());
   for (const auto& m : r.generated.metrics) generated.push_back(q.value(m));
   proceduralView_->layer().setValues(generated);
-  const viz::ColourScale scale = viz::quantityScale(r, request_, request_.metric);
+  const viz::ColourScale scale = viz::quantityScale(r, shown(), request_.metric);
   if (observedChanged || scale.minimum != shownScale_.minimum || scale.maximum != shownScale_.maximum ||
       scale.kind != shownScale_.kind || scale.title != shownScale_.title) {
     observedView_->layer().setScale(scale);
@@ -671,14 +689,14 @@ bool MainWindow::recolour(bool observedChanged) {
   }
   observedView_->setTitle(QString("Observed: %1 parcels").arg(r.observedLots.size()));
   proceduralView_->setTitle(QString("Procedural (%1, seed %2): %3 parcels")
-                                .arg(QString::fromStdString(request_.style))
+                                .arg(QString::fromStdString(shown().style))
                                 .arg(r.generated.seed)
                                 .arg(generated.size()));
   return observedChanged;
 }
 
 void MainWindow::drawHistogram() {
-  const viz::QuantityHistogram h = viz::quantityHistogram(*result_, request_, request_.metric);
+  const viz::QuantityHistogram h = viz::quantityHistogram(*result_, shown(), request_.metric);
   histogramCounts_.clear();
   if (h.edges.empty()) {
     chart_->ClearPlots();

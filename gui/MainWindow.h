@@ -102,6 +102,9 @@ private:
   QWidget* buildControls();
   void submit();
   void showReport(const UpdateReport& report);
+  void drawReport(const UpdateReport& report);
+  /// The request of the result shown, with the colouring chosen now.
+  viz::CompareRequest shown() const;
   void showError(const QString& message);
   /// Recolours the views; returns whether the observed view changed (it is
   /// drawn again only then). `observedChanged`: its data changed.
@@ -117,7 +120,10 @@ private:
   QThread thread_;
   SessionWorker* worker_;
   viz::CompareRequest request_;
-  std::shared_ptr<const viz::CompareResult> result_;
+  std::shared_ptr<const viz::CompareResult> result_;  ///< shown (possibly a result in between)
+  viz::CompareRequest shownRequest_;                    ///< the request of result_
+  std::shared_ptr<const viz::CompareResult> finalResult_;  ///< the last complete result (exports)
+  viz::CompareRequest finalRequest_;                       ///< its request
   bool loaded_ = false;
   qint64 pendingSerial_ = 0, shownSerial_ = 0;
   bool failedOrCancelled_ = false;

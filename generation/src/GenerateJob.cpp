@@ -81,7 +81,7 @@ std::int64_t positionKey(const Polygon& shape, const io::LocalFrame& frame) {
 
 namespace {
 
-void checkStyle(const std::string& style, bool allowAuto) {
+void checkStyle(const std::string& style, bool allowAuto, const std::string& where = "") {
   std::string names;
   bool known = false;
   for (const auto& [name, help] : generationStyles()) {
@@ -89,7 +89,10 @@ void checkStyle(const std::string& style, bool allowAuto) {
     known = known || name == style;
     names += (names.empty() ? "" : ", ") + name;
   }
-  if (!known) throw usageError("--style " + style + " is not available (styles: " + names + ")");
+  if (!known) {
+    throw usageError((where.empty() ? "--style " : where + ": style ") + style + " is not available (styles: " +
+                     names + ")");
+  }
 }
 
 std::uint64_t runSeed(const ParameterValues& values) {
@@ -177,7 +180,7 @@ std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInp
   for (const auto& [id, o] : request.overrides) {
     const std::string where = "block " + std::to_string(id);
     if (!ids.count(id)) throw usageError(where + ": no such block (override)");
-    if (!o.style.empty()) checkStyle(o.style, true);
+    if (!o.style.empty()) checkStyle(o.style, true, where);
     ParameterValues merged = request.parameters;
     for (const auto& [name, v] : o.parameters) merged[name] = v;
     check(o.parameters, where, true);

@@ -381,3 +381,25 @@ TEST(CompareCommand, MetricDrawsItsMapAndHistogram) {
 
 }  // namespace
 }  // namespace parcelscope
+
+namespace parcelscope {
+namespace {
+
+// The application exports histograms as PDF and parcels as GeoJSON; so does compare.
+TEST(CompareCommand, PdfHistogramsAndGeoJsonParcels) {
+  TempDir dir;
+  const std::string out = dir.file("out");
+  const CliRun r = compareSample(out, "--vector pdf --parcels-format geojson --figure-width 600 --figure-height 300");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(test::slurp(out + "/figures/hist_area.pdf").rfind("%PDF", 0), 0u);
+  EXPECT_FALSE(fs::exists(out + "/figures/hist_area.svg"));
+  EXPECT_NE(test::slurp(out + "/parcels.geojson").find("\"FeatureCollection\""), std::string::npos);
+  EXPECT_FALSE(fs::exists(out + "/parcels.gpkg"));
+  const CliRun bad = compareSample(dir.file("bad"), "--parcels-format shp --figures 0");
+  EXPECT_EQ(bad.code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("--parcels-format shp"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(dir.file("bad")));
+}
+
+}  // namespace
+}  // namespace parcelscope

@@ -197,6 +197,24 @@ TEST(CompareSession, ResultsInBetweenTileEveryBlock) {
   expectSameResult(*u.result, compare(request));
 }
 
+// An update cancelled halfway keeps the blocks it finished; the next update
+// must not reuse those blocks' old comparisons.
+TEST(CompareSession, BlocksFinishedBeforeACancelAreComparedAgain) {
+  TempDir dir;
+  CompareRequest request = sampleRequest();
+  request.input = {};
+  request.input.path = gridOfBlocks(dir);
+  CompareSession session;
+  session.update(request);
+  request.style = "skeleton";
+  const ProgressFn stopHalfway = [](double fraction, const std::string&) { return fraction < 0.4; };
+  EXPECT_THROW(session.update(request, stopHalfway), Error);
+  request.overrides[0].parameters["w-max"] = 15;
+  const auto u = session.update(request);
+  EXPECT_LT(u.blocksRegenerated, 48u) << "the blocks finished before the cancel are kept";
+  expectSameResult(*u.result, compare(request));
+}
+
 TEST(CompareSession, CancelledUpdateLeavesTheLastResult) {
   CompareSession session;
   CompareRequest request = sampleRequest();

@@ -105,6 +105,12 @@ void checkRequest(const CompareRequest& request) {
     if (it != request.parameters.end()) checkValue(d, it->second);
   }
   analysis::parcelQuantity(request.metric);
+  if (request.vectorFormat != "svg" && request.vectorFormat != "pdf") {
+    throw usageError("--vector " + request.vectorFormat + ": the histograms' vector copy is svg or pdf");
+  }
+  if (request.parcelsFormat != "gpkg" && request.parcelsFormat != "geojson") {
+    throw usageError("--parcels-format " + request.parcelsFormat + ": generated parcels are written as gpkg or geojson");
+  }
 }
 
 void compareStage(CompareResult& r, const CompareRequest& request, const std::vector<char>* keep) {
@@ -257,7 +263,9 @@ ColourScale quantityScale(const CompareResult& r, const CompareRequest& request,
   std::sort(pooled.begin(), pooled.end());
   const double quantile = value(request, "histogram-quantile");
   scale.minimum = pooled.front();
-  scale.maximum = pooled[static_cast<std::size_t>(std::floor(quantile * static_cast<double>(pooled.size() - 1)))];
+  // The nearest-rank quantile, as the histograms' bins (analysis::sharedHistogram).
+  const auto rank = static_cast<std::size_t>(std::ceil(quantile * static_cast<double>(pooled.size())));
+  scale.maximum = pooled[std::min(pooled.size(), std::max<std::size_t>(rank, 1)) - 1];
   if (!(scale.maximum > scale.minimum)) scale.maximum = scale.minimum + 1;
   if (quantile < 1 && pooled.back() > scale.maximum) {
     std::snprintf(title, sizeof title, "; %.4g and above drawn darkest", scale.maximum);
@@ -447,7 +455,7 @@ struct FigureSet {
     written.push_back("figures/" + name + ".png");
     o.png = out.stage(written.back());
     if (name.rfind("map_", 0) != 0) {
-      written.push_back("figures/" + name + ".svg");
+      written.push_back("figures/" + name + "." + request.vectorFormat);
       o.vector = out.stage(written.back());
     }
     o.width = static_cast<int>(value(request, "figure-width"));
@@ -468,7 +476,8 @@ analysis::JobOutcome runCompare(const CompareRequest& request, const std::string
 
   reportProgress(progress, 0.8, "writing");
   const auto writeStart = std::chrono::steady_clock::now();
-  std::vector<std::string> outputs = {"parcels.gpkg",          "blocks.gpkg", "observed_parcels.csv",
+  const std::string parcelsFile = "parcels." + request.parcelsFormat;
+  std::vector<std::string> outputs = {parcelsFile,             "blocks.gpkg", "observed_parcels.csv",
                                       "generated_parcels.csv", "blocks.csv",  "summary.csv",
                                       "distances.csv"};
   // The two layers (SQLite inserts, one thread each) are written while this
@@ -482,7 +491,7 @@ analysis::JobOutcome runCompare(const CompareRequest& request, const std::string
   });
   std::vector<std::vector<Polygon>> geometries;
   const Table generatedTable = generatedTableOf(r, &geometries);
-  const std::string parcelsGpkg = out.stage("parcels.gpkg");
+  const std::string parcelsGpkg = out.stage(parcelsFile);
   std::future<void> parcelWriting = std::async(std::launch::async, [&] {
     io::writePolygonLayer(parcelsGpkg, "parcels", geometries, generatedTable, r.observed->layer.frame,
                           r.observed->layer.crs);

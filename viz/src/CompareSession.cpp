@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <filesystem>
+#include <set>
 
 #include "CompareStages.h"
 #include "parcelscope/core/Error.h"
@@ -16,6 +17,11 @@ namespace {
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::uint64_t runSeedOf(const CompareRequest& request) {
+  const auto it = request.parameters.find("seed");
+  return it == request.parameters.end() ? 1 : static_cast<std::uint64_t>(it->second);
 }
 
 bool sameInput(const io::ReadOptions& a, const io::ReadOptions& b) {
@@ -39,6 +45,9 @@ struct CompareSession::State {
   std::vector<generation::BlockPlan> plans;  // one per entry; outcomes[k] was made with plans[k]
   std::vector<std::shared_ptr<const generation::BlockOutcome>> outcomes;
   std::shared_ptr<const CompareResult> current;
+  // Blocks whose parcels a cancelled update replaced: current->blocks still
+  // compares their old parcels, so their comparison is not reused.
+  std::set<std::int64_t> staleComparisons;
 };
 
 CompareSession::CompareSession() : state_(std::make_unique<State>()) {}
@@ -97,7 +106,22 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   // Set (release) once made[t] is written, so the progress tick may read it.
   std::unique_ptr<std::atomic<bool>[]> ready(new std::atomic<bool>[todo.size()]);
   for (std::size_t t = 0; t < todo.size(); ++t) ready[t] = false;
-  const bool partials = partial && !newInputs &&
+  // Per-block comparisons of the last result are reused for blocks that did
+  // not change, when the bins are the same.
+  const bool sameBins = s.current && compareValue(s.request, "bins") == compareValue(request, "bins") &&
+                        compareValue(s.request, "histogram-quantile") == compareValue(request, "histogram-quantile");
+  auto keepFlags = [&](const std::vector<char>& changedEntries) {
+    std::vector<char> keep(observed->analysis.blocks.size(), 1);
+    for (std::size_t e = 0; e < changedEntries.size(); ++e) {
+      if (changedEntries[e]) keep[static_cast<std::size_t>(inputs.entries[e].blockId)] = 0;
+    }
+    for (std::int64_t id : s.staleComparisons) {
+      if (id >= 0 && static_cast<std::size_t>(id) < keep.size()) keep[static_cast<std::size_t>(id)] = 0;
+    }
+    return keep;
+  };
+  const std::uint64_t seed = runSeedOf(request);
+  const bool partials = partial && !newInputs && sameBins &&
                         std::all_of(outcomes.begin(), outcomes.end(), [](const auto& o) { return o != nullptr; });
   // The first result in between comes after half the interval, so that a long
   // edit shows something soon (and a short one is not slowed by drawing one);
@@ -111,23 +135,22 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
     std::vector<generation::BlockPlan> mixed = done;
     for (const auto& o : outcomes) pointers.push_back(o.get());
     std::size_t n = 0;
-    std::vector<char> keep(observed->analysis.blocks.size(), 1);
+    std::vector<char> changed(plans.size(), 0);
     for (std::size_t t = 0; t < todo.size(); ++t) {
       if (!ready[t].load(std::memory_order_acquire)) continue;
       pointers[todo[t]] = made[t].get();
       mixed[todo[t]] = plans[todo[t]];
-      keep[static_cast<std::size_t>(inputs.entries[todo[t]].blockId)] = 0;
+      changed[todo[t]] = 1;
       ++n;
     }
     if (n == partialDone) return;
     partialDone = n;
     CompareResult r;
     r.observed = observed;
-    const auto seedIt = request.parameters.find("seed");
-    r.generated = generation::assembleParcels(
-        inputs, mixed, pointers, seedIt == request.parameters.end() ? 1 : static_cast<std::uint64_t>(seedIt->second));
+    r.generated = generation::assembleParcels(inputs, mixed, pointers, seed);
     r.blocks = s.current->blocks;
     r.observedLots = s.current->observedLots;
+    const std::vector<char> keep = keepFlags(changed);
     detail::compareStage(r, request, &keep);
     partial(std::make_shared<const CompareResult>(std::move(r)), n, todo.size());
   };
@@ -159,8 +182,11 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
         })
              : std::function<void(std::size_t)>());
   } catch (const Error& e) {
-    if (e.kind() == Error::Kind::Cancelled && !reload && !newInputs) {
+    if (e.kind() == Error::Kind::Cancelled && !newInputs) {
       keepFinished();
+      for (std::size_t t = 0; t < todo.size(); ++t) {
+        if (made[t]) s.staleComparisons.insert(inputs.entries[todo[t]].blockId);
+      }
       s.outcomes = std::move(outcomes);
       s.plans = std::move(done);
     }
@@ -174,19 +200,16 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   r.observed = observed;
   std::vector<const generation::BlockOutcome*> pointers;
   for (const auto& o : outcomes) pointers.push_back(o.get());
-  const auto seedIt = request.parameters.find("seed");
-  r.generated = generation::assembleParcels(inputs, plans, pointers,
-                                            seedIt == request.parameters.end() ? 1 : static_cast<std::uint64_t>(seedIt->second));
+  r.generated = generation::assembleParcels(inputs, plans, pointers, seed);
   r.generated.clampedBounds = clamped;
   const double generateSeconds = secondsSince(generateStart);
 
   const auto compareStart = std::chrono::steady_clock::now();
   std::vector<char> keep;
-  const bool sameBins = s.current && compareValue(s.request, "bins") == compareValue(request, "bins") &&
-                        compareValue(s.request, "histogram-quantile") == compareValue(request, "histogram-quantile");
   if (!reload && sameBins) {
-    keep.assign(observed->analysis.blocks.size(), 1);
-    for (std::size_t t : todo) keep[static_cast<std::size_t>(inputs.entries[t].blockId)] = 0;
+    std::vector<char> changed(plans.size(), 0);
+    for (std::size_t t : todo) changed[t] = 1;
+    keep = keepFlags(changed);
     r.blocks = s.current->blocks;
     r.observedLots = s.current->observedLots;
   }
@@ -203,6 +226,7 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   s.outcomes = std::move(outcomes);
   s.request = request;
   s.current = std::make_shared<const CompareResult>(std::move(r));
+  s.staleComparisons.clear();
   reportProgress(progress, 1.0, "done");
 
   u.result = s.current;
@@ -242,7 +266,10 @@ Json sessionJson(const CompareRequest& request) {
 CompareRequest readSession(const std::string& path) {
   Json root = io::readJson(path);
   if (!root.find("parcelscope_session")) {
-    if (const Json* inner = root.find("session")) root = *inner;  // a compare run.json
+    if (const Json* inner = root.find("session")) {  // a compare run.json
+      Json session = *inner;
+      root = std::move(session);
+    }
   }
   auto bad = [&](const std::string& what) { return inputError(path + ": session " + what); };
   if (!root.isObject() || !root.find("parcelscope_session")) {
@@ -267,7 +294,14 @@ CompareRequest readSession(const std::string& path) {
   request.input.where = text(*input, "where", "input.");
   request.input.crsOverride = text(*input, "crs", "input.");
   if (const std::string style = text(root, "style", ""); !style.empty()) request.style = style;
-  if (const std::string metric = text(root, "metric", ""); !metric.empty()) request.metric = metric;
+  if (const std::string metric = text(root, "metric", ""); !metric.empty()) {
+    try {
+      analysis::parcelQuantity(metric);
+    } catch (const Error& e) {
+      throw bad("member metric: " + std::string(e.what()));
+    }
+    request.metric = metric;
+  }
 
   const std::vector<ParameterDescription> descriptions = compareParameters();
   request.parameters = defaultValues(descriptions);

@@ -31,6 +31,11 @@ struct CompareRequest {
   /// A parcel quantity (analysis::parcelQuantities()) drawn as the extra figures
   /// map_<metric> and hist_<metric> when it is not one drawn anyway.
   std::string metric = "aspect_ratio";
+  /// Vector copy of the histograms written by runCompare: "svg" or "pdf".
+  std::string vectorFormat = "svg";
+  /// Format of the generated parcels written by runCompare: "gpkg"
+  /// (parcels.gpkg) or "geojson" (parcels.geojson).
+  std::string parcelsFormat = "gpkg";
 };
 
 /// The value of compare parameter `name` in `request`, or its default.
