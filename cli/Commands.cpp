@@ -161,7 +161,7 @@ int compareCommand(const std::vector<std::string>& args) {
                "block is subdivided with its own bounds (A-bar -/+ k s_A, W-bar -/+ k s_W) unless --a-min etc.\n"
                "are given; both sets are measured alike and compared. Writes DIR/parcels.gpkg, blocks.gpkg,\n"
                "observed_parcels.csv, generated_parcels.csv, blocks.csv, summary.csv, distances.csv,\n"
-               "summary.json, run.json and DIR/figures/*.png and *.svg (figures need an X server: use\n"
+               "summary.json, run.json and DIR/figures/*.png and *.svg or *.pdf (figures need an X server: use\n"
                "'xvfb-run -a' without a screen, or --figures 0).\n",
                stdout);
     return 0;

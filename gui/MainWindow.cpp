@@ -433,35 +433,31 @@ void MainWindow::saveSession(const QString& path) {
 }
 
 void MainWindow::exportFigure(const QString& name, const QString& path, int width, int height) {
-  if (!finalResult_) return showError("nothing to export yet: open a dataset first");
   // Rendering a figure of a whole city takes a few seconds; say so.
   QApplication::setOverrideCursor(Qt::WaitCursor);
   struct RestoreCursor {
     ~RestoreCursor() { QApplication::restoreOverrideCursor(); }
   } restore;
-  try {
+  exportWith(name + " exported to " + path, [&] {
     viz::exportFigure(*finalResult_, finalRequest_, name.toStdString(), path.toStdString(), width, height);
-    status_->setText(name + " exported to " + path);
-  } catch (const std::exception& e) {
-    showError(e.what());
-  }
+  });
 }
 
 void MainWindow::exportTables(const QString& folder) {
-  if (!finalResult_) return showError("nothing to export yet: open a dataset first");
-  try {
-    viz::exportTables(*finalResult_, folder.toStdString(), {finalRequest_.input.path});
-    status_->setText("tables exported to " + folder);
-  } catch (const std::exception& e) {
-    showError(e.what());
-  }
+  exportWith("tables exported to " + folder,
+             [&] { viz::exportTables(*finalResult_, folder.toStdString(), {finalRequest_.input.path}); });
 }
 
 void MainWindow::exportParcels(const QString& path) {
+  exportWith("generated parcels exported to " + path,
+             [&] { viz::exportParcels(*finalResult_, path.toStdString(), {finalRequest_.input.path}); });
+}
+
+void MainWindow::exportWith(const QString& done, const std::function<void()>& write) {
   if (!finalResult_) return showError("nothing to export yet: open a dataset first");
   try {
-    viz::exportParcels(*finalResult_, path.toStdString(), {finalRequest_.input.path});
-    status_->setText("generated parcels exported to " + path);
+    write();
+    status_->setText(done);
   } catch (const std::exception& e) {
     showError(e.what());
   }

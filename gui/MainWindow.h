@@ -9,6 +9,7 @@
 #include <QString>
 #include <QThread>
 
+#include <functional>
 #include <map>
 #include <memory>
 
@@ -115,6 +116,8 @@ private:
   void rememberRecent(const QString& path);
   void refreshRecent();
   void exportFigureDialog();
+  /// Runs `write` on the last complete result; says `done` or shows the error.
+  void exportWith(const QString& done, const std::function<void()>& write);
   void askForCrs();
 
   QThread thread_;

@@ -172,13 +172,7 @@ std::vector<double> quantitySample(const std::vector<ParcelMetrics>& metrics, co
 }
 
 std::vector<double> metricSample(const std::vector<ParcelMetrics>& metrics, ComparedMetric m) {
-  std::vector<double> out;
-  out.reserve(metrics.size());
-  for (const ParcelMetrics& p : metrics) {
-    const double v = m == ComparedMetric::Area ? p.area : m == ComparedMetric::Width ? p.width : p.aspectRatio;
-    if (std::isfinite(v)) out.push_back(v);
-  }
-  return out;
+  return quantitySample(metrics, parcelQuantity(metricName(m)));
 }
 
 SetSummary summarizeSet(const std::vector<ParcelMetrics>& metrics) {

@@ -65,9 +65,7 @@ double secondsIn(const Timings& t) {
   return s;
 }
 
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
+using detail::secondsSince;
 
 std::vector<ParcelMetrics> pick(const std::vector<ParcelMetrics>& all, const std::vector<int>& indices) {
   std::vector<ParcelMetrics> out;

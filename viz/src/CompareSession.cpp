@@ -15,9 +15,7 @@ namespace parcelscope::viz {
 
 namespace {
 
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
+using detail::secondsSince;
 
 std::uint64_t runSeedOf(const CompareRequest& request) {
   const auto it = request.parameters.find("seed");

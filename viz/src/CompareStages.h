@@ -1,10 +1,15 @@
 #pragma once
 // The comparison stage shared by compare() and CompareSession.
+#include <chrono>
 #include <vector>
 
 #include "parcelscope/viz/CompareJob.h"
 
 namespace parcelscope::viz::detail {
+
+inline double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
 
 /// Fills r.observedLots (when empty), r.blocks, r.city and r.histograms from
 /// r.observed and r.generated. Where `keep` (one flag per observed block) is
