@@ -9,6 +9,7 @@
 #include <iterator>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "parcelscope/core/Geometry.h"
 
@@ -20,6 +21,22 @@ inline Polygon rect(double x0, double y0, double x1, double y1) {
 
 inline Polygon poly(std::initializer_list<Point> outer, std::initializer_list<Ring> holes = {}) {
   return Polygon{Ring(outer), std::vector<Ring>(holes)};
+}
+
+/// Lots of an nx by ny grid of 10 m cells whose corners are moved at random by
+/// up to 0.3 m; neighbouring lots share their corners exactly. Each cell is
+/// kept with probability `keep` (the rest leave holes and separate parts).
+inline std::vector<Polygon> jitteredGrid(std::mt19937& rng, int nx, int ny, double keep) {
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+  std::bernoulli_distribution kept(keep);
+  std::vector<std::vector<Point>> corner(nx + 1, std::vector<Point>(ny + 1));
+  for (int i = 0; i <= nx; ++i)
+    for (int j = 0; j <= ny; ++j) corner[i][j] = {10.0 * i + jitter(rng), 10.0 * j + jitter(rng)};
+  std::vector<Polygon> lots;
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j)
+      if (kept(rng)) lots.push_back({{corner[i][j], corner[i + 1][j], corner[i + 1][j + 1], corner[i][j + 1]}, {}});
+  return lots;
 }
 
 /// A fresh empty folder under the system temp dir, removed at destruction.

@@ -7,11 +7,17 @@
 #include <memory>
 
 #include "OgrConvert.h"
+#include "parcelscope/core/Coverage.h"
 #include "parcelscope/core/Error.h"
 
 namespace parcelscope::io {
 
 namespace {
+// A vertex within this distance (m) of a neighbour's edge is taken to lie on
+// it when dissolving a block: far below any surveyed precision, far above
+// the rounding of projected coordinates near the origin.
+constexpr double kCoverageSnap = 1e-6;
+
 std::vector<Polygon> polygonsOf(const OGRGeometry& g) {
   std::vector<std::unique_ptr<OGRPolygon>> parts;
   detail::collectPolygons(g, parts);
@@ -66,15 +72,37 @@ std::unique_ptr<OGRGeometry> coverageUnion(const OGRMultiPolygon& multi, double 
 std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, double closeDistance) {
   detail::QuietErrors quiet;
   if (polygons.empty()) return {};
-  OGRMultiPolygon multi;
-  double totalArea = 0;
-  for (const Polygon* p : polygons) {
-    multi.addGeometryDirectly(detail::toOgr(*p).release());
-    totalArea += area(*p);
+  // Parcels that share their edges vertex for vertex (most blocks), also after
+  // splitting edges at a neighbour's vertex lying on them: cancel the shared
+  // edges, and keep the rings left when GEOS finds them valid. Otherwise GEOS
+  // unions them: its coverage union, then a general union.
+  std::unique_ptr<OGRGeometry> result;
+  for (const double snap : {0.0, kCoverageSnap}) {
+    auto dissolved = dissolveCoverage(polygons, {snap});
+    if (!dissolved || dissolved->empty()) continue;
+    if (dissolved->size() == 1) {
+      auto single = detail::toOgr(dissolved->front());
+      if (!single->IsValid()) continue;
+      if (dissolved->front().holes.empty()) return std::move(*dissolved);  // nothing to close
+      result = std::move(single);
+    } else {
+      auto multi = detail::toOgr(*dissolved);
+      if (!multi->IsValid()) continue;
+      result = std::move(multi);
+    }
+    break;
   }
-  std::unique_ptr<OGRGeometry> result = coverageUnion(multi, totalArea);
-  if (!result) result.reset(multi.UnionCascaded());
-  if (!result) result.reset(multi.Buffer(0.0));
+  if (!result) {
+    OGRMultiPolygon multi;
+    double totalArea = 0;
+    for (const Polygon* p : polygons) {
+      multi.addGeometryDirectly(detail::toOgr(*p).release());
+      totalArea += area(*p);
+    }
+    result = coverageUnion(multi, totalArea);
+    if (!result) result.reset(multi.UnionCascaded());
+    if (!result) result.reset(multi.Buffer(0.0));
+  }
   const bool simple = result && wkbFlatten(result->getGeometryType()) == wkbPolygon &&
                       result->toPolygon()->getNumInteriorRings() == 0;
   if (result && closeDistance > 0 && !simple) {

@@ -5,6 +5,7 @@
 #include <GeographicLib/Geodesic.hpp>
 #include <filesystem>
 #include <fstream>
+#include <random>
 
 #include "TestUtil.h"
 #include "parcelscope/core/Error.h"
@@ -189,6 +190,55 @@ TEST(GeometryOps, UnionClosesGapsNarrowerThanTheTolerance) {
   ASSERT_EQ(courtyard.size(), 1u);
   EXPECT_EQ(courtyard[0].holes.size(), 1u);
   EXPECT_NEAR(area(courtyard[0]), 800.0, 1e-6);
+}
+
+// Jittered grids with cells left out (holes, separate parts, corners where
+// only two cells meet): the union equals GEOS's general union of the same lots.
+TEST(GeometryOps, UnionOfRandomGridsMatchesGeosUnion) {
+  const unsigned seed = std::random_device{}();
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  std::mt19937 rng(seed);
+  auto toOgr = [](const Polygon& p) {
+    auto ring = std::make_unique<OGRLinearRing>();
+    for (const Point& v : p.outer) ring->addPoint(v.x, v.y);
+    ring->addPoint(p.outer.front().x, p.outer.front().y);
+    auto polygon = std::make_unique<OGRPolygon>();
+    polygon->addRingDirectly(ring.release());
+    return polygon;
+  };
+  for (int round = 0; round < 30; ++round) {
+    const std::vector<Polygon> lots =
+        test::jitteredGrid(rng, 2 + static_cast<int>(rng() % 5), 2 + static_cast<int>(rng() % 5), 0.8);
+    if (lots.empty()) continue;
+    std::vector<const Polygon*> members;
+    OGRMultiPolygon all;
+    for (const Polygon& p : lots) {
+      members.push_back(&p);
+      all.addGeometryDirectly(toOgr(p).release());
+    }
+    const auto ours = unionAndClose(members, 0.0);
+    std::unique_ptr<OGRGeometry> geos(all.UnionCascaded());
+    ASSERT_NE(geos, nullptr);
+    OGRMultiPolygon mine;
+    for (const Polygon& p : ours) {
+      auto polygon = toOgr(p);
+      for (const Ring& h : p.holes) {
+        auto ring = std::make_unique<OGRLinearRing>();
+        for (const Point& v : h) ring->addPoint(v.x, v.y);
+        ring->addPoint(h.front().x, h.front().y);
+        polygon->addRingDirectly(ring.release());
+      }
+      mine.addGeometryDirectly(polygon.release());
+    }
+    EXPECT_TRUE(mine.IsValid());
+    std::unique_ptr<OGRGeometry> difference(mine.SymDifference(geos.get()));
+    ASSERT_NE(difference, nullptr);
+    double ourArea = 0;
+    for (const Polygon& p : ours) ourArea += area(p);
+    const double differenceArea = difference->IsEmpty() ? 0.0 : OGR_G_Area(OGRGeometry::ToHandle(difference.get()));
+    EXPECT_LE(differenceArea, 1e-9 * ourArea);
+    EXPECT_NEAR(OGR_G_Area(OGRGeometry::ToHandle(geos.get())), ourArea, 1e-9 * ourArea);
+  }
 }
 
 TEST(GeometryOps, ValidityAndIntersection) {

@@ -12,6 +12,9 @@ namespace parcelscope::io {
 /// (buffer out by half of it, back in by half of it) so that parts separated by
 /// gaps narrower than `closeDistance` join and slivers narrower than it vanish.
 /// Holes wider than `closeDistance` are kept. Returns normalised polygons.
+/// Polygons forming a clean coverage (see `dissolveCoverage`) are dissolved
+/// without an overlay when GEOS finds the outline valid; others go through
+/// GEOS's coverage union, then its general union.
 /// Throws Error(Geometry) if GEOS fails even after a buffer(0) repair.
 std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, double closeDistance);
 
