@@ -115,7 +115,7 @@ Json readJson(const std::string& path) {
 
 void writePolygonLayer(const std::string& path, const std::string& layerName,
                        const std::vector<std::vector<Polygon>>& geometries, const Table& attributes,
-                       const LocalFrame& frame, const CrsInfo& crs) {
+                       const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex) {
   detail::ensureGdalRegistered();
   detail::QuietErrors quiet;
   CPLErrorReset();
@@ -140,7 +140,9 @@ void writePolygonLayer(const std::string& path, const std::string& layerName,
     srs.SetFromUserInput("OGC:CRS84");
   }
   srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  OGRLayer* layer = ds->CreateLayer(layerName.c_str(), &srs, wkbMultiPolygon, nullptr);
+  CPLStringList layerOptions;
+  if (!geojson && !spatialIndex) layerOptions.SetNameValue("SPATIAL_INDEX", "NO");
+  OGRLayer* layer = ds->CreateLayer(layerName.c_str(), &srs, wkbMultiPolygon, layerOptions.List());
   if (!layer) throw fail("cannot create layer " + layerName);
   for (const Column& c : attributes.columns) {
     const OGRFieldType type = c.type == Column::Type::Integer ? OFTInteger64

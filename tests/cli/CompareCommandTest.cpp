@@ -170,6 +170,7 @@ void expectCompareOutputs(const std::string& out, const Expected& e) {
   EXPECT_GE(layer->GetLayerDefn()->GetFieldIndex("block_id"), 0);
   EXPECT_GE(layer->GetLayerDefn()->GetFieldIndex("aspect_ratio"), 0);
   EXPECT_EQ(layer->GetFeatureCount(), generated);
+  EXPECT_TRUE(layer->TestCapability(OLCFastSpatialFilter)) << "no spatial index";
   ASSERT_NE(layer->GetSpatialRef(), nullptr);
   // The input's own CRS, or the one given with --crs.
   OGRSpatialReference expected;
@@ -263,11 +264,21 @@ TEST(CompareCommand, WithoutDisplayFiguresFailCleanlyAndFiguresZeroSkipsThem) {
   EXPECT_EQ(r.code, 1) << r.output;
   EXPECT_NE(r.output.find("xvfb-run"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir.file("a")));
-  const CliRun tablesOnly =
-      runCli("compare " + kSampleArgs + " --figures 0 --out '" + dir.file("b") + "' --quiet", "env -u DISPLAY");
+  const CliRun tablesOnly = runCli(
+      "compare " + kSampleArgs + " --figures 0 --spatial-index 0 --out '" + dir.file("b") + "' --quiet",
+      "env -u DISPLAY");
   ASSERT_EQ(tablesOnly.code, 0) << tablesOnly.output;
   EXPECT_TRUE(fs::exists(dir.file("b") + "/summary.json"));
   EXPECT_FALSE(fs::exists(dir.file("b") + "/figures"));
+  // --spatial-index 0: the same layers without their R-tree.
+  for (const char* name : {"parcels", "blocks"}) {
+    auto gpkg = openVector(dir.file("b") + "/" + name + ".gpkg");
+    ASSERT_TRUE(gpkg);
+    OGRLayer* layer = gpkg->GetLayerByName(name);
+    ASSERT_NE(layer, nullptr);
+    EXPECT_GT(layer->GetFeatureCount(), 0);
+    EXPECT_FALSE(layer->TestCapability(OLCFastSpatialFilter)) << name;
+  }
 }
 
 TEST(CompareCommand, DrawsAProgressBarOnATerminal) {

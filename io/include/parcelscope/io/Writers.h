@@ -29,10 +29,13 @@ Json readJson(const std::string& path);
 /// `geometries[i]` (one or more polygons, written as a MultiPolygon) and the
 /// attributes of `attributes.rows[i]`. Coordinates are mapped back from local
 /// metres with `frame` and tagged with `crs` (OGC:CRS84 when the CRS was assumed).
+/// A GeoPackage layer gets an R-tree spatial index unless `spatialIndex` is
+/// false: GIS tools draw large layers faster with it, and SQLite takes about
+/// 10 microseconds per feature to build it (3 s for 350,000 parcels).
 /// Throws Error(IO) on failure.
 void writePolygonLayer(const std::string& path, const std::string& layerName,
                        const std::vector<std::vector<Polygon>>& geometries, const Table& attributes,
-                       const LocalFrame& frame, const CrsInfo& crs);
+                       const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex = true);
 
 /// The GDAL version string, for run records.
 std::string gdalVersion();
