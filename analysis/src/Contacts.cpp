@@ -165,9 +165,11 @@ struct PairMeasure {
 // half the close tolerance) meet and that come within the close tolerance;
 // covered intervals within the shared tolerance, united per edge and summed in
 // ring order. `boxA` and `boxB` are the polygons' bounds grown the same way:
-// only edges meeting the other polygon's box can pair.
+// only edges meeting the other polygon's box can pair. Without `closeness`
+// only the shared lengths are measured (`close` stays false): an edge pair
+// with a covered interval is within the tolerance anyway.
 PairMeasure measurePair(const Polygon& a, const Polygon& b, const Box& boxA, const Box& boxB, double closeTolerance,
-                        double sharedTolerance) {
+                        double sharedTolerance, bool closeness = true) {
   thread_local std::vector<NearEdge> ea, eb;
   thread_local std::vector<std::pair<double, double>> intervals;
   thread_local std::vector<Cover> coversB;
@@ -181,8 +183,10 @@ PairMeasure measurePair(const Polygon& a, const Polygon& b, const Box& boxA, con
     for (std::size_t j = 0; j < eb.size(); ++j) {
       const NearEdge& f = eb[j];
       if (!(e.lo[0] <= f.hi[0] && f.lo[0] <= e.hi[0] && e.lo[1] <= f.hi[1] && f.lo[1] <= e.hi[1])) continue;
-      if (segmentDistance(*e.p, *e.q, *f.p, *f.q) > closeTolerance) continue;
-      m.close = true;
+      if (closeness) {
+        if (segmentDistance(*e.p, *e.q, *f.p, *f.q) > closeTolerance) continue;
+        m.close = true;
+      }
       double lo = 0, hi = 0;
       if (coveredInterval(*e.p, *e.q, *f.p, *f.q, sharedTolerance, lo, hi)) intervals.emplace_back(lo, hi);
       if (coveredInterval(*f.p, *f.q, *e.p, *e.q, sharedTolerance, lo, hi)) coversB.push_back({j, 0, lo, hi});
@@ -249,8 +253,9 @@ std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons,
 }
 
 double sharedLength(const Polygon& a, const Polygon& b, double tolerance) {
-  const PairMeasure m = measurePair(a, b, contactBox(a, tolerance), contactBox(b, tolerance), tolerance, tolerance);
-  return m.close ? std::min(m.sharedA, m.sharedB) : 0.0;
+  const PairMeasure m =
+      measurePair(a, b, contactBox(a, tolerance), contactBox(b, tolerance), tolerance, tolerance, false);
+  return std::min(m.sharedA, m.sharedB);
 }
 
 std::vector<double> lengthAlong(const std::vector<const Polygon*>& polygons, const std::vector<Ring>& rings,

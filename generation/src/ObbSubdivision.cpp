@@ -231,8 +231,10 @@ private:
       std::vector<char> partAccess(parts.size(), 0);
       bool allAccess = true;
       if (admissible) {
+        // A part's boundary is the piece's and the cut line, which runs inside
+        // the block: parts of a piece without access have none either.
         for (std::size_t k = 0; k < parts.size(); ++k) {
-          partAccess[k] = hasAccess(parts[k]);
+          partAccess[k] = access && hasAccess(parts[k]);
           allAccess = allAccess && partAccess[k];
         }
       }
