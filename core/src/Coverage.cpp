@@ -1,6 +1,7 @@
 #include "parcelscope/core/Coverage.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <utility>
 
@@ -94,31 +95,82 @@ std::optional<std::vector<Edge>> cancelShared(const std::vector<Edge>& edges) {
   return left;
 }
 
-// Chains edges into closed rings; nothing unless every vertex starts exactly
-// one edge and every chain closes on itself.
+// Cuts a ring at every vertex it passes twice into rings that pass it once:
+// the loop between the two visits becomes a ring of its own.
+void splitAtRepeats(const Ring& ring, const std::vector<char>& pinch, std::vector<Ring>& out) {
+  Ring stack;
+  std::vector<char> stackPinch;
+  for (std::size_t i = 0; i < ring.size(); ++i) {
+    if (pinch[i]) {
+      for (std::size_t k = stack.size(); k-- > 0;) {
+        if (stackPinch[k] && same(stack[k], ring[i])) {
+          out.emplace_back(stack.begin() + static_cast<std::ptrdiff_t>(k), stack.end());
+          stack.resize(k);
+          stackPinch.resize(k);
+          break;
+        }
+      }
+    }
+    stack.push_back(ring[i]);
+    stackPinch.push_back(pinch[i]);
+  }
+  out.push_back(std::move(stack));
+}
+
+// Chains edges into closed rings. Where several edges start at one vertex
+// (parts or holes touching at a point), an edge arriving there continues with
+// the first edge met turning clockwise from the way it came, and a ring that
+// passes such a vertex twice is cut there: rings touch at the vertex, as a
+// valid polygon's rings may, instead of running through it. Nothing when two
+// edges would continue with the same edge.
 std::optional<std::vector<Ring>> chainRings(std::vector<Edge> edges) {
   std::sort(edges.begin(), edges.end(), [](const Edge& p, const Edge& q) { return before(p.a, q.a); });
-  for (std::size_t i = 1; i < edges.size(); ++i) {
-    if (same(edges[i - 1].a, edges[i].a)) return std::nullopt;
+  const std::size_t n = edges.size();
+  std::vector<std::size_t> next(n);
+  std::vector<char> taken(n, 0), pinch(n, 0);
+  for (std::size_t e = 0; e < n; ++e) {
+    const Point& v = edges[e].b;
+    auto first = std::lower_bound(edges.begin(), edges.end(), v,
+                                  [](const Edge& x, const Point& p) { return before(x.a, p); });
+    if (first == edges.end() || !same(first->a, v)) return std::nullopt;
+    auto last = first + 1;
+    while (last != edges.end() && same(last->a, v)) ++last;
+    auto chosen = first;
+    if (last - first > 1) {
+      const double back = std::atan2(edges[e].a.y - v.y, edges[e].a.x - v.x);
+      double best = 10.0;
+      for (auto it = first; it != last; ++it) {
+        double turn = back - std::atan2(it->b.y - v.y, it->b.x - v.x);  // clockwise from the way back
+        while (turn <= 0) turn += 2 * kPi;
+        while (turn > 2 * kPi) turn -= 2 * kPi;
+        if (turn < best) {
+          best = turn;
+          chosen = it;
+        }
+      }
+      for (auto it = first; it != last; ++it) pinch[static_cast<std::size_t>(it - edges.begin())] = 1;
+    }
+    next[e] = static_cast<std::size_t>(chosen - edges.begin());
+    if (taken[next[e]]++) return std::nullopt;
   }
-  std::vector<char> used(edges.size(), 0);
+  std::vector<char> used(n, 0);
   std::vector<Ring> rings;
-  for (std::size_t first = 0; first < edges.size(); ++first) {
+  for (std::size_t first = 0; first < n; ++first) {
     if (used[first]) continue;
     Ring ring;
-    std::size_t current = first;
-    while (true) {
-      used[current] = 1;
-      ring.push_back(edges[current].a);
-      const Point& end = edges[current].b;
-      const auto next = std::lower_bound(edges.begin(), edges.end(), end,
-                                         [](const Edge& e, const Point& p) { return before(e.a, p); });
-      if (next == edges.end() || !same(next->a, end)) return std::nullopt;
-      current = static_cast<std::size_t>(next - edges.begin());
-      if (current == first) break;
-      if (used[current]) return std::nullopt;
+    std::vector<char> ringPinch;
+    bool pinched = false;
+    for (std::size_t e = first; !used[e]; e = next[e]) {
+      used[e] = 1;
+      ring.push_back(edges[e].a);
+      ringPinch.push_back(pinch[e]);
+      pinched = pinched || pinch[e];
     }
-    rings.push_back(std::move(ring));
+    if (pinched) {
+      splitAtRepeats(ring, ringPinch, rings);
+    } else {
+      rings.push_back(std::move(ring));
+    }
   }
   return rings;
 }
@@ -156,11 +208,13 @@ std::optional<std::vector<Polygon>> dissolveCoverage(const std::vector<const Pol
     if (parts.size() == 1) {
       best = 0;
     } else {
-      // The smallest outer ring holding the hole's first vertex. A vertex on a
-      // ring may go either way; a wrong choice leaves the hole outside its
-      // shell, which the validity check the caller makes rejects.
+      // The smallest outer ring holding the middle of the hole's first edge
+      // (a hole's vertex may touch a ring; its edges do not run along one). A
+      // wrong choice leaves the hole outside its shell, which the validity
+      // check the caller makes rejects.
+      const Point probe{0.5 * (hole[0].x + hole[1].x), 0.5 * (hole[0].y + hole[1].y)};
       for (std::size_t s = 0; s < parts.size(); ++s) {
-        if (pointInRing(hole.front(), parts[s].outer) && (best == parts.size() || shellAreas[s] < shellAreas[best])) {
+        if (pointInRing(probe, parts[s].outer) && (best == parts.size() || shellAreas[s] < shellAreas[best])) {
           best = s;
         }
       }

@@ -41,12 +41,16 @@ TEST(DissolveCoverage, GridOfLotsBecomesItsOutline) {
 
 TEST(DissolveCoverage, TJunctionsNeedTheSnap) {
   // One long lot above two short ones: the vertex (1, 1) lies on the long lot's edge.
+  // Without the snap the edges left run back along each other, making no
+  // clean outline.
   const std::vector<Polygon> lots = {rect(0, 0, 1, 1), rect(1, 0, 2, 1), rect(0, 1, 2, 2)};
-  EXPECT_FALSE(dissolveCoverage(pointers(lots)).has_value());
+  const auto raw = dissolveCoverage(pointers(lots));
+  EXPECT_FALSE(raw && raw->size() == 1 && raw->front().outer.size() == 7 && raw->front().holes.empty());
   const auto outline = dissolveCoverage(pointers(lots), {1e-6});
   ASSERT_TRUE(outline.has_value());
   ASSERT_EQ(outline->size(), 1u);
   EXPECT_DOUBLE_EQ(area(outline->front()), 4.0);
+  EXPECT_EQ(outline->front().outer.size(), 7u);
   EXPECT_TRUE(outline->front().holes.empty());
   // A vertex 1 mm off the edge is not on it.
   const std::vector<Polygon> off = {rect(0, 0, 1, 1.001), rect(1, 0, 2, 1), rect(0, 1, 2, 2)};
@@ -69,9 +73,37 @@ TEST(DissolveCoverage, RefusesWhatIsNotACleanCoverage) {
   const Polygon a = rect(0, 0, 1, 1);
   // The same lot twice: its edges occur twice in one direction.
   EXPECT_FALSE(dissolveCoverage({&a, &a}).has_value());
-  // Lots touching at one corner: two edges left start at (1, 1).
-  const Polygon b = rect(1, 1, 2, 2);
-  EXPECT_FALSE(dissolveCoverage({&a, &b}).has_value());
+  // Overlapping without shared edges: the rings are returned as they are,
+  // crossing; only a validity check can tell.
+  const Polygon c = rect(0.5, 0.5, 1.5, 1.5);
+  const auto crossing = dissolveCoverage({&a, &c});
+  ASSERT_TRUE(crossing.has_value());
+  EXPECT_EQ(crossing->size(), 2u);
+}
+
+TEST(DissolveCoverage, RingsTouchingAtAVertexStayApart) {
+  // Two lots meeting at one corner: two parts.
+  const Polygon a = rect(0, 0, 1, 1), b = rect(1, 1, 2, 2);
+  const auto parts = dissolveCoverage({&a, &b});
+  ASSERT_TRUE(parts.has_value());
+  ASSERT_EQ(parts->size(), 2u);
+  EXPECT_EQ((*parts)[0].outer.size(), 4u);
+  EXPECT_EQ((*parts)[1].outer.size(), 4u);
+  // Lots around a courtyard that touches the outline at (2, 0): one outer
+  // ring and one hole, meeting at that vertex.
+  const std::vector<Polygon> lots = {
+      test::poly({{0, 0}, {2, 0}, {1, 1}, {1, 2}, {0, 2}}), test::poly({{2, 0}, {4, 0}, {4, 2}, {3, 2}, {3, 1}}),
+      test::poly({{1, 2}, {1, 1}, {3, 1}, {3, 2}, {3, 3}, {1, 3}}), test::poly({{0, 2}, {1, 2}, {1, 3}, {0, 3}}),
+      test::poly({{3, 2}, {4, 2}, {4, 3}, {3, 3}})};
+  std::vector<const Polygon*> members;
+  for (const Polygon& p : lots) members.push_back(&p);
+  const auto block = dissolveCoverage(members);
+  ASSERT_TRUE(block.has_value());
+  ASSERT_EQ(block->size(), 1u);
+  ASSERT_EQ(block->front().holes.size(), 1u);
+  EXPECT_EQ(block->front().holes[0].size(), 3u);  // (2, 0), (1, 1), (3, 1)
+  EXPECT_EQ(block->front().outer.size(), 9u);     // (2, 0) on the outline too
+  EXPECT_NEAR(area(block->front()), 12.0 - 1.0, 1e-12);
 }
 
 // Jittered grids: lots share their corners exactly, some cells are left out

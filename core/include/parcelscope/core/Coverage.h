@@ -24,10 +24,13 @@ struct DissolveOptions {
 /// ring holding them. Rings start at their lowest (x, then y) vertex and parts
 /// come in order of it, so the result does not depend on the input order.
 ///
-/// Returns nothing when the edges left do not chain into rings one way only:
-/// an edge present twice in one direction (overlap), a vertex where two
-/// remaining edges start (polygons touching at a point), a ring of zero area,
-/// or a hole outside every outer ring. A result is not proven valid:
+/// Where polygons or holes touch at a vertex, the rings are kept apart there
+/// (they touch, as a valid polygon's rings may).
+///
+/// Returns nothing when the edges left do not chain into rings: an edge present
+/// twice in one direction (overlap), a vertex with more edges ending than
+/// starting, a ring of zero area, or a hole outside every outer ring. A result
+/// is not proven valid:
 /// polygons that overlap without sharing edges give crossing rings, so check
 /// it (GEOS) before use.
 std::optional<std::vector<Polygon>> dissolveCoverage(const std::vector<const Polygon*>& polygons,
