@@ -554,7 +554,12 @@ void MainWindow::submit() {
   pendingSerial_ = worker_->submit(request_);
   started_[pendingSerial_].start();
   firstViewMs_ = -1;
-  status_->setText("updating...");
+  // Said only when the update takes a while: any change of a label makes Qt
+  // compose the whole window again (it holds OpenGL widgets), which would
+  // delay drawing a quick result.
+  QTimer::singleShot(250, this, [this, serial = pendingSerial_] {
+    if (serial == pendingSerial_ && serial != shownSerial_ && !failedOrCancelled_) status_->setText("updating...");
+  });
 }
 
 void MainWindow::showReport(const UpdateReport& report) {
