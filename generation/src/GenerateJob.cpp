@@ -13,19 +13,6 @@
 
 namespace parcelscope::generation {
 
-ObbParameters blockParameters(const GenerateRequest& request, double aMin, double aMax, double wMin,
-                              double wMax) {
-  ObbParameters p = obbParametersFrom(request.parameters);
-  auto pick = [&](const char* name, double perBlock, double& target) {
-    if (!request.explicitParameters.count(name) && std::isfinite(perBlock)) target = perBlock;
-  };
-  pick("a-min", aMin, p.aMin);
-  pick("a-max", aMax, p.aMax);
-  pick("w-min", wMin, p.wMin);
-  pick("w-max", wMax, p.wMax);
-  return p;
-}
-
 const std::vector<std::pair<std::string, std::string>>& generationStyles() {
   static const std::vector<std::pair<std::string, std::string>> styles = {
       {"obb", "OBB recursive subdivision (Vanegas et al. 2012, 4.3)"},

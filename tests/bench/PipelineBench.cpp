@@ -74,6 +74,20 @@ void StatsPipeline(benchmark::State& state) {
 }
 BENCHMARK(StatsPipeline)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
+// The blocks of an analysed input and their plans under `style` with default
+// parameters, as generate() makes them (per-block bounds, each block's seed).
+std::pair<parcelscope::generation::BlockInputs, std::vector<parcelscope::generation::BlockPlan>> plannedBlocks(
+    const parcelscope::analysis::ObservedData& observed, const std::string& style) {
+  parcelscope::generation::GenerateRequest request;
+  request.fromParcels = true;
+  request.observed = &observed;
+  request.style = style;
+  request.parameters = parcelscope::defaultValues(parcelscope::generation::generationParameterDescriptions());
+  auto inputs = parcelscope::generation::prepareBlocks(request);
+  auto plans = parcelscope::generation::planBlocks(request, inputs);
+  return {std::move(inputs), std::move(plans)};
+}
+
 // OBB subdivision of every cambridge_ma block with its own derived bounds
 // (Vanegas et al. 2012 report 1-10 ms per block after an edit). Single thread.
 void ObbSubdivisionPerBlock(benchmark::State& state) {
@@ -82,18 +96,14 @@ void ObbSubdivisionPerBlock(benchmark::State& state) {
   in.path = kCambridge;
   const auto d = parcelscope::analysis::loadObserved(
       in, parcelscope::defaultValues(parcelscope::analysis::analysisParameters()));
-  parcelscope::generation::GenerateRequest request;
-  request.parameters = parcelscope::defaultValues(parcelscope::generation::obbParameterDescriptions());
+  const auto [inputs, plans] = plannedBlocks(d, "obb");
   std::size_t blocks = 0, parcels = 0;
   for (auto _ : state) {
     blocks = parcels = 0;
-    for (std::size_t b = 0; b < d.analysis.blocks.size(); ++b) {
-      const auto& s = d.analysis.statistics[b];
-      const auto p = parcelscope::generation::blockParameters(request, s.aMin, s.aMax, s.wMin, s.wMax);
-      for (const auto& part : d.analysis.blocks[b].parts) {
-        parcels += parcelscope::generation::subdivideObb(part, p, b).parcels.size();
-        ++blocks;
-      }
+    for (std::size_t k = 0; k < inputs.entries.size(); ++k) {
+      parcels += parcelscope::generation::subdivideObb(inputs.entries[k].shape, plans[k].parameters.bounds, plans[k].seed)
+                     .parcels.size();
+      ++blocks;
     }
   }
   state.counters["blocks"] = static_cast<double>(blocks);
@@ -217,24 +227,18 @@ void SkeletonSubdivisionPerBlock(benchmark::State& state) {
   in.path = kCambridge;
   const auto d = parcelscope::analysis::loadObserved(
       in, parcelscope::defaultValues(parcelscope::analysis::analysisParameters()));
-  gen::GenerateRequest request;
-  request.parameters = parcelscope::defaultValues(gen::generationParameterDescriptions());
-  gen::SkeletonParameters p = gen::skeletonParametersFrom(request.parameters);
+  const auto [inputs, plans] = plannedBlocks(d, "skeleton");
   std::size_t parcels = 0, fallbacks = 0;
   std::vector<double> ms;
   for (auto _ : state) {
     parcels = fallbacks = 0;
     ms.clear();
-    for (std::size_t b = 0; b < d.analysis.blocks.size(); ++b) {
-      const auto& s = d.analysis.statistics[b];
-      p.bounds = gen::blockParameters(request, s.aMin, s.aMax, s.wMin, s.wMax);
-      for (const auto& part : d.analysis.blocks[b].parts) {
-        const auto t0 = std::chrono::steady_clock::now();
-        const auto sub = gen::subdivideSkeleton(part, p, b);
-        ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-        parcels += sub.parcels.size();
-        fallbacks += sub.fallback;
-      }
+    for (std::size_t k = 0; k < inputs.entries.size(); ++k) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const auto sub = gen::subdivideSkeleton(inputs.entries[k].shape, plans[k].parameters, plans[k].seed);
+      ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      parcels += sub.parcels.size();
+      fallbacks += sub.fallback;
     }
   }
   std::vector<double> sorted = ms;

@@ -3,6 +3,9 @@
 // 2012, section 6).
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <memory>
+
 #include "TestUtil.h"
 #include "generation/TilingCheck.h"
 #include "parcelscope/analysis/StatsJob.h"
@@ -29,33 +32,27 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
   in.path = test::sharedDataset(dataset.file);
   in.crsOverride = dataset.crs;
   const auto observed = analysis::loadObserved(in, defaultValues(analysis::analysisParameters()));
+  // The blocks and their plans as generate() makes them: per-block bounds
+  // clamped into range, the block's seed, street widths for the skeleton.
   GenerateRequest request;
+  request.fromParcels = true;
+  request.observed = &observed;
+  request.style = style;
   request.parameters = defaultValues(generationParameterDescriptions());  // xi = 1
-  SkeletonParameters skeleton = skeletonParametersFrom(request.parameters);
-
-  struct Unit {
-    const Polygon* shape;
-    ObbParameters p;
-    int id;
-  };
-  std::vector<Unit> units;
-  for (std::size_t b = 0; b < observed.analysis.blocks.size(); ++b) {
-    const auto& s = observed.analysis.statistics[b];
-    for (const Polygon& part : observed.analysis.blocks[b].parts) {
-      units.push_back({&part, blockParameters(request, s.aMin, s.aMax, s.wMin, s.wMax), static_cast<int>(b)});
-    }
-  }
-  std::vector<Subdivision> results(units.size());
-  std::vector<test::TilingReport> reports(units.size());
-  parallelFor(units.size(), [&](std::size_t k) {
-    SkeletonParameters p = skeleton;
-    p.bounds = units[k].p;
-    results[k] = subdivideBlock(*units[k].shape, style, p, blockSeed(1, units[k].id));
-    reports[k] = test::checkTiling(*units[k].shape, results[k].parcels);
+  BlockInputs inputs = prepareBlocks(request);
+  if (style != "obb") streetWidthsOf(inputs);
+  const std::vector<BlockPlan> plans = planBlocks(request, inputs);
+  const std::size_t n = inputs.entries.size();
+  std::vector<Subdivision> results(n);
+  std::vector<test::TilingReport> reports(n);
+  parallelFor(n, [&](std::size_t k) {
+    results[k] = runBlock(inputs, k, plans[k], request.parameters.at("min-frontage")).subdivision;
+    reports[k] = test::checkTiling(inputs.entries[k].shape, results[k].parcels);
   });
   int parcels = 0, withoutAccess = 0, failed = 0, oversize = 0, fallbacks = 0, patios = 0;
-  for (std::size_t k = 0; k < units.size(); ++k) {
-    const std::string what = std::string(dataset.file) + " " + style + " block " + std::to_string(units[k].id);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::string what =
+        std::string(dataset.file) + " " + style + " block " + std::to_string(inputs.entries[k].blockId);
     EXPECT_FALSE(results[k].failed) << what << ": " << results[k].failure;
     EXPECT_LE(reports[k].areaError, 1e-6) << what;
     EXPECT_LE(reports[k].maxOverlap, 1e-6) << what;
@@ -70,10 +67,10 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
   }
   std::printf("%s %s: %zu blocks, %d parcels (%d in patios), %d oversize, %d without street access, "
               "%d fell back to obb, %d failed\n",
-              dataset.file, style.c_str(), units.size(), parcels, patios, oversize, withoutAccess, fallbacks, failed);
+              dataset.file, style.c_str(), n, parcels, patios, oversize, withoutAccess, fallbacks, failed);
   EXPECT_EQ(withoutAccess, 0);
   // The skeleton route handles at least 95 % of real blocks itself.
-  EXPECT_LE(fallbacks, static_cast<int>(units.size()) / 20);
+  EXPECT_LE(fallbacks, static_cast<int>(n) / 20);
 }
 
 INSTANTIATE_TEST_SUITE_P(Datasets, RealBlocks,
@@ -104,12 +101,15 @@ TEST(GenerateJob, DerivedBoundsBelowTheRangesAreClampedNotRefused) {
   EXPECT_GT(g.parcels.size(), 500u);
 }
 
-TEST(BlockParameters, UserValuesOverridePerBlockValuesWhichOverrideDefaults) {
+TEST(PlanBlocks, UserValuesOverridePerBlockValuesWhichOverrideDefaults) {
   GenerateRequest r;
   r.parameters = defaultValues(obbParameterDescriptions());
   r.parameters["a-max"] = 555;
   r.explicitParameters = {"a-max"};
-  const ObbParameters p = blockParameters(r, 100, 900, 4, std::nan(""));
+  BlockInputs inputs;
+  inputs.source = std::make_shared<const io::ParcelLayer>();
+  inputs.entries.push_back({7, test::rect(0, 0, 100, 50), 100, 900, 4, std::nan(""), 1.0});
+  const ObbParameters p = planBlocks(r, inputs).at(0).parameters.bounds;
   EXPECT_DOUBLE_EQ(p.aMin, 100);   // per block
   EXPECT_DOUBLE_EQ(p.aMax, 555);   // given by the user
   EXPECT_DOUBLE_EQ(p.wMin, 4);     // per block

@@ -75,11 +75,6 @@ struct GenerateRequest {
   BlockOverrides overrides;
 };
 
-/// Parameters a block runs with: the request's values, with the per-block bounds
-/// (NaN when the block has none) where the user did not set them.
-ObbParameters blockParameters(const GenerateRequest& request, double aMin, double aMax, double wMin,
-                              double wMax);
-
 struct GeneratedParcels {
   /// The input as read (frame, CRS, cleaning report), shared with the BlockInputs it came from.
   std::shared_ptr<const io::ParcelLayer> source;
