@@ -1,5 +1,7 @@
 #include "Contacts.h"
 
+#include "parcelscope/analysis/Metrics.h"
+
 #include "BoxPairs.h"
 
 #include "parcelscope/core/Parallel.h"
@@ -9,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <tuple>
 
 namespace parcelscope::analysis::detail {
@@ -168,14 +171,10 @@ struct PairMeasure {
 // only edges meeting the other polygon's box can pair. Without `closeness`
 // only the shared lengths are measured (`close` stays false): an edge pair
 // with a covered interval is within the tolerance anyway.
-PairMeasure measurePair(const Polygon& a, const Polygon& b, const Box& boxA, const Box& boxB, double closeTolerance,
-                        double sharedTolerance, bool closeness = true) {
-  thread_local std::vector<NearEdge> ea, eb;
+PairMeasure measureEdges(const std::vector<NearEdge>& ea, const std::vector<NearEdge>& eb, double closeTolerance,
+                         double sharedTolerance, bool closeness) {
   thread_local std::vector<std::pair<double, double>> intervals;
   thread_local std::vector<Cover> coversB;
-  const double grow = 0.5 * closeTolerance;
-  edgesNear(a, grow, boxB, ea);
-  edgesNear(b, grow, boxA, eb);
   coversB.clear();
   PairMeasure m;
   for (const NearEdge& e : ea) {
@@ -204,6 +203,15 @@ PairMeasure measurePair(const Polygon& a, const Polygon& b, const Box& boxA, con
     i = j;
   }
   return m;
+}
+
+PairMeasure measurePair(const Polygon& a, const Polygon& b, const Box& boxA, const Box& boxB, double closeTolerance,
+                        double sharedTolerance, bool closeness = true) {
+  thread_local std::vector<NearEdge> ea, eb;
+  const double grow = 0.5 * closeTolerance;
+  edgesNear(a, grow, boxB, ea);
+  edgesNear(b, grow, boxA, eb);
+  return measureEdges(ea, eb, closeTolerance, sharedTolerance, closeness);
 }
 
 }  // namespace
@@ -282,3 +290,36 @@ std::vector<double> lengthAlong(const std::vector<const Polygon*>& polygons, con
 }
 
 }  // namespace parcelscope::analysis::detail
+
+namespace parcelscope::analysis {
+
+struct PreparedBoundary::Impl {
+  std::vector<detail::NearEdge> edges;  // every edge of the reference, boxes grown by half the tolerance, ring order
+  Box box;                      // the reference's contact box
+  double tolerance = 0;
+};
+
+PreparedBoundary::PreparedBoundary(const Polygon& reference, double tolerance) : impl_(std::make_unique<Impl>()) {
+  impl_->tolerance = tolerance;
+  impl_->box = detail::contactBox(reference, tolerance);
+  const Box everything{-HUGE_VAL, -HUGE_VAL, HUGE_VAL, HUGE_VAL};
+  detail::edgesNear(reference, 0.5 * tolerance, everything, impl_->edges);
+}
+
+PreparedBoundary::~PreparedBoundary() = default;
+
+double PreparedBoundary::sharedLength(const Polygon& piece) const {
+  thread_local std::vector<detail::NearEdge> ea, eb;
+  const Impl& r = *impl_;
+  const double grow = 0.5 * r.tolerance;
+  detail::edgesNear(piece, grow, r.box, ea);
+  const Box box = detail::contactBox(piece, r.tolerance);
+  eb.clear();
+  for (const detail::NearEdge& e : r.edges) {
+    if (e.lo[0] <= box.maxX && box.minX <= e.hi[0] && e.lo[1] <= box.maxY && box.minY <= e.hi[1]) eb.push_back(e);
+  }
+  const detail::PairMeasure m = detail::measureEdges(ea, eb, r.tolerance, r.tolerance, false);
+  return std::min(m.sharedA, m.sharedB);
+}
+
+}  // namespace parcelscope::analysis

@@ -4,6 +4,7 @@
 // the edges that reach the other polygon's box, so that cost grows with the
 // number of nearby edge pairs, not with the product of polygon sizes (a street
 // network stored as one parcel has tens of thousands of edges).
+#include <memory>
 #include <vector>
 
 #include "parcelscope/core/Geometry.h"

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "LocalShift.h"
 #include "PolygonSplit.h"
@@ -67,6 +68,7 @@ public:
     for (const Ring& h : block.holes) contour_.insert(contour_.end(), h.begin(), h.end());
     const Box b = bounds(block);
     accessTolerance_ = std::max(1e-6, 1e-9 * (b.width() + b.height()));
+    outlineEdges_ = std::make_unique<analysis::PreparedBoundary>(outline_, accessTolerance_);
   }
 
   void run(std::uint64_t seed) { recurse(block_, seed, hasAccess(block_), 0); }
@@ -78,7 +80,7 @@ private:
   };
 
   bool hasAccess(const Polygon& piece) const {
-    return analysis::sharedBoundaryLength(piece, outline_, accessTolerance_) >= p_.minFrontage;
+    return outlineEdges_->sharedLength(piece) >= p_.minFrontage;
   }
 
   void emit(const Polygon& piece, bool access, bool oversize) {
@@ -272,6 +274,7 @@ private:
   Subdivision& out_;
   std::vector<Point> contour_;
   double accessTolerance_ = 1e-6;
+  std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;  // outline_, for the access test
 };
 
 }  // namespace

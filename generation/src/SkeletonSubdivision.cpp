@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <map>
 #include <stdexcept>
 #include <unordered_map>
@@ -248,6 +249,7 @@ public:
     size_ = b.width() + b.height();
     reach_ = 4.0 * size_ + 1.0;
     accessTolerance_ = std::max(1e-6, 1e-9 * size_);
+    outlineEdges_ = std::make_unique<analysis::PreparedBoundary>(outline_, accessTolerance_);
     target_ = 0.5 * (p.bounds.wMin + p.bounds.wMax);
     std::vector<const Ring*> rings{&block.outer};
     for (const Ring& h : block.holes) rings.push_back(&h);
@@ -794,7 +796,7 @@ private:
 
   // ---- 5. post-processing -----------------------------------------------------
   bool hasAccess(const Polygon& piece) const {
-    return analysis::sharedBoundaryLength(piece, outline_, accessTolerance_) >= p_.bounds.minFrontage;
+    return outlineEdges_->sharedLength(piece) >= p_.bounds.minFrontage;
   }
 
   bool rounded(const PWH& exactShape, Polygon& out) const {
@@ -979,6 +981,7 @@ private:
   SkeletonParameters p_;
   detail::Rng rng_;
   double size_ = 0, reach_ = 0, accessTolerance_ = 0, target_ = 0, maxTime_ = 0;
+  std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;  // outline_, for the access test
   std::vector<Edge> edges_;
   std::vector<int> ringStart_;
   std::vector<SkVertex> vertices_;

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "TestUtil.h"
 
@@ -57,6 +59,35 @@ TEST(Metrics, ParallelogramCornersDeviateThirtyDegrees) {
 TEST(Metrics, CollinearVerticesAreNotCorners) {
   const ShapeMetrics m = shapeMetrics(poly({{0, 0}, {5, 0.1}, {10, 0}, {10, 10}, {0, 10}}));
   EXPECT_NEAR(m.pAngle, 0.0, 1.2);  // the 2.3-degree kink is below the corner threshold
+}
+
+// The lots of jittered grids measured against the outline of the whole grid
+// (a block and its parcels): the prepared outline gives exactly what
+// sharedBoundaryLength gives, lot by lot.
+TEST(Metrics, PreparedBoundaryMeasuresAsSharedBoundaryLength) {
+  const unsigned seed = std::random_device{}();
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  std::mt19937 rng(seed);
+  int withFrontage = 0;
+  for (int round = 0; round < 20; ++round) {
+    const std::vector<Polygon> lots = test::jitteredGrid(rng, 2 + static_cast<int>(rng() % 5), 3, 1.0);
+    Box b = bounds(lots.front());
+    for (const Polygon& lot : lots) {
+      const Box x = bounds(lot);
+      b = {std::min(b.minX, x.minX), std::min(b.minY, x.minY), std::max(b.maxX, x.maxX), std::max(b.maxY, x.maxY)};
+    }
+    // An outline through the grid's outer corners (lots on the edge share part of it).
+    const Polygon outline = rect(b.minX + 0.2, b.minY + 0.2, b.maxX - 0.2, b.maxY - 0.2);
+    for (double tolerance : {1e-6, 0.3, 1.0}) {
+      const PreparedBoundary prepared(outline, tolerance);
+      for (const Polygon& lot : lots) {
+        const double expected = sharedBoundaryLength(lot, outline, tolerance);
+        EXPECT_EQ(prepared.sharedLength(lot), expected);
+        withFrontage += expected > 0;
+      }
+    }
+  }
+  EXPECT_GT(withFrontage, 0);
 }
 
 TEST(Metrics, SharedBoundaryOfAdjacentAndNearlyAdjacentLots) {

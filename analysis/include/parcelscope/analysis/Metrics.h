@@ -2,6 +2,7 @@
 // Parcel shape metrics. Each is a noun from the literature, with its formula,
 // unit, range and source. All lengths in m, areas in m², angles in degrees,
 // measured in the local metric plane.
+#include <memory>
 #include "parcelscope/core/Geometry.h"
 
 namespace parcelscope::analysis {
@@ -52,5 +53,22 @@ double cornerAngleDeviation(const Ring& ring);
 /// digitising differences. Used for shared boundaries (neighbours) and for
 /// frontage (boundary on the block's outer contour).
 double sharedBoundaryLength(const Polygon& a, const Polygon& b, double tolerance);
+
+/// One polygon's edges prepared once for measuring many pieces against it (the
+/// parts of a block against the block's outline):
+/// `PreparedBoundary(reference, t).sharedLength(piece)` equals
+/// `sharedBoundaryLength(piece, reference, t)`.
+class PreparedBoundary {
+public:
+  PreparedBoundary(const Polygon& reference, double tolerance);
+  ~PreparedBoundary();
+  PreparedBoundary(const PreparedBoundary&) = delete;
+  PreparedBoundary& operator=(const PreparedBoundary&) = delete;
+  double sharedLength(const Polygon& piece) const;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace parcelscope::analysis
