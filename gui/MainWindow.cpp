@@ -558,7 +558,10 @@ void MainWindow::submit() {
   // compose the whole window again (it holds OpenGL widgets), which would
   // delay drawing a quick result.
   QTimer::singleShot(250, this, [this, serial = pendingSerial_] {
-    if (serial == pendingSerial_ && serial != shownSerial_ && !failedOrCancelled_) status_->setText("updating...");
+    // A result in between already says how far the update is.
+    if (serial == pendingSerial_ && serial != shownSerial_ && !failedOrCancelled_ && firstViewMs_ < 0) {
+      status_->setText("updating...");
+    }
   });
 }
 

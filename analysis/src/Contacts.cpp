@@ -296,12 +296,14 @@ namespace parcelscope::analysis {
 struct PreparedBoundary::Impl {
   std::vector<detail::NearEdge> edges;  // every edge of the reference, boxes grown by half the tolerance, ring order
   Box box;                      // the reference's contact box
+  Box bounds;                   // the reference's bounds
   double tolerance = 0;
 };
 
 PreparedBoundary::PreparedBoundary(const Polygon& reference, double tolerance) : impl_(std::make_unique<Impl>()) {
   impl_->tolerance = tolerance;
   impl_->box = detail::contactBox(reference, tolerance);
+  impl_->bounds = parcelscope::bounds(reference);
   const Box everything{-HUGE_VAL, -HUGE_VAL, HUGE_VAL, HUGE_VAL};
   detail::edgesNear(reference, 0.5 * tolerance, everything, impl_->edges);
 }
@@ -311,6 +313,7 @@ PreparedBoundary::~PreparedBoundary() = default;
 double PreparedBoundary::sharedLength(const Polygon& piece) const {
   thread_local std::vector<detail::NearEdge> ea, eb;
   const Impl& r = *impl_;
+  if (!parcelscope::bounds(piece).expanded(r.tolerance).intersects(r.bounds)) return 0.0;  // as sharedBoundaryLength
   const double grow = 0.5 * r.tolerance;
   detail::edgesNear(piece, grow, r.box, ea);
   const Box box = detail::contactBox(piece, r.tolerance);

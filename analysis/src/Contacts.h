@@ -33,11 +33,12 @@ std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons,
                               const std::vector<std::pair<int, int>>& candidates, double closeTolerance,
                               double sharedTolerance = -1);
 
-/// The shared length `contacts({&a, &b}, tolerance)` gives for the pair (0
-/// when it finds none), computed directly: the same edge pairs (boxes grown by
-/// half the tolerance, then segment distance), the same intervals, summed in
-/// the same order, without building the general search. For the many small
-/// pieces measured against one block outline.
+/// The shared length `contacts({&a, &b}, tolerance)` gives for the pair
+/// (min of both sides' covered lengths), computed directly: the same edge pairs
+/// (boxes grown by half the tolerance), the same intervals, summed in the same
+/// order, without the closeness test (a pair with a covered interval is within
+/// the tolerance) and without building the general search. 0 when nothing is
+/// covered.
 double sharedLength(const Polygon& a, const Polygon& b, double tolerance);
 
 /// For each polygon, the length in m of its boundary running along `rings`

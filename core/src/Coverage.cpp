@@ -124,7 +124,9 @@ void splitAtRepeats(const Ring& ring, const std::vector<char>& pinch, std::vecto
 // valid polygon's rings may, instead of running through it. Nothing when two
 // edges would continue with the same edge.
 std::optional<std::vector<Ring>> chainRings(std::vector<Edge> edges) {
-  std::sort(edges.begin(), edges.end(), [](const Edge& p, const Edge& q) { return before(p.a, q.a); });
+  std::sort(edges.begin(), edges.end(), [](const Edge& p, const Edge& q) {
+    return before(p.a, q.a) || (same(p.a, q.a) && before(p.b, q.b));
+  });
   const std::size_t n = edges.size();
   std::vector<std::size_t> next(n);
   std::vector<char> taken(n, 0), pinch(n, 0);
@@ -190,6 +192,12 @@ std::optional<std::vector<Polygon>> dissolveCoverage(const std::vector<const Pol
   auto rings = chainRings(std::move(*left));
   if (!rings) return std::nullopt;
 
+  // Every ring from its lowest vertex, and rings in order of it: the result
+  // does not depend on the order of the polygons.
+  for (Ring& ring : *rings) {
+    std::rotate(ring.begin(), std::min_element(ring.begin(), ring.end(), before), ring.end());
+  }
+  std::sort(rings->begin(), rings->end(), [](const Ring& p, const Ring& q) { return before(p.front(), q.front()); });
   std::vector<Polygon> parts;
   std::vector<double> shellAreas;
   std::vector<Ring> holes;

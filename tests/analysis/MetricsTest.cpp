@@ -76,11 +76,16 @@ TEST(Metrics, PreparedBoundaryMeasuresAsSharedBoundaryLength) {
       const Box x = bounds(lot);
       b = {std::min(b.minX, x.minX), std::min(b.minY, x.minY), std::max(b.maxX, x.maxX), std::max(b.maxY, x.maxY)};
     }
-    // An outline through the grid's outer corners (lots on the edge share part of it).
-    const Polygon outline = rect(b.minX + 0.2, b.minY + 0.2, b.maxX - 0.2, b.maxY - 0.2);
+    // An outline near the grid's outer corners (lots on the edge share part of
+    // it), with a courtyard near an inner corner; and lots far off as well.
+    Polygon outline = rect(b.minX + 0.2, b.minY + 0.2, b.maxX - 0.2, b.maxY - 0.2);
+    outline.holes.push_back({{10.1, 10.1}, {10.1, 19.9}, {19.9, 19.9}, {19.9, 10.1}});
+    std::vector<Polygon> pieces = lots;
+    pieces.push_back(rect(b.maxX + 0.5, b.minY, b.maxX + 5, b.minY + 5));
+    pieces.push_back(rect(b.maxX + 5, b.maxY + 5, b.maxX + 9, b.maxY + 9));
     for (double tolerance : {1e-6, 0.3, 1.0}) {
       const PreparedBoundary prepared(outline, tolerance);
-      for (const Polygon& lot : lots) {
+      for (const Polygon& lot : pieces) {
         const double expected = sharedBoundaryLength(lot, outline, tolerance);
         EXPECT_EQ(prepared.sharedLength(lot), expected);
         withFrontage += expected > 0;

@@ -6,6 +6,7 @@
 #include <ogr_api.h>
 #include <ogr_geometry.h>
 
+#include <cmath>
 #include <memory>
 
 #include "TestUtil.h"
@@ -95,16 +96,26 @@ TEST_P(SharedDataset, DissolvedBlocksEqualGeosUnion) {
       members.push_back(&d.layer.parcels[i].shape);
       parcels.addGeometryDirectly(toOgr(d.layer.parcels[i].shape).release());
     }
-    const auto dissolved = dissolveCoverage(members, {1e-6});
-    if (!dissolved) return;
+    // As unionAndClose tries it: without the snap, then with it.
     OGRMultiPolygon outline;
-    for (const Polygon& part : *dissolved) outline.addGeometryDirectly(toOgr(part).release());
-    if (!outline.IsValid()) return;  // unionAndClose hands these to GEOS
-    accepted[b] = 1;
+    for (const double snap : {0.0, 1e-6}) {
+      const auto dissolved = dissolveCoverage(members, {snap});
+      if (!dissolved) continue;
+      outline.empty();
+      for (const Polygon& part : *dissolved) outline.addGeometryDirectly(toOgr(part).release());
+      if (outline.IsValid()) {
+        accepted[b] = 1;
+        break;
+      }
+    }
+    if (!accepted[b]) return;  // unionAndClose hands these to GEOS
     std::unique_ptr<OGRGeometry> united(parcels.UnionCascaded());
-    if (!united) return;
-    std::unique_ptr<OGRGeometry> delta(outline.SymDifference(united.get()));
-    difference[b] = delta && !delta->IsEmpty() ? OGR_G_Area(OGRGeometry::ToHandle(delta.get())) : 0.0;
+    std::unique_ptr<OGRGeometry> delta(united ? outline.SymDifference(united.get()) : nullptr);
+    if (!united || !delta) {
+      difference[b] = HUGE_VAL;  // GEOS failed: nothing to compare with
+      return;
+    }
+    difference[b] = delta->IsEmpty() ? 0.0 : OGR_G_Area(OGRGeometry::ToHandle(delta.get()));
     ours[b] = OGR_G_Area(OGRGeometry::ToHandle(&outline));
     geos[b] = OGR_G_Area(OGRGeometry::ToHandle(united.get()));
   });
@@ -116,7 +127,7 @@ TEST_P(SharedDataset, DissolvedBlocksEqualGeosUnion) {
     EXPECT_LE(difference[b], 1e-9 * geos[b]) << e.file << " block " << b;
   }
   std::printf("%s: %zu of %zu blocks dissolved without an overlay\n", e.file, count, n);
-  // The fast path carries most blocks of clean cadastres (cambridge 718 of 743,
+  // The fast path carries most blocks of clean cadastres (cambridge 720 of 743,
   // paris 359 of 364); malibu's parcels overlap and leave gaps (42 of 103).
   EXPECT_GT(count, n / 4);
 }

@@ -75,7 +75,8 @@ void StatsPipeline(benchmark::State& state) {
 BENCHMARK(StatsPipeline)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
 // The blocks of an analysed input and their plans under `style` with default
-// parameters, as generate() makes them (per-block bounds, each block's seed).
+// parameters, as generate() makes them (per-block bounds, each block's seed,
+// street widths for the skeleton styles).
 std::pair<parcelscope::generation::BlockInputs, std::vector<parcelscope::generation::BlockPlan>> plannedBlocks(
     const parcelscope::analysis::ObservedData& observed, const std::string& style) {
   parcelscope::generation::GenerateRequest request;
@@ -84,6 +85,7 @@ std::pair<parcelscope::generation::BlockInputs, std::vector<parcelscope::generat
   request.style = style;
   request.parameters = parcelscope::defaultValues(parcelscope::generation::generationParameterDescriptions());
   auto inputs = parcelscope::generation::prepareBlocks(request);
+  if (style != "obb") parcelscope::generation::streetWidthsOf(inputs);
   auto plans = parcelscope::generation::planBlocks(request, inputs);
   return {std::move(inputs), std::move(plans)};
 }
@@ -235,7 +237,8 @@ void SkeletonSubdivisionPerBlock(benchmark::State& state) {
     ms.clear();
     for (std::size_t k = 0; k < inputs.entries.size(); ++k) {
       const auto t0 = std::chrono::steady_clock::now();
-      const auto sub = gen::subdivideSkeleton(inputs.entries[k].shape, plans[k].parameters, plans[k].seed);
+      const auto sub =
+          gen::subdivideSkeleton(inputs.entries[k].shape, plans[k].parameters, plans[k].seed, inputs.widths[k]);
       ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
       parcels += sub.parcels.size();
       fallbacks += sub.fallback;

@@ -57,7 +57,8 @@ double sharedBoundaryLength(const Polygon& a, const Polygon& b, double tolerance
 /// One polygon's edges prepared once for measuring many pieces against it (the
 /// parts of a block against the block's outline):
 /// `PreparedBoundary(reference, t).sharedLength(piece)` equals
-/// `sharedBoundaryLength(piece, reference, t)`.
+/// `sharedBoundaryLength(piece, reference, t)`. It points into `reference`,
+/// which must outlive it unchanged.
 class PreparedBoundary {
 public:
   PreparedBoundary(const Polygon& reference, double tolerance);
