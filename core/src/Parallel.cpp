@@ -12,8 +12,25 @@ namespace parcelscope {
 
 unsigned workerCount() { return std::max(1u, std::thread::hardware_concurrency()); }
 
+namespace {
+// True on a thread running a parallelFor's body: a loop nested in it runs on
+// that thread alone (the outer loop already keeps every core busy; starting
+// threads per block would only cost).
+thread_local bool tInsideLoop = false;
+
+struct InsideLoop {
+  bool was = tInsideLoop;
+  InsideLoop() { tInsideLoop = true; }
+  ~InsideLoop() { tInsideLoop = was; }
+};
+}  // namespace
+
 void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
                  const std::function<void(std::size_t)>& tick) {
+  if (tInsideLoop) {
+    for (std::size_t i = 0; i < n; ++i) body(i);
+    return;
+  }
   std::atomic<std::size_t> next{0}, done{0};
   std::atomic<bool> stop{false};
   std::exception_ptr error;
@@ -24,6 +41,7 @@ void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
     stop = true;
   };
   auto work = [&] {
+    const InsideLoop inside;
     for (std::size_t i; !stop && (i = next.fetch_add(1)) < n;) {
       try {
         body(i);
