@@ -65,7 +65,10 @@ std::vector<ParameterDescription> panelParameters() {
     }
   }
   for (const auto& d : all) {
-    if (d.name == "figures" || d.name == "spatial-index" || d.name == "figure-width" || d.name == "figure-height") continue;
+    // Options of written files, not of the parcels.
+    if (d.name == "figures" || d.name == "spatial-index" || d.name == "figure-width" || d.name == "figure-height") {
+      continue;
+    }
     bool seen = false;
     for (const auto& o : out) seen = seen || o.name == d.name;
     if (!seen) out.push_back(d);

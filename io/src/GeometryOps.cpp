@@ -80,16 +80,12 @@ std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, 
   for (const double snap : {0.0, kCoverageSnap}) {
     auto dissolved = dissolveCoverage(polygons, {snap});
     if (!dissolved || dissolved->empty()) continue;
-    if (dissolved->size() == 1) {
-      auto single = detail::toOgr(dissolved->front());
-      if (!single->IsValid()) continue;
-      if (dissolved->front().holes.empty()) return std::move(*dissolved);  // nothing to close
-      result = std::move(single);
-    } else {
-      auto multi = detail::toOgr(*dissolved);
-      if (!multi->IsValid()) continue;
-      result = std::move(multi);
-    }
+    const bool single = dissolved->size() == 1;
+    std::unique_ptr<OGRGeometry> outline = single ? std::unique_ptr<OGRGeometry>(detail::toOgr(dissolved->front()))
+                                                  : std::unique_ptr<OGRGeometry>(detail::toOgr(*dissolved));
+    if (!outline->IsValid()) continue;
+    if (single && dissolved->front().holes.empty()) return std::move(*dissolved);  // nothing to close
+    result = std::move(outline);
     break;
   }
   if (!result) {
