@@ -259,10 +259,45 @@ std::vector<analysis::ParcelMetrics> measureEntry(const BlockInputs& inputs, std
 
 }  // namespace
 
-BlockOutcome runBlock(const BlockInputs& inputs, std::size_t entry, const BlockPlan& plan, double minFrontage) {
+namespace {
+bool sameRing(const Ring& a, const Ring& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i].x != b[i].x || a[i].y != b[i].y) return false;
+  }
+  return true;
+}
+
+bool sameParcels(const std::vector<Polygon>& a, const std::vector<Polygon>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!sameRing(a[i].outer, b[i].outer) || a[i].holes.size() != b[i].holes.size()) return false;
+    for (std::size_t h = 0; h < a[i].holes.size(); ++h) {
+      if (!sameRing(a[i].holes[h], b[i].holes[h])) return false;
+    }
+  }
+  return true;
+}
+}  // namespace
+
+BlockOutcome runBlock(const BlockInputs& inputs, std::size_t entry, const BlockPlan& plan, double minFrontage,
+                      const BlockReuse& reuse) {
   BlockOutcome o;
-  o.subdivision = subdivideEntry(inputs, entry, plan);
-  o.metrics = measureEntry(inputs, entry, o.subdivision, minFrontage);
+  const BlockOutcome* previous = reuse.previous && reuse.previousPlan ? reuse.previous : nullptr;
+  if (plan.style == "obb") {
+    const bool reusable = previous && previous->subdivision.obbSplits && reuse.previousPlan->style == "obb" &&
+                          reuse.previousPlan->seed == plan.seed &&
+                          obbSplitsReusable(reuse.previousPlan->parameters.bounds, plan.parameters.bounds);
+    o.subdivision = subdivideObb(inputs.entries[entry].shape, plan.parameters.bounds, plan.seed,
+                                 {reusable ? previous->subdivision.obbSplits.get() : nullptr, reuse.record});
+  } else {
+    o.subdivision = subdivideEntry(inputs, entry, plan);
+  }
+  if (previous && sameParcels(o.subdivision.parcels, previous->subdivision.parcels)) {
+    o.metrics = previous->metrics;  // the same parcels in the same block: the same measurements
+  } else {
+    o.metrics = measureEntry(inputs, entry, o.subdivision, minFrontage);
+  }
   return o;
 }
 

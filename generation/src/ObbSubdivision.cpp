@@ -49,10 +49,32 @@ ObbParameters obbParametersFrom(const ParameterValues& v) {
   return p;
 }
 
+struct ObbSplits {
+  /// The split a piece got: its parts in recursion order and their street access.
+  struct Split {
+    std::vector<Polygon> parts;  ///< empty: no admissible split (the piece stays, oversize)
+    std::vector<char> access;
+  };
+  /// A piece that did not fit: its split and what became of each part (null:
+  /// the part fitted and was never split).
+  struct Node {
+    std::shared_ptr<const Split> split;
+    std::vector<std::shared_ptr<const Node>> children;
+  };
+  std::shared_ptr<const Node> root;  ///< null: the block fitted as it is
+};
+
+bool obbSplitsReusable(const ObbParameters& a, const ObbParameters& b) {
+  return a.aMin == b.aMin && a.wMin == b.wMin && a.omega == b.omega && a.xi == b.xi &&
+         a.snapDistance == b.snapDistance && a.minFrontage == b.minFrontage;
+}
+
 namespace {
 
 using detail::Rng;
 using detail::splitmix64;
+using Node = ObbSplits::Node;
+using NodePtr = std::shared_ptr<const Node>;
 
 // The OBB of Vanegas et al.: the smallest box with a side along one of the
 // ring's own edges (edge-aligned, so small edits elsewhere do not turn it).
@@ -62,8 +84,8 @@ constexpr std::size_t kMaxParcelsPerBlock = 200000;
 
 class Subdivider {
 public:
-  Subdivider(const Polygon& block, const ObbParameters& p, Subdivision& out)
-      : block_(block), outline_{block.outer, {}}, p_(p), out_(out) {
+  Subdivider(const Polygon& block, const ObbParameters& p, Subdivision& out, bool record)
+      : block_(block), outline_{block.outer, {}}, p_(p), out_(out), record_(record) {
     for (const Point& v : block.outer) contour_.push_back(v);
     for (const Ring& h : block.holes) contour_.insert(contour_.end(), h.begin(), h.end());
     const Box b = bounds(block);
@@ -71,7 +93,11 @@ public:
     outlineEdges_ = std::make_unique<analysis::PreparedBoundary>(outline_, accessTolerance_);
   }
 
-  void run(std::uint64_t seed) { recurse(block_, seed, hasAccess(block_), 0); }
+  /// Subdivides the block, reusing the splits of `previous` (may be null);
+  /// returns the splits made and reused when recording.
+  NodePtr run(std::uint64_t seed, const NodePtr& previous) {
+    return recurse(block_, seed, hasAccess(block_), 0, previous);
+  }
 
 private:
   struct Candidate {
@@ -189,23 +215,11 @@ private:
     return true;
   }
 
-  void recurse(const Polygon& piece, std::uint64_t seed, bool access, int depth) {
-    const double a = area(piece);
-    const OrientedBox measured = minimumAreaBox(piece.outer);
-    const bool fits = a <= p_.aMax && measured.width <= p_.wMax;
-    // Safety nets against pathological bounds: recursion depth and a budget of
-    // parcels per block.
-    if (fits || depth > 60 || out_.parcels.size() >= kMaxParcelsPerBlock) {
-      emit(piece, access, !fits);
-      return;
-    }
-    // Random choices and the children's seeds are drawn before any recursion.
-    Rng rng{seed};
-    const bool wantAccess = access && rng.uniform() < p_.xi;
-    const double shiftAcross = (2 * rng.uniform() - 1) * p_.omega;
-    const double shiftAlong = (2 * rng.uniform() - 1) * p_.omega;
-    const std::uint64_t childBase = rng.next();
-
+  // The split of a piece that does not fit: its parts in a fixed order (along
+  // the OBB axes, so seeds follow position) with their access; no parts when
+  // no candidate is admissible.
+  ObbSplits::Split split(const Polygon& piece, bool access, bool wantAccess, double shiftAcross,
+                         double shiftAlong) const {
     const OrientedBox box = edgeAlignedBox(piece.outer);
     const Point u = box.u, v{-box.u.y, box.u.x};
     std::vector<Candidate> candidates = {{false, 0.25 * box.length * shiftAcross}};
@@ -250,7 +264,6 @@ private:
       }
       if (c == 0) addFallbacks();
       if (!admissible) continue;
-      // Children in a fixed order (along the OBB axes) so seeds follow position.
       std::vector<std::size_t> order(parts.size());
       for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
       std::vector<Point> centres;
@@ -260,12 +273,50 @@ private:
         if (px != py) return px < py;
         return centres[x].x * v.x + centres[x].y * v.y < centres[y].x * v.x + centres[y].y * v.y;
       });
-      for (std::size_t k = 0; k < order.size(); ++k) {
-        recurse(parts[order[k]], splitmix64(childBase + k), partAccess[order[k]] != 0, depth + 1);
+      ObbSplits::Split out;
+      for (std::size_t k : order) {
+        out.parts.push_back(std::move(parts[k]));
+        out.access.push_back(partAccess[k]);
       }
-      return;
+      return out;
     }
-    emit(piece, access, true);
+    return {};
+  }
+
+  NodePtr recurse(const Polygon& piece, std::uint64_t seed, bool access, int depth, const NodePtr& previous) {
+    const double a = area(piece);
+    const OrientedBox measured = minimumAreaBox(piece.outer);
+    const bool fits = a <= p_.aMax && measured.width <= p_.wMax;
+    // Safety nets against pathological bounds: recursion depth and a budget of
+    // parcels per block.
+    if (fits || depth > 60 || out_.parcels.size() >= kMaxParcelsPerBlock) {
+      emit(piece, access, !fits);
+      return record_ ? previous : nullptr;  // what is known below stays for smaller bounds
+    }
+    // Random choices and the children's seeds are drawn before any recursion.
+    Rng rng{seed};
+    const bool wantAccess = access && rng.uniform() < p_.xi;
+    const double shiftAcross = (2 * rng.uniform() - 1) * p_.omega;
+    const double shiftAlong = (2 * rng.uniform() - 1) * p_.omega;
+    const std::uint64_t childBase = rng.next();
+
+    auto node = std::make_shared<Node>();
+    if (previous && previous->split) {
+      node->split = previous->split;
+    } else {
+      node->split = std::make_shared<const ObbSplits::Split>(split(piece, access, wantAccess, shiftAcross, shiftAlong));
+    }
+    const ObbSplits::Split& chosen = *node->split;
+    if (chosen.parts.empty()) {
+      emit(piece, access, true);
+      return record_ ? NodePtr(std::move(node)) : nullptr;
+    }
+    node->children.resize(chosen.parts.size());
+    for (std::size_t k = 0; k < chosen.parts.size(); ++k) {
+      const NodePtr below = previous && k < previous->children.size() ? previous->children[k] : nullptr;
+      node->children[k] = recurse(chosen.parts[k], splitmix64(childBase + k), chosen.access[k] != 0, depth + 1, below);
+    }
+    return record_ ? NodePtr(std::move(node)) : nullptr;
   }
 
   const Polygon& block_;
@@ -275,6 +326,7 @@ private:
   std::vector<Point> contour_;
   double accessTolerance_ = 1e-6;
   std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;  // outline_, for the access test
+  bool record_ = false;
 };
 
 }  // namespace
@@ -283,7 +335,8 @@ std::uint64_t blockSeed(std::uint64_t runSeed, std::int64_t blockId) {
   return splitmix64(splitmix64(runSeed) ^ static_cast<std::uint64_t>(blockId));
 }
 
-Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, std::uint64_t seed) {
+Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, std::uint64_t seed,
+                         const ObbReuse& reuse) {
   Subdivision out;
   ObbParameters p = parameters;
   p.aMax = std::max(p.aMax, p.aMin);
@@ -295,7 +348,13 @@ Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, 
       out.failed = true;
       out.failure = "block is not a valid polygon with holes for exact splitting";
     } else {
-      Subdivider(local, p, out).run(seed);
+      const NodePtr previous = reuse.previous ? reuse.previous->root : nullptr;
+      NodePtr made = Subdivider(local, p, out, reuse.record).run(seed, previous);
+      if (reuse.record) {
+        auto splits = std::make_shared<ObbSplits>();
+        splits->root = std::move(made);
+        out.obbSplits = std::move(splits);
+      }
     }
   } catch (const std::exception& e) {
     out = Subdivision{};

@@ -114,6 +114,16 @@ int main(int argc, char** argv) {
     });
     measure("  skeleton-only street-angle slider (obb: none regenerated)", std::max(3, repeats / 3),
             [&](int i) { w.setParameter("street-angle", 20.0 + i); });
+
   }
+  // Last, as it sets the bounds for every block (the first move of a bound
+  // slider does that): the W_max slider, obb reusing each block's splits.
+  w.setStyle("obb");
+  w.setOutlinesVisible(true);
+  w.setParameter("w-max", 30.0);
+  settle(w);
+  std::printf("style obb, parcel outlines on, bounds set for every block\n");
+  measure("  W_max slider (every block regenerated)", repeats,
+          [&](int i) { w.setParameter("w-max", i % 2 ? 25.0 : 35.0); });
   return 0;
 }

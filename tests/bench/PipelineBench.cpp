@@ -262,23 +262,31 @@ BENCHMARK(SkeletonSubdivisionPerBlock)->Unit(benchmark::kMillisecond)->UseRealTi
 }  // namespace
 
 // The incremental session behind the GUI on cambridge_ma: one global change
-// (omega, every block regenerated) and one block's override (one block), each
-// alternating between two values so that every iteration regenerates.
+// (omega, every block regenerated), one block's override (one block), and the
+// W_max slider with the bounds set for every block (every block regenerated,
+// reusing its splits), each alternating between two values so that every
+// iteration regenerates.
 void SessionUpdate(benchmark::State& state) {
   if (!haveData(state)) return;
   const bool global = state.range(0) == 1;
+  const bool wMax = state.range(0) == 2;
   parcelscope::viz::CompareRequest request;
   request.input.path = kCambridge;
   request.input.where = "ML <> 'ROAD'";
   request.style = state.range(1) == 1 ? "skeleton" : "obb";
   request.parameters = parcelscope::defaultValues(parcelscope::viz::compareParameters());
   request.parameters["figures"] = 0;
+  if (wMax) {  // as the application does once a bound slider moves: all four bounds set
+    for (const char* bound : {"a-min", "a-max", "w-min", "w-max"}) request.explicitParameters.insert(bound);
+  }
   parcelscope::viz::CompareSession session;
   session.update(request);
   int i = 0;
   std::size_t regenerated = 0;
   for (auto _ : state) {
-    if (global) {
+    if (wMax) {
+      request.parameters["w-max"] = ++i % 2 ? 25.0 : 35.0;
+    } else if (global) {
       request.parameters["omega"] = ++i % 2 ? 0.25 : 0.35;
       request.explicitParameters.insert("omega");
     } else {
@@ -287,9 +295,18 @@ void SessionUpdate(benchmark::State& state) {
     regenerated = session.update(request).blocksRegenerated;
   }
   state.counters["blocks_regenerated"] = static_cast<double>(regenerated);
-  state.SetLabel(request.style + (global ? ", omega for every block" : ", one block's A_max"));
+  state.SetLabel(request.style + (wMax     ? ", W_max for every block"
+                                  : global ? ", omega for every block"
+                                           : ", one block's A_max"));
 }
-BENCHMARK(SessionUpdate)->Args({1, 0})->Args({0, 0})->Args({1, 1})->Args({0, 1})->Unit(benchmark::kMillisecond)
-    ->UseRealTime()->MinTime(3.0);
+BENCHMARK(SessionUpdate)
+    ->Args({1, 0})
+    ->Args({0, 0})
+    ->Args({2, 0})
+    ->Args({1, 1})
+    ->Args({0, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(3.0);
 
 BENCHMARK_MAIN();

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -175,6 +176,52 @@ TEST(ObbSubdivision, RandomShapesAreTiledValidlyAndReproducibly) {
   }
   std::printf("%d shapes, %d parcels, %d without street access at xi = 1\n", shapes, parcels, accessExceptions);
   EXPECT_EQ(accessExceptions, 0);
+}
+
+// Moving A_max and W_max up and down while reusing the recorded splits gives,
+// at every step, exactly the parcels a fresh run gives; the other parameters
+// make the splits unusable.
+TEST(ObbSubdivision, ReusedSplitsGiveWhatAFreshRunGives) {
+  const std::uint64_t seed = std::random_device{}();
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> scale(0.3, 3.0);
+  int reusedSteps = 0;
+  for (int i = 0; i < 200 / test::kSanitizerDivisor; ++i) {
+    const Polygon block = test::randomShape(rng, i % 7);
+    ObbParameters p = test::randomBounds(rng, area(block));
+    const std::uint64_t s = rng();
+    Subdivision last = subdivideObb(block, p, s, {nullptr, true});
+    ASSERT_NE(last.obbSplits, nullptr);
+    for (int step = 0; step < 6; ++step) {
+      const ObbParameters before = p;
+      p.aMax = std::max(p.aMin, p.aMax * scale(rng));
+      p.wMax = std::max(p.wMin, p.wMax * scale(rng));
+      ASSERT_TRUE(obbSplitsReusable(before, p));
+      const Subdivision reused = subdivideObb(block, p, s, {last.obbSplits.get(), true});
+      const Subdivision fresh = subdivideObb(block, p, s);
+      const std::string what = "shape " + std::to_string(i) + " step " + std::to_string(step);
+      ASSERT_EQ(reused.parcels.size(), fresh.parcels.size()) << what;
+      for (std::size_t k = 0; k < fresh.parcels.size(); ++k) {
+        ASSERT_EQ(reused.parcels[k].outer.size(), fresh.parcels[k].outer.size()) << what;
+        for (std::size_t v = 0; v < fresh.parcels[k].outer.size(); ++v) {
+          EXPECT_EQ(reused.parcels[k].outer[v].x, fresh.parcels[k].outer[v].x) << what;
+          EXPECT_EQ(reused.parcels[k].outer[v].y, fresh.parcels[k].outer[v].y) << what;
+        }
+      }
+      EXPECT_EQ(reused.oversize, fresh.oversize) << what;
+      EXPECT_EQ(reused.withoutAccess, fresh.withoutAccess) << what;
+      reusedSteps += fresh.parcels.size() > 1;
+      last = reused;
+    }
+  }
+  EXPECT_GT(reusedSteps, 0);
+  ObbParameters a, b = a;
+  b.omega = 0.5;
+  EXPECT_FALSE(obbSplitsReusable(a, b));
+  b = a;
+  b.wMin = a.wMin + 1;
+  EXPECT_FALSE(obbSplitsReusable(a, b));
 }
 
 TEST(ObbSubdivision, ArbitraryPointRingsNeverThrowAndTileWhenValid) {

@@ -167,8 +167,13 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
     parallelFor(
         todo.size(),
         [&](std::size_t t) {
+          // The block's last run, whose splits and measurements the new plan may reuse.
+          generation::BlockReuse reuse;
+          reuse.previous = outcomes[todo[t]].get();
+          reuse.previousPlan = outcomes[todo[t]] ? &done[todo[t]] : nullptr;
+          reuse.record = true;
           made[t] = std::make_shared<const generation::BlockOutcome>(
-              generation::runBlock(inputs, todo[t], plans[todo[t]], minFrontage));
+              generation::runBlock(inputs, todo[t], plans[todo[t]], minFrontage, reuse));
           ready[t].store(true, std::memory_order_release);
         },
         tick ? std::function<void(std::size_t)>([&](std::size_t n) {

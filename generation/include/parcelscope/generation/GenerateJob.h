@@ -138,9 +138,21 @@ struct BlockOutcome {
   Subdivision subdivision;
   std::vector<analysis::ParcelMetrics> metrics;
 };
+/// What runBlock may reuse from the block's last run.
+struct BlockReuse {
+  /// The entry's outcome under `previousPlan` (both null: nothing to reuse).
+  const BlockOutcome* previous = nullptr;
+  const BlockPlan* previousPlan = nullptr;
+  /// Keep the OBB splits in the outcome for the next run (see ObbSplits).
+  bool record = false;
+};
 /// Runs `plan` on entry `entry` of `inputs` (street widths must have been measured
 /// with streetWidthsOf when the style is not obb). `minFrontage` as the analysis's.
-BlockOutcome runBlock(const BlockInputs& inputs, std::size_t entry, const BlockPlan& plan, double minFrontage);
+/// With `reuse`, an OBB plan differing from the previous one only in A_max or
+/// W_max reuses its splits, and parcels equal to the previous ones keep their
+/// metrics; the outcome is the same as without.
+BlockOutcome runBlock(const BlockInputs& inputs, std::size_t entry, const BlockPlan& plan, double minFrontage,
+                      const BlockReuse& reuse = {});
 
 /// The run's result from one outcome per entry (in entry order).
 GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<BlockPlan>& plans,

@@ -14,6 +14,8 @@
 // So parcels never fall below A_min or W_min unless the block itself does, and
 // exceed A_max or W_max only where the geometry leaves no admissible split.
 #include <cstdint>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "parcelscope/core/Geometry.h"
@@ -38,6 +40,13 @@ const std::vector<ParameterDescription>& obbParameterDescriptions();
 /// Parameters from values named as in obbParameterDescriptions(); missing names keep defaults.
 ObbParameters obbParametersFrom(const ParameterValues& values);
 
+/// The splits an OBB subdivision made, piece by piece. Which split a piece gets
+/// does not depend on A_max or W_max, only where the recursion stops; a later
+/// run of the same block, seed and other parameters reuses them, so a bounds
+/// slider moves without splitting again (parcels persist under edits, as in
+/// Vanegas et al. 2012). Opaque; shared, never changed once made.
+struct ObbSplits;
+
 struct Subdivision {
   std::vector<Polygon> parcels;   ///< tile the block (normalised, local metres)
   int oversize = 0;               ///< parcels above A_max or W_max with no admissible split
@@ -47,13 +56,28 @@ struct Subdivision {
   bool fallback = false;          ///< another style could not subdivide the block; OBB did
   std::string fallbackReason;     ///< why, when fallback
   int patioParcels = 0;           ///< parcels that are (parts of) inner patios, without street access by design
+  std::shared_ptr<const ObbSplits> obbSplits;  ///< OBB only, when asked to record them
 };
+
+/// Splits to reuse and whether to record this run's.
+struct ObbReuse {
+  /// Splits recorded by an earlier run of the same block and seed whose
+  /// parameters pass obbSplitsReusable; nullptr: split afresh.
+  const ObbSplits* previous = nullptr;
+  bool record = false;  ///< keep this run's splits (with those reused) in Subdivision::obbSplits
+};
+
+/// True when splits recorded with `recorded` serve a run with `wanted`: every
+/// parameter but A_max and W_max is the same.
+bool obbSplitsReusable(const ObbParameters& recorded, const ObbParameters& wanted);
 
 /// Subdivides one block (normalised polygon, holes allowed) into parcels.
 /// Deterministic: the same block, parameters and seed give the same parcels.
 /// Never throws on bad geometry: a block the exact kernel rejects comes back
 /// whole with failed = true.
-Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, std::uint64_t seed);
+/// With `reuse.previous`, the parcels are those a fresh run gives.
+Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, std::uint64_t seed,
+                         const ObbReuse& reuse = {});
 
 /// Seed of the block with key `blockKey` (generate uses the block's position)
 /// in a run with seed `runSeed` (splitmix64 mix), so a block's parcels do not
