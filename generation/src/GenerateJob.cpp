@@ -261,22 +261,15 @@ std::vector<analysis::ParcelMetrics> measureEntry(const BlockInputs& inputs, std
 
 namespace {
 bool sameRing(const Ring& a, const Ring& b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (a[i].x != b[i].x || a[i].y != b[i].y) return false;
-  }
-  return true;
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                    [](const Point& p, const Point& q) { return p.x == q.x && p.y == q.y; });
 }
 
 bool sameParcels(const std::vector<Polygon>& a, const std::vector<Polygon>& b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (!sameRing(a[i].outer, b[i].outer) || a[i].holes.size() != b[i].holes.size()) return false;
-    for (std::size_t h = 0; h < a[i].holes.size(); ++h) {
-      if (!sameRing(a[i].holes[h], b[i].holes[h])) return false;
-    }
-  }
-  return true;
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const Polygon& p, const Polygon& q) {
+    return sameRing(p.outer, q.outer) &&
+           std::equal(p.holes.begin(), p.holes.end(), q.holes.begin(), q.holes.end(), sameRing);
+  });
 }
 }  // namespace
 

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <memory>
 
+#include "OgrTestUtil.h"
 #include "TestUtil.h"
 #include "parcelscope/core/Coverage.h"
 #include "parcelscope/core/Parallel.h"
@@ -77,24 +78,12 @@ TEST_P(SharedDataset, DissolvedBlocksEqualGeosUnion) {
   const std::size_t n = d.analysis.blocks.size();
   std::vector<char> accepted(n, 0);
   std::vector<double> difference(n, 0), ours(n, 0), geos(n, 0);
-  auto toOgr = [](const Polygon& p) {
-    auto polygon = std::make_unique<OGRPolygon>();
-    auto ring = [](const Ring& r) {
-      auto o = std::make_unique<OGRLinearRing>();
-      for (const Point& v : r) o->addPoint(v.x, v.y);
-      o->addPoint(r.front().x, r.front().y);
-      return o;
-    };
-    polygon->addRingDirectly(ring(p.outer).release());
-    for (const Ring& h : p.holes) polygon->addRingDirectly(ring(h).release());
-    return polygon;
-  };
   parallelFor(n, [&](std::size_t b) {
     std::vector<const Polygon*> members;
     OGRMultiPolygon parcels;
     for (int i : d.analysis.blocks[b].parcels) {
       members.push_back(&d.layer.parcels[i].shape);
-      parcels.addGeometryDirectly(toOgr(d.layer.parcels[i].shape).release());
+      parcels.addGeometryDirectly(test::toOgr(d.layer.parcels[i].shape).release());
     }
     // As unionAndClose tries it: without the snap, then with it.
     OGRMultiPolygon outline;
@@ -102,7 +91,7 @@ TEST_P(SharedDataset, DissolvedBlocksEqualGeosUnion) {
       const auto dissolved = dissolveCoverage(members, {snap});
       if (!dissolved) continue;
       outline.empty();
-      for (const Polygon& part : *dissolved) outline.addGeometryDirectly(toOgr(part).release());
+      for (const Polygon& part : *dissolved) outline.addGeometryDirectly(test::toOgr(part).release());
       if (outline.IsValid()) {
         accepted[b] = 1;
         break;

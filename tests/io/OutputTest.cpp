@@ -8,6 +8,7 @@
 #include <fstream>
 #include <random>
 
+#include "OgrTestUtil.h"
 #include "TestUtil.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/io/GeometryOps.h"
@@ -216,14 +217,6 @@ TEST(GeometryOps, UnionOfRandomGridsMatchesGeosUnion) {
   const unsigned seed = std::random_device{}();
   SCOPED_TRACE("seed " + std::to_string(seed));
   std::mt19937 rng(seed);
-  auto toOgr = [](const Polygon& p) {
-    auto ring = std::make_unique<OGRLinearRing>();
-    for (const Point& v : p.outer) ring->addPoint(v.x, v.y);
-    ring->addPoint(p.outer.front().x, p.outer.front().y);
-    auto polygon = std::make_unique<OGRPolygon>();
-    polygon->addRingDirectly(ring.release());
-    return polygon;
-  };
   for (int round = 0; round < 30; ++round) {
     std::vector<Polygon> lots =
         test::jitteredGrid(rng, 2 + static_cast<int>(rng() % 5), 2 + static_cast<int>(rng() % 5), 0.8);
@@ -233,24 +226,14 @@ TEST(GeometryOps, UnionOfRandomGridsMatchesGeosUnion) {
     OGRMultiPolygon all;
     for (const Polygon& p : lots) {
       members.push_back(&p);
-      all.addGeometryDirectly(toOgr(p).release());
+      all.addGeometryDirectly(test::toOgr(p).release());
     }
     const auto ours = unionAndClose(members, 0.0);
     std::unique_ptr<OGRGeometry> geos(all.UnionCascaded());
     ASSERT_NE(geos, nullptr);
-    OGRMultiPolygon mine;
-    for (const Polygon& p : ours) {
-      auto polygon = toOgr(p);
-      for (const Ring& h : p.holes) {
-        auto ring = std::make_unique<OGRLinearRing>();
-        for (const Point& v : h) ring->addPoint(v.x, v.y);
-        ring->addPoint(h.front().x, h.front().y);
-        polygon->addRingDirectly(ring.release());
-      }
-      mine.addGeometryDirectly(polygon.release());
-    }
-    EXPECT_TRUE(mine.IsValid());
-    std::unique_ptr<OGRGeometry> difference(mine.SymDifference(geos.get()));
+    const auto mine = test::toOgr(ours);
+    EXPECT_TRUE(mine->IsValid());
+    std::unique_ptr<OGRGeometry> difference(mine->SymDifference(geos.get()));
     ASSERT_NE(difference, nullptr);
     double ourArea = 0;
     for (const Polygon& p : ours) ourArea += area(p);
