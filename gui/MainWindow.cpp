@@ -17,6 +17,7 @@
 #include <QLabel>
 #include <QMenuBar>
 #include <QMimeData>
+#include <QPainter>
 #include <QProgressBar>
 #include <QPushButton>
 #include <QScrollArea>
@@ -28,12 +29,15 @@
 #include <QTableWidget>
 #include <QToolBar>
 #include <QVBoxLayout>
-#include <QVTKOpenGLNativeWidget.h>
+#include <QVTKOpenGLStereoWidget.h>
 
 #include <vtkChartXY.h>
+#include <vtkContextInteractorStyle.h>
 #include <vtkContextScene.h>
 #include <vtkContextView.h>
 #include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkObjectFactory.h>
+#include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
 
 #include <cmath>
@@ -47,6 +51,16 @@
 #include "parcelscope/viz/Scenes.h"
 
 namespace parcelscope::gui {
+
+// The histogram's interactor style: the chart's own, which redraws a modified
+// chart 40 ms later on a timer, plus a way to draw now and cancel that timer.
+class ChartStyle : public vtkContextInteractorStyle {
+public:
+  static ChartStyle* New();
+  vtkTypeMacro(ChartStyle, vtkContextInteractorStyle)
+  void drawNow() { RenderNow(); }
+};
+vtkStandardNewMacro(ChartStyle);
 
 namespace {
 
@@ -155,13 +169,21 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
   }
 
   // Histogram and numbers.
-  histogramWidget_ = new QVTKOpenGLNativeWidget;
+  histogramWidget_ = new QVTKOpenGLStereoWidget;
   histogramWidget_->setRenderWindow(histogramWindow_);
   histogramWidget_->setMinimumSize(300, 220);
   histogramView_->SetRenderWindow(histogramWindow_);
   histogramView_->SetInteractor(histogramWidget_->interactor());
   histogramView_->GetRenderer()->SetBackground(1, 1, 1);
   histogramView_->GetScene()->AddItem(chart_);
+  {
+    // The chart's own interactor style, replaced by one that can draw now.
+    vtkRenderWindowInteractor* iren = histogramWidget_->interactor();
+    if (auto* own = vtkContextInteractorStyle::SafeDownCast(iren->GetInteractorStyle())) own->SetScene(nullptr);
+    histogramStyle_ = vtkSmartPointer<ChartStyle>::New();
+    histogramStyle_->SetScene(histogramView_->GetScene());
+    iren->SetInteractorStyle(histogramStyle_);
+  }
   numbers_ = new QTableWidget;
   numbers_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   numbers_->verticalHeader()->setVisible(false);
@@ -171,6 +193,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
   lower->addWidget(numbers_);
   lower->setStretchFactor(0, 3);
   lower->setStretchFactor(1, 2);
+  lower->setSizes({650, 350});  // a view's container has no size hint of its own
 
   auto* central = new QWidget;
   auto* layout = new QVBoxLayout(central);
@@ -713,7 +736,18 @@ void MainWindow::drawHistogram() {
                             std::max(360, histogramWidget_->height()));
     for (const auto& s : h.series) histogramCounts_.push_back(s.counts);
   }
-  histogramWindow_->Render();
+  histogramStyle_->drawNow();
+  if (histogramView_->GetScene()->GetDirty()) histogramWindow_->Render();
+}
+
+QImage MainWindow::screenshot() {
+  QPixmap shot = grab();
+  QPainter painter(&shot);
+  for (QVTKOpenGLStereoWidget* view : findChildren<QVTKOpenGLStereoWidget*>()) {
+    if (view->isVisible()) painter.drawImage(QRect(view->mapTo(this, QPoint(0, 0)), view->size()), view->grabFramebuffer());
+  }
+  painter.end();
+  return shot.toImage();
 }
 
 QString MainWindow::histogramTitle() const { return QString::fromStdString(chart_->GetTitle()); }
@@ -733,6 +767,7 @@ void MainWindow::fillNumbers() {
   numbers_->setColumnCount(columns);
   QStringList header;
   for (const auto& c : summary.columns) header << QString::fromStdString(c.name);
+  while (header.size() < columns) header << QString();
   numbers_->setHorizontalHeaderLabels(header);
   int row = 0;
   for (const auto& r : summary.rows) {

@@ -5,6 +5,7 @@
 // it to a SessionWorker, which calls the same library code as `parcelscope
 // compare`; this class only gathers input and shows results.
 #include <QElapsedTimer>
+#include <QImage>
 #include <QMainWindow>
 #include <QString>
 #include <QThread>
@@ -14,6 +15,7 @@
 #include <memory>
 
 #include <vtkNew.h>
+#include <vtkSmartPointer.h>
 
 #include "SessionWorker.h"
 #include "parcelscope/viz/CompareSession.h"
@@ -26,13 +28,14 @@ class QMenu;
 class QProgressBar;
 class QPushButton;
 class QTableWidget;
-class QVTKOpenGLNativeWidget;
+class QVTKOpenGLStereoWidget;
 class vtkChartXY;
 class vtkContextView;
 class vtkGenericOpenGLRenderWindow;
 
 namespace parcelscope::gui {
 
+class ChartStyle;
 class MapView;
 class ParameterPanel;
 
@@ -66,6 +69,10 @@ public:
   /// Overrides the selected block's style and parameters, or clears its override.
   void overrideSelectedBlock(const QString& style, const ParameterValues& parameters);
   void clearSelectedOverride();
+
+  /// The window as on screen: its widgets with the views' OpenGL images
+  /// (which QWidget::grab leaves out, as each view is a native window).
+  QImage screenshot();
 
   const viz::CompareRequest& request() const { return request_; }
   std::shared_ptr<const viz::CompareResult> result() const { return result_; }
@@ -141,10 +148,11 @@ private:
 
   MapView* observedView_;
   MapView* proceduralView_;
-  QVTKOpenGLNativeWidget* histogramWidget_;
+  QVTKOpenGLStereoWidget* histogramWidget_;
   vtkNew<vtkGenericOpenGLRenderWindow> histogramWindow_;
   vtkNew<vtkContextView> histogramView_;
   vtkNew<vtkChartXY> chart_;
+  vtkSmartPointer<ChartStyle> histogramStyle_;
   QTableWidget* numbers_;
   QLabel* errorBar_;
   QLabel* status_;

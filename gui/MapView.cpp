@@ -3,7 +3,7 @@
 #include <QLabel>
 #include <QTimer>
 #include <QVBoxLayout>
-#include <QVTKOpenGLNativeWidget.h>
+#include <QVTKOpenGLStereoWidget.h>
 
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
@@ -68,7 +68,11 @@ MapView::MapView(const QString& title, bool withColourBar, QWidget* parent) : QW
   f.setBold(true);
   title_->setFont(f);
   layout->addWidget(title_);
-  widget_ = new QVTKOpenGLNativeWidget(this);
+  // A native OpenGL window in a container: its frames go to the screen as
+  // they are. In a QOpenGLWidget (QVTKOpenGLNativeWidget) Qt composes the
+  // whole window through OpenGL after every frame instead, which with a
+  // software OpenGL costs about 30 ms per change.
+  widget_ = new QVTKOpenGLStereoWidget(this);
   widget_->setMinimumSize(240, 200);
   // No multisampling: with a software OpenGL (Xvfb, remote desktops) it makes
   // every frame several times slower; the maps are flat fills and thin lines.

@@ -10,7 +10,7 @@
 #include "parcelscope/viz/Scenes.h"
 
 class QLabel;
-class QVTKOpenGLNativeWidget;
+class QVTKOpenGLStereoWidget;
 class vtkCamera;
 class vtkGenericOpenGLRenderWindow;
 class vtkRenderer;
@@ -33,7 +33,7 @@ public:
   void fit(const Box& extent);
   /// Renders now.
   void render();
-  QVTKOpenGLNativeWidget* vtkWidget() { return widget_; }
+  QVTKOpenGLStereoWidget* vtkWidget() { return widget_; }
   /// Where the world point `p` (local metres) appears in vtkWidget(), in widget coordinates.
   QPoint widgetPoint(const Point& p);
 
@@ -43,7 +43,7 @@ signals:
 private:
   void scheduleRender();
   QLabel* title_;
-  QVTKOpenGLNativeWidget* widget_;
+  QVTKOpenGLStereoWidget* widget_;
   vtkNew<vtkGenericOpenGLRenderWindow> window_;
   vtkNew<vtkRenderer> renderer_;
   vtkNew<vtkRenderer> legend_;

@@ -4,14 +4,14 @@
 #include <QCommandLineParser>
 #include <QSurfaceFormat>
 #include <QTimer>
-#include <QVTKOpenGLNativeWidget.h>
+#include <QVTKOpenGLStereoWidget.h>
 
 #include <cstdio>
 
 #include "MainWindow.h"
 
 int main(int argc, char** argv) {
-  QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
+  QSurfaceFormat::setDefaultFormat(QVTKOpenGLStereoWidget::defaultFormat());
   QApplication app(argc, argv);
   QApplication::setApplicationName("parcelscope-gui");
   QCommandLineParser parser;
@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
     const QString path = parser.value(screenshot);
     QObject::connect(&window, &parcelscope::gui::MainWindow::viewsUpdated, &window, [&window, path] {
       QTimer::singleShot(300, &window, [&window, path] {
-        const bool ok = window.grab().save(path);
+        const bool ok = window.screenshot().save(path);
         std::fprintf(stderr, ok ? "screenshot written to %s\n" : "cannot write %s\n", path.toLocal8Bit().constData());
         QApplication::exit(ok ? 0 : 1);
       });

@@ -16,7 +16,7 @@
 #include <QTableWidget>
 #include <QTemporaryDir>
 #include <QTest>
-#include <QVTKOpenGLNativeWidget.h>
+#include <QVTKOpenGLStereoWidget.h>
 
 #include <cmath>
 #include <filesystem>
@@ -141,7 +141,7 @@ private slots:
     const auto r = window_->result();
     const parcelscope::Point inside = parcelscope::interiorPoint(r->observed->analysis.blocks[4].parts.front());
     auto* view = window_->proceduralView();
-    QTest::mouseClick(view->vtkWidget(), Qt::LeftButton, {}, view->widgetPoint(inside));
+    QTest::mouseClick(view->vtkWidget()->embeddedOpenGLWindow(), Qt::LeftButton, {}, view->widgetPoint(inside));
     QTest::qWait(50);
     QCOMPARE(window_->selectedBlock(), 4);
     const std::int64_t before = r->blocks[4].comparison.generated.parcels;
@@ -219,7 +219,7 @@ private slots:
     window_->selectBlock(-1);
     QTest::qWait(300);
     const QString shot = dir_.path() + "/window.png";
-    QVERIFY(window_->grab().save(shot));
+    QVERIFY(window_->screenshot().save(shot));
     const std::string baseline = std::string(PARCELSCOPE_SOURCE_DIR) + "/tests/data/baseline/gui_main_window.png";
     if (qEnvironmentVariableIsSet("PARCELSCOPE_UPDATE_BASELINES")) {
       std::filesystem::copy_file(shot.toStdString(), baseline, std::filesystem::copy_options::overwrite_existing);
@@ -239,7 +239,7 @@ private slots:
 };
 
 int main(int argc, char** argv) {
-  QSurfaceFormat::setDefaultFormat(QVTKOpenGLNativeWidget::defaultFormat());
+  QSurfaceFormat::setDefaultFormat(QVTKOpenGLStereoWidget::defaultFormat());
   QApplication app(argc, argv);
   std::filesystem::create_directories(PARCELSCOPE_RENDER_FAILURES);
   MainWindowTest test;
