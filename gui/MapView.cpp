@@ -91,6 +91,16 @@ MapView::MapView(const QString& title, bool withColourBar, QWidget* parent) : QW
   window_->AddRenderer(legend_);
   layer_.addTo(renderer_);
   outline_.addTo(renderer_);
+  // Before every frame, whoever asks for it (a change, a pan or zoom of the
+  // shared camera): outlines for the shapes large enough at this zoom.
+  vtkNew<vtkCallbackCommand> scale;
+  scale->SetClientData(this);
+  scale->SetCallback([](vtkObject*, unsigned long, void* self, void*) {
+    auto* view = static_cast<MapView*>(self);
+    const int* size = view->renderer_->GetSize();
+    if (size[1] > 0) view->layer_.setMetresPerPixel(2 * view->renderer_->GetActiveCamera()->GetParallelScale() / size[1]);
+  });
+  renderer_->AddObserver(vtkCommand::StartEvent, scale);
   if (withColourBar) {
     vtkScalarBarActor* bar = layer_.colourBar();
     bar->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();

@@ -25,6 +25,9 @@
 #include <vector>
 
 #include "MainWindow.h"
+#include "MapView.h"
+
+#include <vtkCamera.h>
 
 using parcelscope::gui::MainWindow;
 
@@ -145,11 +148,17 @@ int main(int argc, char** argv) {
     }
     print(row);
   };
+  const auto outlined = [&] {
+    std::printf("  (outlines around %zu of %zu observed and %zu of %zu procedural parcels at this zoom)\n",
+                w.observedView()->layer().outlinedShapes(), w.result()->observedLots.size(),
+                w.proceduralView()->layer().outlinedShapes(), w.result()->generated.parcels.size());
+  };
   for (const auto& [style, outlines] : {std::pair{"obb", true}, {"skeleton", true}, {"obb", false}}) {
     w.setStyle(style);
     w.setOutlinesVisible(outlines);
     settle(w);
     std::printf("style %s, parcel outlines %s\n", style, outlines ? "on" : "off");
+    if (outlines) outlined();
     // A block picked by the user: its own A_max, alternating.
     w.selectBlock(100);
     measure("  block override (1 block regenerated)", repeats, [&](int i) {
@@ -167,6 +176,26 @@ int main(int argc, char** argv) {
             [&](int i) { w.setParameter("street-angle", 20.0 + i); });
 
   }
+  // Zoomed in 4x on the middle, where outlines are drawn around most parcels.
+  w.setStyle("obb");
+  w.setOutlinesVisible(true);
+  settle(w);
+  w.observedView()->camera()->Zoom(4);
+  w.observedView()->render();
+  w.proceduralView()->render();
+  std::printf("style obb, parcel outlines on, zoomed in 4x\n");
+  outlined();
+  w.selectBlock(100);
+  measure("  block override (1 block regenerated)", repeats, [&](int i) {
+    w.overrideSelectedBlock({}, {{"a-max", i % 2 ? 400.0 : 600.0}, {"a-min", 100.0}});
+  });
+  w.clearSelectedOverride();
+  settle(w);
+  measure("  colour by another quantity (no regeneration)", repeats, [&](int i) {
+    w.setColourBy(i % 2 ? "area" : "aspect_ratio");
+  });
+  w.observedView()->camera()->Zoom(0.25);
+
   // Last, as it sets the bounds for every block (the first move of a bound
   // slider does that): the W_max slider, obb reusing each block's splits.
   w.setStyle("obb");

@@ -10,6 +10,7 @@
 #include "TestUtil.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/viz/Figures.h"
+#include "parcelscope/viz/Scenes.h"
 #include "viz/ImageCheck.h"
 
 namespace parcelscope::viz {
@@ -107,6 +108,80 @@ TEST(RenderMaps, ConcaveShapesFillOnlyThemselves) {
   EXPECT_EQ(image.rgb(300, notchY), 0xffffffu) << "the notch is filled";
   EXPECT_NE(image.rgb(300, baseY), 0xffffffu) << "the base of the U is empty";
   EXPECT_NE(image.rgb(300 - 200, notchY), 0xffffffu) << "the left arm is empty";
+}
+
+// Outlines only around shapes at least kMinOutlinedPixels across: a grid of
+// 4 px cells is drawn as its fill alone, a grid of 100 px cells with outlines.
+TEST(RenderMaps, OutlinesOnlyAroundShapesLargeEnoughToShowThem) {
+  TempDir dir;
+  ColourScale scale;
+  scale.minimum = 1;
+  scale.maximum = 5;
+  scale.title = "value";
+  // The share of the map's inked pixels that are not the fill's colour.
+  const auto outlineShare = [&](int cells) {
+    std::vector<Polygon> grid;
+    const double side = 1000.0 / cells;
+    for (int i = 0; i < cells; ++i) {
+      for (int j = 0; j < cells; ++j) grid.push_back(rect(i * side, j * side, (i + 1) * side, (j + 1) * side));
+    }
+    MapPanel panel{"grid", {}, {}};
+    for (const Polygon& g : grid) {
+      panel.shapes.push_back(&g);
+      panel.values.push_back(1.0);
+    }
+    const FigureOutput out = output(dir, "grid" + std::to_string(cells), 600, 600);
+    renderMaps("a grid", {panel}, scale, out);
+    const test::Image image = test::readPng(out.png);
+    const std::uint32_t fill = image.rgb(250, 250);  // inside a cell of either grid
+    EXPECT_GT(red(fill), 200);
+    int other = 0, inked = 0;
+    for (int y = static_cast<int>(0.15 * 600); y < static_cast<int>(0.85 * 600); ++y) {
+      for (int x = 0; x < 600; ++x) {
+        const std::uint32_t c = image.rgb(x, y);
+        if (c == 0xffffff) continue;
+        ++inked;
+        other += std::abs(red(c) - red(fill)) + std::abs(green(c) - green(fill)) + std::abs(blue(c) - blue(fill)) > 30;
+      }
+    }
+    EXPECT_GT(inked, 100000);
+    return static_cast<double>(other) / inked;
+  };
+  // 1000 m over about 400 px: 2.5 m per pixel, so 10 m cells are 4 px across
+  // (outlined, they would cover half the map; the square's own edge, blended
+  // with the white around it, is about 1.3 %) and 250 m cells 100 px (their
+  // outlines, two pixels wide once smoothed, about 5 %).
+  EXPECT_LT(outlineShare(100), 0.025);
+  EXPECT_GT(outlineShare(4), 0.035);
+}
+
+TEST(OutlineSize, IsTheSideOfASquareAndAboutTwiceAStripsWidth) {
+  EXPECT_DOUBLE_EQ(outlineSize(rect(0, 0, 40, 40)), 40.0);
+  EXPECT_NEAR(outlineSize(rect(0, 0, 100, 2)), 4 * 200.0 / 204.0, 1e-12);
+  Polygon empty;
+  EXPECT_EQ(outlineSize(empty), 0.0);
+}
+
+TEST(MapLayer, OutlinesFollowTheScaleDrawn) {
+  const Polygon small = rect(0, 0, 10, 10), large = rect(20, 0, 120, 100);
+  Polygon courtyard = rect(200, 0, 300, 100);
+  courtyard.holes.push_back({{230, 30}, {230, 70}, {270, 70}, {270, 30}});
+  MapLayer layer;
+  layer.setShapes({&small, &large, &courtyard}, {1, 2, 3});
+  EXPECT_EQ(layer.outlinedShapes(), 3u);  // no scale yet: every shape
+  layer.setMetresPerPixel(1.0);           // 6 m and up
+  EXPECT_EQ(layer.outlinedShapes(), 3u);
+  layer.setMetresPerPixel(5.0);  // 30 m and up: the courtyard is 4 * 8400 / 560 = 60 m across
+  EXPECT_EQ(layer.outlinedShapes(), 2u);
+  layer.setMetresPerPixel(12.0);  // 72 m and up
+  EXPECT_EQ(layer.outlinedShapes(), 1u);
+  layer.setMetresPerPixel(100.0);
+  EXPECT_EQ(layer.outlinedShapes(), 0u);
+  // New shapes keep the scale.
+  layer.setShapes({&large}, {1});
+  EXPECT_EQ(layer.outlinedShapes(), 0u);
+  layer.setMetresPerPixel(0.5);
+  EXPECT_EQ(layer.outlinedShapes(), 1u);
 }
 
 TEST(RenderMaps, RefusesMismatchedValuesAndEmptyMaps) {

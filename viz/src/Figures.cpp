@@ -269,10 +269,11 @@ std::vector<vtkIdType> triangulate(const Polygon& shape, vtkPolygon* earCut, vtk
 }
 
 // Triangles filling every shape (holes left open), one cell value per
-// triangle, and the shapes' rings as closed polylines. With `cache`, shapes
-// found in it are not triangulated again, and it is left holding this panel's shapes.
+// triangle, and the rings of shapes at least `minOutlined` across
+// (outlineSize) as closed polylines. With `cache`, shapes found in it are not
+// triangulated again, and it is left holding this panel's shapes.
 void buildPanel(const MapPanel& panel, PanelGeometry& g, std::vector<vtkIdType>* trianglesPerShape = nullptr,
-                TriangleCache* cache = nullptr) {
+                TriangleCache* cache = nullptr, double minOutlined = 0) {
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   vtkNew<vtkCellArray> lines, triangles;
@@ -284,9 +285,11 @@ void buildPanel(const MapPanel& panel, PanelGeometry& g, std::vector<vtkIdType>*
   for (std::size_t k = 0; k < panel.shapes.size(); ++k) {
     const Polygon& shape = *panel.shapes[k];
     const vtkIdType offset = points->GetNumberOfPoints();
+    const bool outlined = minOutlined <= 0 || outlineSize(shape) >= minOutlined;
     auto addRing = [&](const Ring& ring) {
       const vtkIdType first = points->GetNumberOfPoints();
       for (const Point& p : ring) points->InsertNextPoint(p.x, p.y, 0.0);
+      if (!outlined) return;
       lines->InsertNextCell(static_cast<int>(ring.size() + 1));
       for (std::size_t v = 0; v < ring.size(); ++v) lines->InsertCellPoint(first + static_cast<vtkIdType>(v));
       lines->InsertCellPoint(first);
@@ -390,6 +393,11 @@ void addScaleBar(vtkRenderer* r, double left, double bottom, double visibleWidth
 
 std::string vtkVersionString() { return std::string("VTK ") + vtkVersion::GetVTKVersion(); }
 
+double outlineSize(const Polygon& shape) {
+  const double p = perimeter(shape);
+  return p > 0 ? 4 * area(shape) / p : 0.0;
+}
+
 void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, const ColourScale& scale,
                 const FigureOutput& out) {
   checkOutput(out);
@@ -429,9 +437,10 @@ void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, c
   window->AddRenderer(titles);
 
   std::vector<PanelGeometry> geometry(panels.size());
+  const double metresPerPixel = 2 * halfHeight / (out.height * (titleBottom - barTop));
   for (int i = 0; i < n; ++i) {
     addText(titles, panels[i].title, (i + 0.5) / n, 0.18, fontSize(out, 0.026), false, VTK_TEXT_CENTERED);
-    buildPanel(panels[i], geometry[i]);
+    buildPanel(panels[i], geometry[i], nullptr, nullptr, kMinOutlinedPixels * metresPerPixel);
     vtkNew<vtkRenderer> r;
     r->SetViewport(static_cast<double>(i) / n, barTop, static_cast<double>(i + 1) / n, titleBottom);
     r->SetBackground(1, 1, 1);
@@ -597,6 +606,40 @@ struct MapLayer::Impl {
   vtkNew<vtkScalarBarActor> bar;
   std::vector<vtkIdType> trianglesPerShape;
   TriangleCache triangles;
+  // Every shape's rings (cells ringStart[k] to ringStart[k + 1]), its size
+  // across, and the sizes sorted: the outlined shapes are those at least
+  // kMinOutlinedPixels * metresPerPixel across.
+  vtkSmartPointer<vtkCellArray> allRings = vtkSmartPointer<vtkCellArray>::New();
+  std::vector<vtkIdType> ringStart{0};
+  std::vector<double> size, sortedSize;
+  double metresPerPixel = 0;
+  std::size_t outlined = 0;
+
+  std::size_t outlinedAt(double mpp) const {
+    const double least = kMinOutlinedPixels * mpp;
+    return static_cast<std::size_t>(sortedSize.end() - std::lower_bound(sortedSize.begin(), sortedSize.end(), least));
+  }
+  // Keeps only the outlined shapes' rings in the drawn outlines.
+  void selectOutlines(bool force) {
+    const std::size_t count = outlinedAt(metresPerPixel);
+    if (count == outlined && !force) return;
+    outlined = count;
+    if (count == size.size()) {
+      geometry.rings->SetLines(allRings);
+      return;
+    }
+    const double least = kMinOutlinedPixels * metresPerPixel;
+    vtkNew<vtkCellArray> some;
+    vtkNew<vtkIdList> cell;
+    for (std::size_t k = 0; k < size.size(); ++k) {
+      if (size[k] < least) continue;
+      for (vtkIdType c = ringStart[k]; c < ringStart[k + 1]; ++c) {
+        allRings->GetCellAtId(c, cell);
+        some->InsertNextCell(cell);
+      }
+    }
+    geometry.rings->SetLines(some);
+  }
 };
 
 MapLayer::MapLayer() : impl_(std::make_unique<Impl>()) {
@@ -639,7 +682,25 @@ void MapLayer::setShapes(const std::vector<const Polygon*>& shapes, const std::v
   buildPanel(panel, fresh, &impl_->trianglesPerShape, &impl_->triangles);
   impl_->geometry.fill->ShallowCopy(fresh.fill);
   impl_->geometry.rings->ShallowCopy(fresh.rings);
+  Impl& m = *impl_;
+  m.allRings = fresh.rings->GetLines();
+  m.ringStart.assign(1, 0);
+  m.size.clear();
+  for (const Polygon* shape : shapes) {
+    m.ringStart.push_back(m.ringStart.back() + 1 + static_cast<vtkIdType>(shape->holes.size()));
+    m.size.push_back(outlineSize(*shape));
+  }
+  m.sortedSize = m.size;
+  std::sort(m.sortedSize.begin(), m.sortedSize.end());
+  m.selectOutlines(true);
 }
+
+void MapLayer::setMetresPerPixel(double metresPerPixel) {
+  impl_->metresPerPixel = metresPerPixel;
+  impl_->selectOutlines(false);
+}
+
+std::size_t MapLayer::outlinedShapes() const { return impl_->outlined; }
 
 void MapLayer::setValues(const std::vector<double>& values) {
   if (values.size() != impl_->trianglesPerShape.size()) {

@@ -49,6 +49,15 @@ struct MapPanel {
   std::vector<double> values;          ///< one per shape
 };
 
+/// Outlines are drawn only around shapes at least this many pixels across
+/// (outlineSize): smaller ones would be covered by their own outline, and a
+/// city drawn whole would turn grey. Maps and views both follow it.
+inline constexpr double kMinOutlinedPixels = 6.0;
+
+/// A shape's size across for the rule above, in its units: 4 area / perimeter
+/// (the side of a square; about twice the width of a long strip).
+double outlineSize(const Polygon& shape);
+
 /// Renders `panels` side by side with the same extent (the union of every
 /// panel's shapes) and the same scale, each with its title and a scale bar in
 /// metres, one shared colour bar below and `title` above. Throws Error(Usage)

@@ -32,6 +32,11 @@ public:
   void addTo(vtkRenderer* renderer);
   /// Shows or hides the grey outlines (on by default).
   void setOutlinesVisible(bool visible);
+  /// The scale drawn at (metres per pixel): only shapes at least
+  /// kMinOutlinedPixels across get an outline. 0 (the default): every shape.
+  void setMetresPerPixel(double metresPerPixel);
+  /// How many shapes have an outline at the current scale.
+  std::size_t outlinedShapes() const;
   /// The scale's colour bar (horizontal), for the caller to place.
   vtkScalarBarActor* colourBar();
 
