@@ -153,30 +153,31 @@ int main(int argc, char** argv) {
                 w.observedView()->layer().outlinedShapes(), w.result()->observedLots.size(),
                 w.proceduralView()->layer().outlinedShapes(), w.result()->generated.parcels.size());
   };
-  for (const auto& [style, outlines] : {std::pair{"obb", true}, {"skeleton", true}, {"obb", false}}) {
-    w.setStyle(style);
-    w.setOutlinesVisible(outlines);
-    settle(w);
-    std::printf("style %s, parcel outlines %s\n", style, outlines ? "on" : "off");
-    if (outlines) outlined();
-    // A block picked by the user: its own A_max, alternating.
+  // A block picked by the user: its own A_max, alternating; then the colouring.
+  const auto localChanges = [&] {
     w.selectBlock(100);
     measure("  block override (1 block regenerated)", repeats, [&](int i) {
       w.overrideSelectedBlock({}, {{"a-max", i % 2 ? 400.0 : 600.0}, {"a-min", 100.0}});
     });
     w.clearSelectedOverride();
     settle(w);
-    measure("  colour by another quantity (no regeneration)", repeats, [&](int i) {
-      w.setColourBy(i % 2 ? "area" : "aspect_ratio");
-    });
+    measure("  colour by another quantity (no regeneration)", repeats,
+            [&](int i) { w.setColourBy(i % 2 ? "area" : "aspect_ratio"); });
+  };
+  for (const auto& [style, outlines] : {std::pair{"obb", true}, {"skeleton", true}, {"obb", false}}) {
+    w.setStyle(style);
+    w.setOutlinesVisible(outlines);
+    settle(w);
+    std::printf("style %s, parcel outlines %s\n", style, outlines ? "on" : "off");
+    if (outlines) outlined();
+    localChanges();
     measure("  omega slider (every block regenerated)", std::max(3, repeats / 3), [&](int i) {
       w.setParameter("omega", 0.2 + 0.05 * (i % 4));
     });
     measure("  skeleton-only street-angle slider (obb: none regenerated)", std::max(3, repeats / 3),
             [&](int i) { w.setParameter("street-angle", 20.0 + i); });
-
   }
-  // Zoomed in 4x on the middle, where outlines are drawn around most parcels.
+  // Zoomed in 4x on the middle, where parcels of 12 m and more get outlines.
   w.setStyle("obb");
   w.setOutlinesVisible(true);
   settle(w);
@@ -185,15 +186,7 @@ int main(int argc, char** argv) {
   w.proceduralView()->render();
   std::printf("style obb, parcel outlines on, zoomed in 4x\n");
   outlined();
-  w.selectBlock(100);
-  measure("  block override (1 block regenerated)", repeats, [&](int i) {
-    w.overrideSelectedBlock({}, {{"a-max", i % 2 ? 400.0 : 600.0}, {"a-min", 100.0}});
-  });
-  w.clearSelectedOverride();
-  settle(w);
-  measure("  colour by another quantity (no regeneration)", repeats, [&](int i) {
-    w.setColourBy(i % 2 ? "area" : "aspect_ratio");
-  });
+  localChanges();
   w.observedView()->camera()->Zoom(0.25);
 
   // Last, as it sets the bounds for every block (the first move of a bound
