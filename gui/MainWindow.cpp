@@ -621,21 +621,28 @@ void MainWindow::drawReport(const UpdateReport& report) {
   if (first) {
     std::vector<const Polygon*> shapes;
     std::vector<double> values;
+    std::vector<int> blocks;
     for (std::size_t i = 0; i < r.observed->layer.parcels.size(); ++i) {
       if (a.blockOf[i] < 0) continue;
       shapes.push_back(&r.observed->layer.parcels[i].shape);
       values.push_back(q.value(a.metrics[i]));
+      blocks.push_back(a.blockOf[i]);
     }
-    observedView_->layer().setShapes(shapes, values);
+    observedView_->layer().setShapes(shapes, values, blocks);
   }
   {
+    // Grouped by block, so that only the layer parts holding changed blocks are built again.
     std::vector<const Polygon*> shapes;
     std::vector<double> values;
+    std::vector<int> blocks(r.generated.parcels.size(), -1);
+    for (std::size_t b = 0; b < r.generated.blocks.size(); ++b) {
+      for (int p : r.generated.blocks[b].parcels) blocks[static_cast<std::size_t>(p)] = static_cast<int>(b);
+    }
     for (std::size_t i = 0; i < r.generated.parcels.size(); ++i) {
       shapes.push_back(&r.generated.parcels[i]);
       values.push_back(q.value(r.generated.metrics[i]));
     }
-    proceduralView_->layer().setShapes(shapes, values);
+    proceduralView_->layer().setShapes(shapes, values, blocks);
   }
   const bool observedChanged = recolour(first || selectionChanged_);
   selectionChanged_ = false;

@@ -13,6 +13,16 @@
 #include "parcelscope/viz/Scenes.h"
 #include "viz/ImageCheck.h"
 
+#include <vtkDataArray.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkWindowToImageFilter.h>
+
+#include <cmath>
+
 namespace parcelscope::viz {
 namespace {
 
@@ -182,6 +192,79 @@ TEST(MapLayer, OutlinesFollowTheScaleDrawn) {
   EXPECT_EQ(layer.outlinedShapes(), 0u);
   layer.setMetresPerPixel(0.5);
   EXPECT_EQ(layer.outlinedShapes(), 1u);
+}
+
+// The layer drawn off screen, as RGB bytes.
+std::vector<unsigned char> draw(MapLayer& layer, const Box& extent) {
+  vtkNew<vtkRenderWindow> window;
+  window->SetOffScreenRendering(1);
+  window->SetSize(240, 240);
+  vtkNew<vtkRenderer> renderer;
+  renderer->SetBackground(1, 1, 1);
+  window->AddRenderer(renderer);
+  layer.addTo(renderer);
+  fitCamera(renderer, extent, 1.0);
+  window->Render();
+  vtkNew<vtkWindowToImageFilter> grab;
+  grab->SetInput(window);
+  grab->SetInputBufferTypeToRGB();
+  grab->Update();
+  vtkDataArray* pixels = grab->GetOutput()->GetPointData()->GetScalars();
+  std::vector<unsigned char> out(static_cast<std::size_t>(pixels->GetNumberOfValues()));
+  for (vtkIdType i = 0; i < pixels->GetNumberOfValues(); ++i) out[static_cast<std::size_t>(i)] = static_cast<unsigned char>(pixels->GetVariantValue(i).ToInt());
+  return out;
+}
+
+// Blocks of parcels in a row, each block cut into `cuts[b]` strips.
+struct Row {
+  std::vector<Polygon> parcels;
+  std::vector<const Polygon*> shapes;
+  std::vector<double> values;
+  std::vector<int> blocks;
+  Row(const std::vector<int>& cuts, double shift) {
+    for (std::size_t b = 0; b < cuts.size(); ++b) {
+      for (int c = 0; c < cuts[b]; ++c) {
+        const double x = 30.0 * static_cast<double>(b), w = 25.0 / cuts[b];
+        parcels.push_back(rect(x + c * w, 0, x + (c + 1) * w, 60));
+        values.push_back(1 + std::fmod(shift + static_cast<double>(parcels.size()) * 0.37, 4.0));
+        blocks.push_back(static_cast<int>(b));
+      }
+    }
+    for (const Polygon& p : parcels) shapes.push_back(&p);
+  }
+};
+
+// Only the parts holding a changed block are built again, and a layer updated
+// so draws exactly what a layer given the final shapes at once draws.
+TEST(MapLayer, RebuildsOnlyChangedPartsAndDrawsWhatAFreshLayerDraws) {
+  std::vector<int> cuts(40, 3);
+  const Row first(cuts, 0);
+  cuts[7] = 5;
+  const Row second(cuts, 0), recoloured(cuts, 1.5);
+  ColourScale scale;
+  scale.minimum = 1;
+  scale.maximum = 5;
+  scale.title = "value";
+  MapLayer updated;
+  updated.setScale(scale);
+  updated.setShapes(first.shapes, first.values, first.blocks);
+  EXPECT_EQ(updated.partsRebuilt(), 16u);
+  updated.setShapes(second.shapes, second.values, second.blocks);  // block 7 cut again
+  EXPECT_EQ(updated.partsRebuilt(), 1u);
+  updated.setShapes(recoloured.shapes, recoloured.values, recoloured.blocks);  // new values only
+  EXPECT_EQ(updated.partsRebuilt(), 0u);
+  MapLayer fresh;
+  fresh.setScale(scale);
+  fresh.setShapes(recoloured.shapes, recoloured.values, recoloured.blocks);
+  const Box extent{0, 0, 1200, 60};
+  const auto a = draw(updated, extent), b = draw(fresh, extent);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_TRUE(a == b) << "an updated layer draws other pixels than a fresh one";
+  // And not what the first shapes drew.
+  MapLayer old;
+  old.setScale(scale);
+  old.setShapes(first.shapes, first.values, first.blocks);
+  EXPECT_FALSE(draw(old, extent) == a);
 }
 
 TEST(RenderMaps, RefusesMismatchedValuesAndEmptyMaps) {

@@ -37,6 +37,7 @@
 #include <vtkWindowToImageFilter.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstring>
 #include <unordered_map>
@@ -598,29 +599,35 @@ void renderHistogram(const std::string& title, const std::string& xTitle, const 
 
 // Interactive pieces (Scenes.h).
 
-struct MapLayer::Impl {
+// The layer is drawn in kLayerParts parts, each with its own VTK data, so that
+// a change to a few shapes (one block regenerated) rebuilds, and sends to
+// OpenGL again, only the parts holding them.
+constexpr std::size_t kLayerParts = 16;
+
+struct LayerPart {
   PanelGeometry geometry;
   vtkNew<vtkPolyDataMapper> fillMapper, ringMapper;
   vtkNew<vtkActor> fill, rings;
-  vtkSmartPointer<vtkLookupTable> lut = lookupTable(ColourScale{});
-  vtkNew<vtkScalarBarActor> bar;
+  std::vector<std::size_t> members;  // the layer's shapes drawn here, in order
+  std::uint64_t hash = 0;            // of those shapes
+  std::vector<double> values;
   std::vector<vtkIdType> trianglesPerShape;
   TriangleCache triangles;
-  // Every shape's rings (cells ringStart[k] to ringStart[k + 1]), its size
-  // across, and the sizes sorted: the outlined shapes are those at least
+  // Every member's rings (cells ringStart[k] to ringStart[k + 1]), its size
+  // across, and the sizes sorted: the outlined members are those at least
   // kMinOutlinedPixels * metresPerPixel across.
   vtkSmartPointer<vtkCellArray> allRings = vtkSmartPointer<vtkCellArray>::New();
   std::vector<vtkIdType> ringStart{0};
   std::vector<double> size, sortedSize;
-  double metresPerPixel = 0;
   std::size_t outlined = 0;
 
-  std::size_t outlinedAt(double mpp) const {
-    const double least = kMinOutlinedPixels * mpp;
+  std::size_t outlinedAt(double metresPerPixel) const {
+    const double least = kMinOutlinedPixels * metresPerPixel;
     return static_cast<std::size_t>(sortedSize.end() - std::lower_bound(sortedSize.begin(), sortedSize.end(), least));
   }
-  // Keeps only the outlined shapes' rings in the drawn outlines.
-  void selectOutlines(bool force) {
+
+  // Keeps only the outlined members' rings in the drawn outlines.
+  void selectOutlines(double metresPerPixel, bool force) {
     const std::size_t count = outlinedAt(metresPerPixel);
     if (count == outlined && !force) return;
     outlined = count;
@@ -640,23 +647,72 @@ struct MapLayer::Impl {
     }
     geometry.rings->SetLines(some);
   }
+
+  void rebuild(const std::vector<const Polygon*>& shapes, double metresPerPixel) {
+    MapPanel panel;
+    for (std::size_t k : members) panel.shapes.push_back(shapes[k]);
+    panel.values = values;
+    PanelGeometry fresh;
+    trianglesPerShape.clear();
+    buildPanel(panel, fresh, &trianglesPerShape, &triangles);
+    geometry.fill->ShallowCopy(fresh.fill);
+    geometry.rings->ShallowCopy(fresh.rings);
+    allRings = fresh.rings->GetLines();
+    ringStart.assign(1, 0);
+    size.clear();
+    for (const Polygon* shape : panel.shapes) {
+      ringStart.push_back(ringStart.back() + 1 + static_cast<vtkIdType>(shape->holes.size()));
+      size.push_back(outlineSize(*shape));
+    }
+    sortedSize = size;
+    std::sort(sortedSize.begin(), sortedSize.end());
+    selectOutlines(metresPerPixel, true);
+  }
+
+  // New cell values from `values` (this part's), when they differ.
+  void recolour(std::vector<double> fresh) {
+    if (fresh == values) return;
+    values = std::move(fresh);
+    vtkNew<vtkDoubleArray> scalars;
+    scalars->SetName("value");
+    vtkIdType total = 0;
+    for (vtkIdType n : trianglesPerShape) total += n;
+    scalars->SetNumberOfValues(total);
+    vtkIdType next = 0;
+    for (std::size_t k = 0; k < values.size(); ++k) {
+      for (vtkIdType t = 0; t < trianglesPerShape[k]; ++t) scalars->SetValue(next++, values[k]);
+    }
+    geometry.fill->GetCellData()->SetScalars(scalars);
+    geometry.fill->Modified();
+  }
+};
+
+struct MapLayer::Impl {
+  std::array<LayerPart, kLayerParts> parts;
+  std::size_t shapes = 0;
+  vtkSmartPointer<vtkLookupTable> lut = lookupTable(ColourScale{});
+  vtkNew<vtkScalarBarActor> bar;
+  double metresPerPixel = 0;
+  std::size_t rebuilt = 0;
 };
 
 MapLayer::MapLayer() : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
-  m.fillMapper->SetInputData(m.geometry.fill);
-  m.fillMapper->SetScalarModeToUseCellData();
-  m.fillMapper->UseLookupTableScalarRangeOn();
-  m.fillMapper->ScalarVisibilityOn();
-  m.fillMapper->SetLookupTable(m.lut);
-  m.fill->SetMapper(m.fillMapper);
-  m.fill->GetProperty()->LightingOff();
-  m.ringMapper->SetInputData(m.geometry.rings);
-  m.ringMapper->ScalarVisibilityOff();
-  m.rings->SetMapper(m.ringMapper);
-  m.rings->SetPosition(0, 0, 1);
-  m.rings->GetProperty()->SetColor(0.45, 0.45, 0.45);
-  m.rings->GetProperty()->LightingOff();
+  for (LayerPart& p : m.parts) {
+    p.fillMapper->SetInputData(p.geometry.fill);
+    p.fillMapper->SetScalarModeToUseCellData();
+    p.fillMapper->UseLookupTableScalarRangeOn();
+    p.fillMapper->ScalarVisibilityOn();
+    p.fillMapper->SetLookupTable(m.lut);
+    p.fill->SetMapper(p.fillMapper);
+    p.fill->GetProperty()->LightingOff();
+    p.ringMapper->SetInputData(p.geometry.rings);
+    p.ringMapper->ScalarVisibilityOff();
+    p.rings->SetMapper(p.ringMapper);
+    p.rings->SetPosition(0, 0, 1);
+    p.rings->GetProperty()->SetColor(0.45, 0.45, 0.45);
+    p.rings->GetProperty()->LightingOff();
+  }
   m.bar->SetLookupTable(m.lut);
   m.bar->SetOrientationToHorizontal();
   m.bar->SetNumberOfLabels(5);
@@ -669,55 +725,66 @@ MapLayer::MapLayer() : impl_(std::make_unique<Impl>()) {
 
 MapLayer::~MapLayer() = default;
 
-void MapLayer::setShapes(const std::vector<const Polygon*>& shapes, const std::vector<double>& values) {
-  if (shapes.size() != values.size()) {
+void MapLayer::setShapes(const std::vector<const Polygon*>& shapes, const std::vector<double>& values,
+                         const std::vector<int>& groups) {
+  if (shapes.size() != values.size() || (!groups.empty() && groups.size() != shapes.size())) {
     throw usageError("map layer: " + std::to_string(shapes.size()) + " shapes but " + std::to_string(values.size()) +
-                     " values");
+                     " values and " + std::to_string(groups.size()) + " groups");
   }
-  MapPanel panel;
-  panel.shapes = shapes;
-  panel.values = values;
-  PanelGeometry fresh;
-  impl_->trianglesPerShape.clear();
-  buildPanel(panel, fresh, &impl_->trianglesPerShape, &impl_->triangles);
-  impl_->geometry.fill->ShallowCopy(fresh.fill);
-  impl_->geometry.rings->ShallowCopy(fresh.rings);
   Impl& m = *impl_;
-  m.allRings = fresh.rings->GetLines();
-  m.ringStart.assign(1, 0);
-  m.size.clear();
-  for (const Polygon* shape : shapes) {
-    m.ringStart.push_back(m.ringStart.back() + 1 + static_cast<vtkIdType>(shape->holes.size()));
-    m.size.push_back(outlineSize(*shape));
+  m.rebuilt = 0;
+  std::array<std::vector<std::size_t>, kLayerParts> members;
+  for (std::size_t k = 0; k < shapes.size(); ++k) {
+    // Without groups, runs of consecutive shapes.
+    const std::size_t part = groups.empty() ? k * kLayerParts / shapes.size()
+                                            : static_cast<std::size_t>(groups[k] < 0 ? -groups[k] : groups[k]) % kLayerParts;
+    members[part].push_back(k);
   }
-  m.sortedSize = m.size;
-  std::sort(m.sortedSize.begin(), m.sortedSize.end());
-  m.selectOutlines(true);
+  for (std::size_t i = 0; i < kLayerParts; ++i) {
+    LayerPart& p = m.parts[i];
+    std::uint64_t hash = members[i].size();
+    for (std::size_t k : members[i]) hash = hash * 0x100000001b3ull ^ shapeHash(*shapes[k]);
+    std::vector<double> partValues;
+    partValues.reserve(members[i].size());
+    for (std::size_t k : members[i]) partValues.push_back(values[k]);
+    if (hash == p.hash && members[i].size() == p.members.size()) {
+      p.members = std::move(members[i]);
+      p.recolour(std::move(partValues));
+      continue;
+    }
+    p.members = std::move(members[i]);
+    p.hash = hash;
+    p.values = std::move(partValues);
+    p.rebuild(shapes, m.metresPerPixel);
+    ++m.rebuilt;
+  }
+  m.shapes = shapes.size();
 }
 
 void MapLayer::setMetresPerPixel(double metresPerPixel) {
   impl_->metresPerPixel = metresPerPixel;
-  impl_->selectOutlines(false);
+  for (LayerPart& p : impl_->parts) p.selectOutlines(metresPerPixel, false);
 }
 
-std::size_t MapLayer::outlinedShapes() const { return impl_->outlined; }
+std::size_t MapLayer::partsRebuilt() const { return impl_->rebuilt; }
+
+std::size_t MapLayer::outlinedShapes() const {
+  std::size_t n = 0;
+  for (const LayerPart& p : impl_->parts) n += p.outlined;
+  return n;
+}
 
 void MapLayer::setValues(const std::vector<double>& values) {
-  if (values.size() != impl_->trianglesPerShape.size()) {
-    throw usageError("map layer: " + std::to_string(impl_->trianglesPerShape.size()) + " shapes but " +
-                     std::to_string(values.size()) + " values");
+  if (values.size() != impl_->shapes) {
+    throw usageError("map layer: " + std::to_string(impl_->shapes) + " shapes but " + std::to_string(values.size()) +
+                     " values");
   }
-  vtkNew<vtkDoubleArray> scalars;
-  scalars->SetName("value");
-  vtkIdType total = 0;
-  for (vtkIdType n : impl_->trianglesPerShape) total += n;
-  scalars->SetNumberOfValues(total);
-  vtkIdType next = 0;
-  for (std::size_t k = 0; k < values.size(); ++k) {
-    for (vtkIdType t = 0; t < impl_->trianglesPerShape[k]; ++t) scalars->SetValue(next++, values[k]);
+  for (LayerPart& p : impl_->parts) {
+    std::vector<double> partValues;
+    partValues.reserve(p.members.size());
+    for (std::size_t k : p.members) partValues.push_back(values[k]);
+    p.recolour(std::move(partValues));
   }
-  impl_->geometry.fill->GetCellData()->SetScalars(scalars);
-  impl_->geometry.fill->Modified();
 }
 
 void MapLayer::setScale(const ColourScale& scale) {
@@ -725,17 +792,21 @@ void MapLayer::setScale(const ColourScale& scale) {
   impl_->lut->DeepCopy(lut);
   impl_->lut->Modified();
   impl_->bar->SetTitle(scale.title.c_str());
-  impl_->fillMapper->Modified();
+  for (LayerPart& p : impl_->parts) p.fillMapper->Modified();
 }
 
 void MapLayer::addTo(vtkRenderer* renderer) {
-  renderer->AddActor(impl_->fill);
-  renderer->AddActor(impl_->rings);
+  for (LayerPart& p : impl_->parts) {
+    renderer->AddActor(p.fill);
+    renderer->AddActor(p.rings);
+  }
 }
 
 vtkScalarBarActor* MapLayer::colourBar() { return impl_->bar; }
 
-void MapLayer::setOutlinesVisible(bool visible) { impl_->rings->SetVisibility(visible); }
+void MapLayer::setOutlinesVisible(bool visible) {
+  for (LayerPart& p : impl_->parts) p.rings->SetVisibility(visible);
+}
 
 struct OutlineLayer::Impl {
   vtkNew<vtkPolyData> rings;

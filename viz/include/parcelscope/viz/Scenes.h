@@ -23,8 +23,12 @@ public:
   MapLayer(const MapLayer&) = delete;
   MapLayer& operator=(const MapLayer&) = delete;
   /// Replaces the shapes (local metres; holes left open) and their values.
-  /// Throws Error(Usage) when the counts differ.
-  void setShapes(const std::vector<const Polygon*>& shapes, const std::vector<double>& values);
+  /// `groups` (one per shape, or empty) keeps each group's shapes together in
+  /// one of the layer's parts: only the parts whose shapes changed are built
+  /// again, so give the block of each parcel. Throws Error(Usage) when the
+  /// counts differ.
+  void setShapes(const std::vector<const Polygon*>& shapes, const std::vector<double>& values,
+                 const std::vector<int>& groups = {});
   /// Replaces only the values (same shapes as the last setShapes), without
   /// triangulating again.
   void setValues(const std::vector<double>& values);
@@ -37,6 +41,8 @@ public:
   void setMetresPerPixel(double metresPerPixel);
   /// How many shapes have an outline at the current scale.
   std::size_t outlinedShapes() const;
+  /// How many of the layer's parts the last setShapes built again.
+  std::size_t partsRebuilt() const;
   /// The scale's colour bar (horizontal), for the caller to place.
   vtkScalarBarActor* colourBar();
 
