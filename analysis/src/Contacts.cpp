@@ -70,14 +70,12 @@ void sumCovers(std::vector<Cover>& covers, const std::vector<EdgeInfo>& edges, S
 }
 }  // namespace
 
-bool coveredInterval(const Point& p, const Point& q, const Point& r, const Point& s, double tolerance,
-                     double& lo, double& hi) {
+namespace {
+
+// coveredInterval, given both edges' lengths (not 0) and unit directions.
+inline bool coveredAlong(const Point& p, double len, double ux, double uy, const Point& r, const Point& s, double vx,
+                         double vy, double tolerance, double& lo, double& hi) {
   static const double sinMax = std::sin(10.0 * kPi / 180.0);
-  const double len = norm(q.x - p.x, q.y - p.y);
-  const double l2 = norm(s.x - r.x, s.y - r.y);
-  if (len == 0 || l2 == 0) return false;
-  const double ux = (q.x - p.x) / len, uy = (q.y - p.y) / len;
-  const double vx = (s.x - r.x) / l2, vy = (s.y - r.y) / l2;
   if (std::fabs(ux * vy - uy * vx) > sinMax) return false;  // not parallel
   // Offsets of r and s from the line of [p, q] and their positions along it.
   const double dr = (r.x - p.x) * -uy + (r.y - p.y) * ux;
@@ -99,6 +97,17 @@ bool coveredInterval(const Point& p, const Point& q, const Point& r, const Point
   lo = std::max(0.0, a);
   hi = std::min(len, b);
   return hi > lo;
+}
+
+}  // namespace
+
+bool coveredInterval(const Point& p, const Point& q, const Point& r, const Point& s, double tolerance,
+                     double& lo, double& hi) {
+  const double len = norm(q.x - p.x, q.y - p.y);
+  const double l2 = norm(s.x - r.x, s.y - r.y);
+  if (len == 0 || l2 == 0) return false;
+  return coveredAlong(p, len, (q.x - p.x) / len, (q.y - p.y) / len, r, s, (s.x - r.x) / l2, (s.y - r.y) / l2,
+                      tolerance, lo, hi);
 }
 
 double unionLength(std::vector<std::pair<double, double>>& intervals) {
@@ -123,7 +132,15 @@ struct NearEdge {
   const Point* p;
   const Point* q;
   double lo[2], hi[2];
+  double len, ux, uy;  // length and unit direction, computed once per edge
 };
+
+// coveredInterval(*e.p, *e.q, *f.p, *f.q, ...) with the lengths and directions
+// computed when the edges were gathered: the same values, without the square roots.
+bool coveredInterval(const NearEdge& e, const NearEdge& f, double tolerance, double& lo, double& hi) {
+  if (e.len == 0 || f.len == 0) return false;
+  return coveredAlong(*e.p, e.len, e.ux, e.uy, *f.p, *f.q, f.ux, f.uy, tolerance, lo, hi);
+}
 
 }  // namespace
 
@@ -146,11 +163,19 @@ void edgesNear(const Polygon& polygon, double grow, const Box& box, std::vector<
     for (std::size_t i = 0, n = r.size(); i < n; ++i) {
       const Point& p = r[i];
       const Point& q = r[(i + 1) % n];
-      const NearEdge e{&p,
-                       &q,
-                       {std::min(p.x, q.x) - grow, std::min(p.y, q.y) - grow},
-                       {std::max(p.x, q.x) + grow, std::max(p.y, q.y) + grow}};
+      NearEdge e{&p,
+                 &q,
+                 {std::min(p.x, q.x) - grow, std::min(p.y, q.y) - grow},
+                 {std::max(p.x, q.x) + grow, std::max(p.y, q.y) + grow},
+                 0,
+                 0,
+                 0};
       if (e.lo[0] <= box.maxX && box.minX <= e.hi[0] && e.lo[1] <= box.maxY && box.minY <= e.hi[1]) {
+        e.len = norm(q.x - p.x, q.y - p.y);
+        if (e.len != 0) {
+          e.ux = (q.x - p.x) / e.len;
+          e.uy = (q.y - p.y) / e.len;
+        }
         out.push_back(e);
       }
     }
@@ -187,8 +212,8 @@ PairMeasure measureEdges(const std::vector<NearEdge>& ea, const std::vector<Near
         m.close = true;
       }
       double lo = 0, hi = 0;
-      if (coveredInterval(*e.p, *e.q, *f.p, *f.q, sharedTolerance, lo, hi)) intervals.emplace_back(lo, hi);
-      if (coveredInterval(*f.p, *f.q, *e.p, *e.q, sharedTolerance, lo, hi)) coversB.push_back({j, 0, lo, hi});
+      if (coveredInterval(e, f, sharedTolerance, lo, hi)) intervals.emplace_back(lo, hi);
+      if (coveredInterval(f, e, sharedTolerance, lo, hi)) coversB.push_back({j, 0, lo, hi});
     }
     if (!intervals.empty()) m.sharedA += unionLength(intervals);
   }
