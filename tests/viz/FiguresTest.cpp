@@ -18,6 +18,8 @@
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkRenderWindow.h>
+#include <vtkRendererCollection.h>
+#include <vtkSmartPointer.h>
 #include <vtkRenderer.h>
 #include <vtkWindowToImageFilter.h>
 
@@ -194,11 +196,20 @@ TEST(MapLayer, OutlinesFollowTheScaleDrawn) {
   EXPECT_EQ(layer.outlinedShapes(), 1u);
 }
 
-// The layer drawn off screen, as RGB bytes.
+// The layer drawn off screen, as RGB bytes. One window for every drawing (and
+// requireDisplay's connection kept open): Xvfb resets when its last client
+// leaves, and a connection opened during the reset fails.
 std::vector<unsigned char> draw(MapLayer& layer, const Box& extent) {
-  vtkNew<vtkRenderWindow> window;
-  window->SetOffScreenRendering(1);
-  window->SetSize(240, 240);
+  requireDisplay();
+  static vtkSmartPointer<vtkRenderWindow> window;
+  if (!window) {
+    window = vtkSmartPointer<vtkRenderWindow>::New();
+    window->SetOffScreenRendering(1);
+    window->SetSize(240, 240);
+  }
+  while (window->GetRenderers()->GetNumberOfItems() > 0) {
+    window->RemoveRenderer(window->GetRenderers()->GetFirstRenderer());
+  }
   vtkNew<vtkRenderer> renderer;
   renderer->SetBackground(1, 1, 1);
   window->AddRenderer(renderer);
