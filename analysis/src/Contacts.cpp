@@ -187,6 +187,7 @@ void edgesNear(const Polygon& polygon, double grow, const Box& box, std::vector<
 struct PairMeasure {
   bool close = false;
   double sharedA = 0, sharedB = 0;  // boundary of a along b, of b along a
+  bool enough = false;              // stopped early: both shared lengths reach `enough`
 };
 
 // One pair of polygons, edge pair by edge pair: edges whose boxes (grown by
@@ -197,7 +198,7 @@ struct PairMeasure {
 // only the shared lengths are measured (`close` stays false): an edge pair
 // with a covered interval is within the tolerance anyway.
 PairMeasure measureEdges(const std::vector<NearEdge>& ea, const std::vector<NearEdge>& eb, double closeTolerance,
-                         double sharedTolerance, bool closeness) {
+                         double sharedTolerance, bool closeness, double enough = HUGE_VAL) {
   thread_local std::vector<std::pair<double, double>> intervals;
   thread_local std::vector<Cover> coversB;
   coversB.clear();
@@ -211,9 +212,17 @@ PairMeasure measureEdges(const std::vector<NearEdge>& ea, const std::vector<Near
         if (segmentDistance(*e.p, *e.q, *f.p, *f.q) > closeTolerance) continue;
         m.close = true;
       }
-      double lo = 0, hi = 0;
-      if (coveredInterval(e, f, sharedTolerance, lo, hi)) intervals.emplace_back(lo, hi);
-      if (coveredInterval(f, e, sharedTolerance, lo, hi)) coversB.push_back({j, 0, lo, hi});
+      double lo = 0, hi = 0, loB = 0, hiB = 0;
+      const bool alongA = coveredInterval(e, f, sharedTolerance, lo, hi);
+      if (alongA) intervals.emplace_back(lo, hi);
+      const bool alongB = coveredInterval(f, e, sharedTolerance, loB, hiB);
+      if (alongB) coversB.push_back({j, 0, loB, hiB});
+      // One edge pair covering `enough` both ways: each shared length (a sum
+      // of unions holding these intervals) is at least that much.
+      if (alongA && alongB && hi - lo >= enough && hiB - loB >= enough) {
+        m.enough = true;
+        return m;
+      }
     }
     if (!intervals.empty()) m.sharedA += unionLength(intervals);
   }
@@ -335,7 +344,13 @@ PreparedBoundary::PreparedBoundary(const Polygon& reference, double tolerance) :
 
 PreparedBoundary::~PreparedBoundary() = default;
 
-double PreparedBoundary::sharedLength(const Polygon& piece) const {
+double PreparedBoundary::sharedLength(const Polygon& piece) const { return measure(piece, HUGE_VAL); }
+
+bool PreparedBoundary::sharesAtLeast(const Polygon& piece, double length) const {
+  return measure(piece, length) >= length;
+}
+
+double PreparedBoundary::measure(const Polygon& piece, double enough) const {
   thread_local std::vector<detail::NearEdge> ea, eb;
   const Impl& r = *impl_;
   if (!parcelscope::bounds(piece).expanded(r.tolerance).intersects(r.bounds)) return 0.0;  // as sharedBoundaryLength
@@ -346,8 +361,8 @@ double PreparedBoundary::sharedLength(const Polygon& piece) const {
   for (const detail::NearEdge& e : r.edges) {
     if (e.lo[0] <= box.maxX && box.minX <= e.hi[0] && e.lo[1] <= box.maxY && box.minY <= e.hi[1]) eb.push_back(e);
   }
-  const detail::PairMeasure m = detail::measureEdges(ea, eb, r.tolerance, r.tolerance, false);
-  return std::min(m.sharedA, m.sharedB);
+  const detail::PairMeasure m = detail::measureEdges(ea, eb, r.tolerance, r.tolerance, false, enough);
+  return m.enough ? enough : std::min(m.sharedA, m.sharedB);
 }
 
 }  // namespace parcelscope::analysis

@@ -106,7 +106,7 @@ private:
   };
 
   bool hasAccess(const Polygon& piece) const {
-    return outlineEdges_->sharedLength(piece) >= p_.minFrontage;
+    return outlineEdges_->sharesAtLeast(piece, p_.minFrontage);
   }
 
   void emit(const Polygon& piece, bool access, bool oversize) {

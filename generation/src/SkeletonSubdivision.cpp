@@ -796,7 +796,7 @@ private:
 
   // ---- 5. post-processing -----------------------------------------------------
   bool hasAccess(const Polygon& piece) const {
-    return outlineEdges_->sharedLength(piece) >= p_.bounds.minFrontage;
+    return outlineEdges_->sharesAtLeast(piece, p_.bounds.minFrontage);
   }
 
   bool rounded(const PWH& exactShape, Polygon& out) const {

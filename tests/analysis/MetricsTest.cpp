@@ -89,6 +89,9 @@ TEST(Metrics, PreparedBoundaryMeasuresAsSharedBoundaryLength) {
         const double expected = sharedBoundaryLength(lot, outline, tolerance);
         EXPECT_EQ(prepared.sharedLength(lot), expected);
         withFrontage += expected > 0;
+        for (double length : {0.0, 0.5, 1.0, 3.0, expected, std::nextafter(expected, HUGE_VAL), 1e9}) {
+          EXPECT_EQ(prepared.sharesAtLeast(lot, length), expected >= length) << "length " << length;
+        }
       }
     }
   }

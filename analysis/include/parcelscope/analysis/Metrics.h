@@ -66,8 +66,12 @@ public:
   PreparedBoundary(const PreparedBoundary&) = delete;
   PreparedBoundary& operator=(const PreparedBoundary&) = delete;
   double sharedLength(const Polygon& piece) const;
+  /// Whether `sharedLength(piece) >= length`, stopping at the first pair of
+  /// edges that settles it (a street-access test).
+  bool sharesAtLeast(const Polygon& piece, double length) const;
 
 private:
+  double measure(const Polygon& piece, double enough) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
