@@ -100,7 +100,7 @@ MapView::MapView(const QString& title, bool withColourBar, QWidget* parent) : QW
     const int* size = view->renderer_->GetSize();
     if (size[1] > 0) view->layer_.setMetresPerPixel(2 * view->renderer_->GetActiveCamera()->GetParallelScale() / size[1]);
   });
-  renderer_->AddObserver(vtkCommand::StartEvent, scale);
+  scaleObserver_ = renderer_->AddObserver(vtkCommand::StartEvent, scale);
   if (withColourBar) {
     vtkScalarBarActor* bar = layer_.colourBar();
     bar->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
@@ -133,6 +133,7 @@ MapView::MapView(const QString& title, bool withColourBar, QWidget* parent) : QW
 
 MapView::~MapView() {
   if (camera_ && observer_) camera_->RemoveObserver(observer_);
+  renderer_->RemoveObserver(scaleObserver_);
 }
 
 void MapView::setTitle(const QString& title) { title_->setText(title); }

@@ -51,6 +51,7 @@ private:
   viz::OutlineLayer outline_;
   bool renderPending_ = false;
   unsigned long observer_ = 0;
+  unsigned long scaleObserver_ = 0;
   vtkSmartPointer<vtkCamera> camera_;
 };
 

@@ -61,7 +61,7 @@ class ScreenWatch {
 public:
   explicit ScreenWatch(MainWindow& w) {
     clock_.start();
-    QObject::connect(&w, &MainWindow::viewsUpdated, [this] { drawnAt_ = clock_.nsecsElapsed(); });
+    QObject::connect(&w, &MainWindow::viewsUpdated, &context_, [this] { drawnAt_ = clock_.nsecsElapsed(); });
     const auto widgets = w.findChildren<QVTKOpenGLStereoWidget*>();
     views_.resize(static_cast<std::size_t>(widgets.size()));
     for (int i = 0; i < widgets.size(); ++i) {
@@ -73,13 +73,20 @@ public:
         auto* self = static_cast<View*>(view);
         self->renderedAt = self->clock->nsecsElapsed();
       });
-      widgets[i]->renderWindow()->AddObserver(vtkCommand::EndEvent, rendered);
-      QObject::connect(widgets[i]->embeddedOpenGLWindow(), &QOpenGLWindow::frameSwapped,
+      observers_.emplace_back(widgets[i]->renderWindow(),
+                              widgets[i]->renderWindow()->AddObserver(vtkCommand::EndEvent, rendered));
+      QObject::connect(widgets[i]->embeddedOpenGLWindow(), &QOpenGLWindow::frameSwapped, &context_,
                        [&v] { v.swappedAt = v.clock->nsecsElapsed(); });
     }
   }
+  ~ScreenWatch() {
+    for (const auto& [window, tag] : observers_) window->RemoveObserver(tag);
+  }
+  ScreenWatch(const ScreenWatch&) = delete;
+  ScreenWatch& operator=(const ScreenWatch&) = delete;
   /// Runs the event loop until every view rendered has been swapped onto the
-  /// screen; returns the milliseconds from the last viewsUpdated to then.
+  /// screen; returns the milliseconds from the last viewsUpdated to then, or
+  /// -1 when a view did not reach the screen within 5 s.
   double waitForScreen() {
     QElapsedTimer guard;
     guard.start();
@@ -88,6 +95,7 @@ public:
       return std::any_of(views_.begin(), views_.end(), [](const View& v) { return v.renderedAt > v.swappedAt; });
     };
     while (pending() && guard.elapsed() < 5000) QCoreApplication::processEvents(QEventLoop::WaitForMoreEvents);
+    if (pending()) return -1;
     QCoreApplication::processEvents();  // the other widgets' paint, if still queued
     return static_cast<double>(clock_.nsecsElapsed() - drawnAt_) / 1e6;
   }
@@ -98,6 +106,8 @@ private:
     qint64 renderedAt = -1;
     qint64 swappedAt = -1;
   };
+  QObject context_;  // the connections end with this watch
+  std::vector<std::pair<vtkRenderWindow*, unsigned long>> observers_;
   QElapsedTimer clock_;
   qint64 drawnAt_ = 0;
   std::vector<View> views_;
@@ -143,7 +153,12 @@ int main(int argc, char** argv) {
       // screen (Qt asks each OpenGL window to swap a few milliseconds later)
       // is added.
       const double toScreen = screen.waitForScreen();
+      if (toScreen < 0) {
+        std::printf("%s: a view was drawn but did not reach the screen within 5 s\n", name.c_str());
+        std::exit(1);
+      }
       row.ms.push_back(w.lastLatencyMs() + toScreen);
+      // (The time to screen of the final views stands in for that of the first.)
       row.firstMs.push_back(w.lastFirstViewMs() + toScreen);
     }
     print(row);

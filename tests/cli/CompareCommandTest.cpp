@@ -2,7 +2,7 @@
 // parses, generated parcels tile their blocks, the distances lie in their
 // ranges, the figures have the requested size and ink, one figure matches its
 // baseline image; no display, a bad style and Ctrl-C leave nothing behind.
-// Runs under xvfb-run (scripts/with-xvfb.sh).
+// Runs under scripts/with-xvfb.sh (its own Xvfb).
 #include <cpl_json.h>
 #include <gdal_priv.h>
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // Off-screen figures read back pixel by pixel: the requested size, ink where
 // the shapes are, the colour scale's ends, holes left open, panels drawn at the
 // same extent and scale, and charts with their text in the SVG copy.
-// Runs under xvfb-run (scripts/with-xvfb.sh).
+// Runs under scripts/with-xvfb.sh (its own Xvfb).
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -205,7 +205,7 @@ std::vector<unsigned char> draw(MapLayer& layer, const Box& extent) {
   if (!window) {
     window = vtkSmartPointer<vtkRenderWindow>::New();
     window->SetOffScreenRendering(1);
-    window->SetSize(240, 240);
+    window->SetSize(600, 200);
   }
   while (window->GetRenderers()->GetNumberOfItems() > 0) {
     window->RemoveRenderer(window->GetRenderers()->GetFirstRenderer());
@@ -214,7 +214,7 @@ std::vector<unsigned char> draw(MapLayer& layer, const Box& extent) {
   renderer->SetBackground(1, 1, 1);
   window->AddRenderer(renderer);
   layer.addTo(renderer);
-  fitCamera(renderer, extent, 1.0);
+  fitCamera(renderer, extent, 3.0);
   window->Render();
   vtkNew<vtkWindowToImageFilter> grab;
   grab->SetInput(window);
@@ -264,9 +264,15 @@ TEST(MapLayer, RebuildsOnlyChangedPartsAndDrawsWhatAFreshLayerDraws) {
   EXPECT_EQ(updated.partsRebuilt(), 1u);
   updated.setShapes(recoloured.shapes, recoloured.values, recoloured.blocks);  // new values only
   EXPECT_EQ(updated.partsRebuilt(), 0u);
+  // At 2 m per pixel, outlines around the 8.3 m strips (14.6 m across) but not
+  // around block 7's 5 m strips (9.2 m across).
+  updated.setMetresPerPixel(2.0);
+  EXPECT_EQ(updated.outlinedShapes(), 39u * 3u);
   MapLayer fresh;
   fresh.setScale(scale);
+  fresh.setMetresPerPixel(2.0);
   fresh.setShapes(recoloured.shapes, recoloured.values, recoloured.blocks);
+  EXPECT_EQ(fresh.outlinedShapes(), 39u * 3u);
   const Box extent{0, 0, 1200, 60};
   const auto a = draw(updated, extent), b = draw(fresh, extent);
   ASSERT_EQ(a.size(), b.size());
@@ -274,6 +280,7 @@ TEST(MapLayer, RebuildsOnlyChangedPartsAndDrawsWhatAFreshLayerDraws) {
   // And not what the first shapes drew.
   MapLayer old;
   old.setScale(scale);
+  old.setMetresPerPixel(2.0);
   old.setShapes(first.shapes, first.values, first.blocks);
   EXPECT_FALSE(draw(old, extent) == a);
 }

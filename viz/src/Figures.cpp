@@ -671,7 +671,11 @@ struct LayerPart {
 
   // New cell values from `values` (this part's), when they differ.
   void recolour(std::vector<double> fresh) {
-    if (fresh == values) return;
+    // Compared bit for bit, so that NaN (no value) counts as unchanged.
+    if (fresh.size() == values.size() &&
+        (fresh.empty() || std::memcmp(fresh.data(), values.data(), fresh.size() * sizeof(double)) == 0)) {
+      return;
+    }
     values = std::move(fresh);
     vtkNew<vtkDoubleArray> scalars;
     scalars->SetName("value");
@@ -737,7 +741,7 @@ void MapLayer::setShapes(const std::vector<const Polygon*>& shapes, const std::v
   for (std::size_t k = 0; k < shapes.size(); ++k) {
     // Without groups, runs of consecutive shapes.
     const std::size_t part = groups.empty() ? k * kLayerParts / shapes.size()
-                                            : static_cast<std::size_t>(groups[k] < 0 ? -groups[k] : groups[k]) % kLayerParts;
+                                            : static_cast<std::size_t>(static_cast<unsigned>(groups[k])) % kLayerParts;
     members[part].push_back(k);
   }
   for (std::size_t i = 0; i < kLayerParts; ++i) {
