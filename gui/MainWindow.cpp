@@ -366,10 +366,13 @@ void MainWindow::buildMenus() {
   file->addSeparator();
   file->addAction("&Quit", this, &QWidget::close, QKeySequence::Quit);
   QMenu* view = menuBar()->addMenu("&View");
+  view->setToolTipsVisible(true);
   QAction* outlines = view->addAction("Parcel &outlines");
   outlines->setCheckable(true);
   outlines->setChecked(true);
-  outlines->setToolTip("Outlines cost about half of every redraw with a software OpenGL");
+  outlines->setToolTip(QString("Grey outlines around parcels at least %1 pixels across at the current zoom "
+                               "(zoom in to see more of them)")
+                           .arg(viz::kMinOutlinedPixels));
   connect(outlines, &QAction::toggled, this, [this](bool on) { setOutlinesVisible(on); });
   QToolBar* bar = addToolBar("Main");
   bar->setObjectName("mainToolBar");
