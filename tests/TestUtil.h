@@ -3,6 +3,7 @@
 // folders, and the location of the shared datasets.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -21,6 +22,15 @@ inline Polygon rect(double x0, double y0, double x1, double y1) {
 
 inline Polygon poly(std::initializer_list<Point> outer, std::initializer_list<Ring> holes = {}) {
   return Polygon{Ring(outer), std::vector<Ring>(holes)};
+}
+
+/// The same rings, vertex for vertex, to the last bit.
+inline bool sameBits(const Polygon& a, const Polygon& b) {
+  auto same = [](const Ring& x, const Ring& y) {
+    return std::equal(x.begin(), x.end(), y.begin(), y.end(),
+                      [](const Point& p, const Point& q) { return p.x == q.x && p.y == q.y; });
+  };
+  return same(a.outer, b.outer) && std::equal(a.holes.begin(), a.holes.end(), b.holes.begin(), b.holes.end(), same);
 }
 
 /// Lots of an nx by ny grid of 10 m cells whose corners are moved at random by

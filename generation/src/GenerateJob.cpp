@@ -42,7 +42,7 @@ constexpr double kDefaultOffsetStyleDepth = 30.0;  // m, style offset without --
 }  // namespace
 
 Subdivision subdivideBlock(const Polygon& block, const std::string& style, const SkeletonParameters& parameters,
-                           std::uint64_t seed, const StreetWidths& streetWidths) {
+                           std::uint64_t seed, const StreetWidths& streetWidths, const SkeletonReuse& reuse) {
   if (style == "obb") return subdivideObb(block, parameters.bounds, seed);
   SkeletonParameters p = parameters;
   if (style == "offset") {
@@ -51,7 +51,7 @@ Subdivision subdivideBlock(const Polygon& block, const std::string& style, const
   } else if (style != "skeleton") {
     throw usageError("no subdivision style '" + style + "'");
   }
-  return subdivideSkeleton(block, p, seed, streetWidths);
+  return subdivideSkeleton(block, p, seed, streetWidths, reuse);
 }
 
 namespace {
@@ -243,10 +243,11 @@ std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInp
 
 namespace {
 
-Subdivision subdivideEntry(const BlockInputs& inputs, std::size_t entry, const BlockPlan& plan) {
+Subdivision subdivideEntry(const BlockInputs& inputs, std::size_t entry, const BlockPlan& plan,
+                           const SkeletonReuse& reuse = {}) {
   const bool widths = plan.style != "obb" && inputs.widths.size() == inputs.entries.size();
   return subdivideBlock(inputs.entries[entry].shape, plan.style, plan.parameters, plan.seed,
-                        widths ? inputs.widths[entry] : StreetWidths{});
+                        widths ? inputs.widths[entry] : StreetWidths{}, reuse);
 }
 
 std::vector<analysis::ParcelMetrics> measureEntry(const BlockInputs& inputs, std::size_t entry,
@@ -284,7 +285,9 @@ BlockOutcome runBlock(const BlockInputs& inputs, std::size_t entry, const BlockP
     o.subdivision = subdivideObb(inputs.entries[entry].shape, plan.parameters.bounds, plan.seed,
                                  {reusable ? previous->subdivision.obbSplits.get() : nullptr, reuse.record});
   } else {
-    o.subdivision = subdivideEntry(inputs, entry, plan);
+    // The layout checks for itself that it was made for this block and these parameters.
+    const SkeletonLayout* layout = previous ? previous->subdivision.skeletonLayout.get() : nullptr;
+    o.subdivision = subdivideEntry(inputs, entry, plan, {layout, reuse.record});
   }
   if (previous && sameParcels(o.subdivision.parcels, previous->subdivision.parcels)) {
     o.metrics = previous->metrics;  // the same parcels in the same block: the same measurements

@@ -5,6 +5,7 @@
 #include <CGAL/create_straight_skeleton_2.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -213,6 +214,29 @@ struct Candidate {
   bool stuck = false;  // no neighbour it could merge into
 };
 
+// Step 1 for one chord tolerance: the contour edges and the skeleton.
+struct SkeletonStage {
+  std::vector<Edge> edges;
+  std::vector<int> ringStart;
+  std::vector<SkVertex> vertices;
+  std::vector<Face> faces;
+  double maxTime = 0;
+};
+
+// Steps 1 (offset cut) to 3: each face's part of the strips after the corner
+// transfers, the patios and the strips.
+struct StripStage {
+  std::vector<Region> regions;
+  Region patios;
+  std::vector<Strip> strips;
+};
+
+// What one try (chord tolerance) has built so far and can hand to a later run.
+struct LayoutAttempt {
+  std::shared_ptr<const SkeletonStage> skeleton;
+  std::shared_ptr<const StripStage> strips;  // only when the block is deep enough for strips
+};
+
 // Exact pieces can carry edges far below a nanometre where a cut passes
 // next to a skeleton point that was rounded to doubles; once rounded, such
 // an edge is a duplicate vertex or a spike. Drops those vertices (moving the
@@ -244,13 +268,62 @@ class SkeletonBuilder {
 public:
   SkeletonBuilder(const Polygon& block, const SkeletonParameters& p, const detail::Rng& rng,
                   const StreetWidths& widths, double chordTolerance)
-      : block_(block), outline_{block.outer, {}}, p_(p), rng_(rng) {
+      : block_(block), outline_{block.outer, {}}, p_(p), rng_(rng), widths_(widths), chordTolerance_(chordTolerance) {
     const Box b = bounds(block);
     size_ = b.width() + b.height();
     reach_ = 4.0 * size_ + 1.0;
     accessTolerance_ = std::max(1e-6, 1e-9 * size_);
     outlineEdges_ = std::make_unique<analysis::PreparedBoundary>(outline_, accessTolerance_);
     target_ = 0.5 * (p.bounds.wMin + p.bounds.wMax);
+  }
+
+  // Runs every step; `memo` gives steps 1-3 when an earlier run built them
+  // for this try, and receives them when this run builds them.
+  void run(Subdivision& out, LayoutAttempt& memo) {
+    if (memo.skeleton) {
+      const SkeletonStage& k = *memo.skeleton;
+      edges_ = k.edges;
+      ringStart_ = k.ringStart;
+      vertices_ = k.vertices;
+      faces_ = k.faces;
+      maxTime_ = k.maxTime;
+    } else {
+      buildEdges();
+      buildSkeleton();
+      memo.skeleton = std::make_shared<const SkeletonStage>(
+          SkeletonStage{edges_, ringStart_, vertices_, faces_, maxTime_});
+    }
+    const double depth = maxTime_;
+    if (depth < p_.bounds.wMin) {
+      singleRow();
+    } else {
+      if (memo.strips) {
+        regions_ = memo.strips->regions;
+        patios_ = memo.strips->patios;
+        strips_ = memo.strips->strips;
+      } else {
+        buildRegions();
+        buildStrips();
+        fixDiagonals();
+        settle();
+        memo.strips = std::make_shared<const StripStage>(StripStage{regions_, patios_, strips_});
+      }
+      for (Strip& s : strips_) slice(s);
+      backRegions();
+    }
+    splitLarge();
+    mergeSmall();
+    joinBackLandToPatios();
+    emit(out);
+  }
+
+private:
+  // The contour edges: chords between the ring vertices kept at this try's
+  // chord tolerance, with their street widths.
+  void buildEdges() {
+    const Polygon& block = block_;
+    const StreetWidths& widths = widths_;
+    const double chordTolerance = chordTolerance_;
     std::vector<const Ring*> rings{&block.outer};
     for (const Ring& h : block.holes) rings.push_back(&h);
     // The kept vertices, unless dropping the others makes the polygon invalid.
@@ -298,26 +371,31 @@ public:
     ringStart_.push_back(static_cast<int>(edges_.size()));
   }
 
-  // Returns the parcels (exact) and the number of them that are patios.
-  void run(Subdivision& out) {
-    buildSkeleton();
-    const double depth = maxTime_;
-    if (depth < p_.bounds.wMin) {
-      singleRow();
-    } else {
-      buildRegions();
-      buildStrips();
-      fixDiagonals();
-      for (Strip& s : strips_) slice(s);
-      backRegions();
-    }
-    splitLarge();
-    mergeSmall();
-    joinBackLandToPatios();
-    emit(out);
+  // Computes the exact value of every constructed vertex of the regions and
+  // patios. A lazy exact number's double approximation tightens once anything
+  // asks for its exact value, and what later steps construct from it (and so
+  // their rounded coordinates) can inherit that approximation. Settled here,
+  // the steps after 3 start from the same state whether this run built steps
+  // 1-3 or an earlier run did (whose later steps may have refined them), so a
+  // run reusing them gives the same last bits by construction. (The tests'
+  // blocks also matched without it; it costs no measurable time.)
+  void settle() const {
+    auto settleRing = [](const P2& ring) {
+      for (auto v = ring.vertices_begin(); v != ring.vertices_end(); ++v) {
+        const auto a = v->approx();
+        if (a.x().inf() != a.x().sup() || a.y().inf() != a.y().sup()) v->exact();
+      }
+    };
+    auto settleRegion = [&](const Region& region) {
+      for (const PWH& part : region) {
+        settleRing(part.outer_boundary());
+        for (auto h = part.holes_begin(); h != part.holes_end(); ++h) settleRing(*h);
+      }
+    };
+    for (const Region& r : regions_) settleRegion(r);
+    settleRegion(patios_);
   }
 
-private:
   // The edge after edge g along its ring.
   int nextEdge(int g) const {
     const int r = edges_[g].ring;
@@ -980,6 +1058,8 @@ private:
   Polygon outline_;
   SkeletonParameters p_;
   detail::Rng rng_;
+  const StreetWidths& widths_;
+  double chordTolerance_ = 0;
   double size_ = 0, reach_ = 0, accessTolerance_ = 0, target_ = 0, maxTime_ = 0;
   std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;  // outline_, for the access test
   std::vector<Edge> edges_;
@@ -1041,11 +1121,54 @@ void checkTiling(const Polygon& block, const Subdivision& out) {
 
 }  // namespace
 
+struct SkeletonLayout {
+  Polygon block;  // as given to subdivideSkeleton
+  StreetWidths widths;
+  SkeletonParameters parameters;
+  std::array<LayoutAttempt, std::size(kChordTolerances)> attempts;  // by try
+};
+
+namespace {
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+bool sameRingBits(const Ring& a, const Ring& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                    [](const Point& p, const Point& q) { return sameBits(p.x, q.x) && sameBits(p.y, q.y); });
+}
+
+bool sameBlock(const Polygon& a, const Polygon& b) {
+  return sameRingBits(a.outer, b.outer) &&
+         std::equal(a.holes.begin(), a.holes.end(), b.holes.begin(), b.holes.end(), sameRingBits);
+}
+
+bool sameWidths(const StreetWidths& a, const StreetWidths& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const auto& x, const auto& y) {
+    return std::equal(x.begin(), x.end(), y.begin(), y.end(), sameBits);
+  });
+}
+}  // namespace
+
+bool skeletonLayoutReusable(const SkeletonParameters& recorded, const SkeletonParameters& wanted) {
+  return sameBits(recorded.offset, wanted.offset) && sameBits(recorded.streetAngle, wanted.streetAngle) &&
+         recorded.corner == wanted.corner;
+}
+
 Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& parameters, std::uint64_t seed,
-                              const StreetWidths& streetWidths) {
+                              const StreetWidths& streetWidths, const SkeletonReuse& reuse) {
   SkeletonParameters p = parameters;
   p.bounds.aMax = std::max(p.bounds.aMax, p.bounds.aMin);
   p.bounds.wMax = std::max(p.bounds.wMax, p.bounds.wMin);
+  auto layout = std::make_shared<SkeletonLayout>();
+  const SkeletonLayout* previous = reuse.previous;
+  if (previous && skeletonLayoutReusable(previous->parameters, p) && sameBlock(previous->block, block) &&
+      sameWidths(previous->widths, streetWidths)) {
+    layout->attempts = previous->attempts;
+  }
+  if (reuse.record) {
+    layout->block = block;
+    layout->widths = streetWidths;
+    layout->parameters = p;
+  }
   const Point o = detail::exactShiftOrigin(block);
   Polygon local = detail::translated(block, -o.x, -o.y);
   Subdivision out;
@@ -1059,7 +1182,7 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
         out = Subdivision{};
         SkeletonBuilder(local, p, detail::Rng{detail::splitmix64(seed ^ 0x5EC0DE)}, streetWidths,
                         kChordTolerances[attempt])
-            .run(out);
+            .run(out, layout->attempts[attempt]);
         break;
       } catch (const SkeletonFolds&) {
         std::size_t vertices = local.outer.size();
@@ -1080,8 +1203,8 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
     out = subdivideObb(block, p.bounds, seed);
     out.fallback = true;
     out.fallbackReason = reason;
-    return out;
   }
+  if (reuse.record) out.skeletonLayout = std::move(layout);
   return out;
 }
 

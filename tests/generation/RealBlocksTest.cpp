@@ -24,24 +24,39 @@ void PrintTo(const Dataset& d, std::ostream* os) { *os << d.file; }
 
 class RealBlocks : public ::testing::TestWithParam<std::tuple<Dataset, const char*>> {};
 
+// The blocks and their plans as generate() makes them: per-block bounds
+// clamped into range, the block's seed, street widths for the skeleton.
+struct Planned {
+  analysis::ObservedData observed;
+  GenerateRequest request;
+  BlockInputs inputs;
+  std::vector<BlockPlan> plans;
+};
+
+std::unique_ptr<Planned> plan(const Dataset& dataset, const std::string& style) {
+  io::ReadOptions in;
+  in.path = test::sharedDataset(dataset.file);
+  in.crsOverride = dataset.crs;
+  auto d = std::make_unique<Planned>();
+  d->observed = analysis::loadObserved(in, defaultValues(analysis::analysisParameters()));
+  d->request.fromParcels = true;
+  d->request.observed = &d->observed;
+  d->request.style = style;
+  d->request.parameters = defaultValues(generationParameterDescriptions());  // xi = 1
+  d->inputs = prepareBlocks(d->request);
+  if (style != "obb") streetWidthsOf(d->inputs);
+  d->plans = planBlocks(d->request, d->inputs);
+  return d;
+}
+
 TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
   PARCELSCOPE_REQUIRE_SHARED_DATASETS();
   const Dataset& dataset = std::get<0>(GetParam());
   const std::string style = std::get<1>(GetParam());
-  io::ReadOptions in;
-  in.path = test::sharedDataset(dataset.file);
-  in.crsOverride = dataset.crs;
-  const auto observed = analysis::loadObserved(in, defaultValues(analysis::analysisParameters()));
-  // The blocks and their plans as generate() makes them: per-block bounds
-  // clamped into range, the block's seed, street widths for the skeleton.
-  GenerateRequest request;
-  request.fromParcels = true;
-  request.observed = &observed;
-  request.style = style;
-  request.parameters = defaultValues(generationParameterDescriptions());  // xi = 1
-  BlockInputs inputs = prepareBlocks(request);
-  if (style != "obb") streetWidthsOf(inputs);
-  const std::vector<BlockPlan> plans = planBlocks(request, inputs);
+  const auto planned = plan(dataset, style);
+  const GenerateRequest& request = planned->request;
+  const BlockInputs& inputs = planned->inputs;
+  const std::vector<BlockPlan>& plans = planned->plans;
   const std::size_t n = inputs.entries.size();
   std::vector<Subdivision> results(n);
   std::vector<test::TilingReport> reports(n);
@@ -71,6 +86,52 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
   EXPECT_EQ(withoutAccess, 0);
   // The skeleton route handles at least 95 % of real blocks itself.
   EXPECT_LE(fallbacks, static_cast<int>(n) / 20);
+}
+
+// A slider moved in a session: each block run again with what its last run
+// recorded (OBB splits under new A_max and W_max; the skeleton layout under
+// new bounds, omega and seed) gives, to the last bit, what a fresh run gives.
+TEST_P(RealBlocks, RunsReusingTheLastRunGiveWhatFreshRunsGive) {
+  PARCELSCOPE_REQUIRE_SHARED_DATASETS();
+  const Dataset& dataset = std::get<0>(GetParam());
+  const std::string style = std::get<1>(GetParam());
+  const auto planned = plan(dataset, style);
+  const BlockInputs& inputs = planned->inputs;
+  const double minFrontage = planned->request.parameters.at("min-frontage");
+  const std::size_t n = inputs.entries.size();
+  std::vector<BlockPlan> moved = planned->plans;
+  for (BlockPlan& p : moved) {
+    p.parameters.bounds.aMax *= 1.3;
+    p.parameters.bounds.wMax *= 0.8;
+    if (style != "obb") {
+      p.parameters.bounds.omega = std::min(1.0, p.parameters.bounds.omega + 0.2);
+      p.seed += 1;
+    }
+  }
+  std::vector<int> differing(n, 0), reusedAnything(n, 0);
+  parallelFor(n, [&](std::size_t k) {
+    const BlockOutcome first = runBlock(inputs, k, planned->plans[k], minFrontage, {nullptr, nullptr, true});
+    const BlockOutcome reused = runBlock(inputs, k, moved[k], minFrontage, {&first, &planned->plans[k], true});
+    const BlockOutcome fresh = runBlock(inputs, k, moved[k], minFrontage);
+    reusedAnything[k] = first.subdivision.obbSplits != nullptr || first.subdivision.skeletonLayout != nullptr;
+    const auto& a = reused.subdivision.parcels;
+    const auto& b = fresh.subdivision.parcels;
+    bool same = a.size() == b.size() && reused.subdivision.oversize == fresh.subdivision.oversize &&
+                reused.subdivision.withoutAccess == fresh.subdivision.withoutAccess;
+    for (std::size_t i = 0; same && i < a.size(); ++i) {
+      same = test::sameBits(a[i], b[i]);
+    }
+    differing[k] = !same;
+  });
+  int bad = 0, recorded = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    EXPECT_FALSE(differing[k]) << dataset.file << " " << style << " block " << inputs.entries[k].blockId;
+    bad += differing[k];
+    recorded += reusedAnything[k];
+  }
+  std::printf("%s %s: %zu blocks, %d recorded what a later run reuses, %d differ from a fresh run\n", dataset.file,
+              style.c_str(), n, recorded, bad);
+  EXPECT_GT(recorded, static_cast<int>(n) * 9 / 10);
 }
 
 INSTANTIATE_TEST_SUITE_P(Datasets, RealBlocks,

@@ -232,6 +232,20 @@ TEST(SkeletonSubdivision, InvalidBlockFallsBackAndIsFlagged) {
 
 constexpr int kRandomShapes = 700 / test::kSanitizerDivisor;
 
+// Random bounds for a block of area a, a random street angle and, with
+// `offset`, a random finite d_offset.
+SkeletonParameters randomParameters(std::mt19937_64& rng, double a, bool offset, bool subdividePatios,
+                                    bool byLength) {
+  std::uniform_real_distribution<double> u(0, 1);
+  SkeletonParameters p;
+  p.bounds = test::randomBounds(rng, a);
+  p.offset = offset ? 5 + 30 * u(rng) : 0;
+  p.subdividePatios = subdividePatios;
+  p.corner = byLength ? CornerRule::StreetLength : CornerRule::StreetWidth;
+  p.streetAngle = 10 + 40 * u(rng);
+  return p;
+}
+
 TEST(SkeletonSubdivision, RandomShapesAreTiledValidlyWithStreetAccess) {
   const std::uint64_t seed = 20261122;
   std::printf("random shapes seed %llu\n", static_cast<unsigned long long>(seed));
@@ -242,12 +256,7 @@ TEST(SkeletonSubdivision, RandomShapesAreTiledValidlyWithStreetAccess) {
     const int kind = i % test::kShapeKinds;
     const Polygon block = test::randomShape(rng, kind);
     const double a = area(block);
-    SkeletonParameters p;
-    p.bounds = test::randomBounds(rng, a);
-    p.offset = i % 4 == 0 ? 5 + 30 * u(rng) : 0;
-    p.subdividePatios = i % 8 == 0;
-    p.corner = i % 2 ? CornerRule::StreetLength : CornerRule::StreetWidth;
-    p.streetAngle = 10 + 40 * u(rng);
+    const SkeletonParameters p = randomParameters(rng, a, i % 4 == 0, i % 8 == 0, i % 2 != 0);
     const std::uint64_t s = rng();
     const Subdivision sub = subdivideSkeleton(block, p, s);
     const std::string what = "shape " + std::to_string(i) + " kind " + std::to_string(kind) +
@@ -272,6 +281,90 @@ TEST(SkeletonSubdivision, RandomShapesAreTiledValidlyWithStreetAccess) {
               kRandomShapes, parcels, patios, fallbacks, withoutAccess);
   EXPECT_EQ(withoutAccess, 0);
   EXPECT_LE(fallbacks, kRandomShapes / 20);  // the skeleton route handles at least 95 %
+}
+
+void expectSameSubdivision(const Subdivision& a, const Subdivision& b, const std::string& what) {
+  auto sameRing = [&](const Ring& x, const Ring& y) {
+    ASSERT_EQ(x.size(), y.size()) << what;
+    for (std::size_t v = 0; v < x.size(); ++v) {
+      EXPECT_EQ(x[v].x, y[v].x) << what;
+      EXPECT_EQ(x[v].y, y[v].y) << what;
+    }
+  };
+  ASSERT_EQ(a.parcels.size(), b.parcels.size()) << what;
+  for (std::size_t k = 0; k < a.parcels.size(); ++k) {
+    sameRing(a.parcels[k].outer, b.parcels[k].outer);
+    ASSERT_EQ(a.parcels[k].holes.size(), b.parcels[k].holes.size()) << what;
+    for (std::size_t h = 0; h < a.parcels[k].holes.size(); ++h) sameRing(a.parcels[k].holes[h], b.parcels[k].holes[h]);
+  }
+  EXPECT_EQ(a.oversize, b.oversize) << what;
+  EXPECT_EQ(a.withoutAccess, b.withoutAccess) << what;
+  EXPECT_EQ(a.patioParcels, b.patioParcels) << what;
+  EXPECT_EQ(a.fallback, b.fallback) << what;
+}
+
+// Moving the bounds, omega and the seed while reusing the recorded skeleton
+// and strips gives, at every step, exactly the parcels a fresh run gives (to
+// the last bit, patios and street widths included); a layout recorded for
+// another block or another offset, street angle or corner rule is ignored.
+TEST(SkeletonSubdivision, ReusedLayoutGivesWhatAFreshRunGives) {
+  const std::uint64_t seed = std::random_device{}();
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  int steps = 0, deep = 0;
+  std::shared_ptr<const SkeletonLayout> other;  // the previous shape's
+  for (int i = 0; i < 60 / test::kSanitizerDivisor; ++i) {
+    const Polygon block = test::randomShape(rng, i % test::kShapeKinds);
+    const double a = area(block);
+    SkeletonParameters p = randomParameters(rng, a, i % 3 == 0, i % 2 == 0, i % 2 != 0);
+    StreetWidths widths;
+    if (i % 4 != 1) {
+      widths.emplace_back(block.outer.size());
+      for (double& w : widths.back()) w = 8 + 20 * u(rng);
+      for (const Ring& h : block.holes) widths.emplace_back(h.size(), 12.0);
+    }
+    std::uint64_t s = rng();
+    Subdivision last = subdivideSkeleton(block, p, s, widths, {nullptr, true});
+    ASSERT_NE(last.skeletonLayout, nullptr);
+    if (other) {
+      expectSameSubdivision(subdivideSkeleton(block, p, s, widths, {other.get(), false}), last,
+                            "shape " + std::to_string(i) + " with another shape's layout");
+    }
+    other = last.skeletonLayout;
+    for (int step = 0; step < 4; ++step) {
+      const std::string what = "shape " + std::to_string(i) + " step " + std::to_string(step);
+      const SkeletonParameters before = p;
+      p.bounds = test::randomBounds(rng, a);
+      if (step == 2) s = rng();
+      ASSERT_TRUE(skeletonLayoutReusable(before, p));
+      const Subdivision reused = subdivideSkeleton(block, p, s, widths, {last.skeletonLayout.get(), true});
+      const Subdivision fresh = subdivideSkeleton(block, p, s, widths);
+      expectSameSubdivision(reused, fresh, what);
+      EXPECT_TILES(block, reused.parcels, what);
+      ++steps;
+      deep += !fresh.fallback && fresh.parcels.size() > 2;
+      last = reused;
+    }
+    // Another offset: the layout does not serve, and the run is a fresh one.
+    SkeletonParameters q = p;
+    q.offset = p.offset > 0 ? 0 : 12;
+    EXPECT_FALSE(skeletonLayoutReusable(p, q));
+    expectSameSubdivision(subdivideSkeleton(block, q, s, widths, {last.skeletonLayout.get(), false}),
+                          subdivideSkeleton(block, q, s, widths), "shape " + std::to_string(i) + " other offset");
+  }
+  EXPECT_GT(deep, steps / 2);
+  SkeletonParameters a, b = a;
+  b.streetAngle = a.streetAngle + 1;
+  EXPECT_FALSE(skeletonLayoutReusable(a, b));
+  b = a;
+  b.corner = CornerRule::StreetLength;
+  EXPECT_FALSE(skeletonLayoutReusable(a, b));
+  b = a;
+  b.bounds.omega = 0.9;
+  b.bounds.wMin = 3;
+  b.subdividePatios = true;
+  EXPECT_TRUE(skeletonLayoutReusable(a, b));
 }
 
 }  // namespace

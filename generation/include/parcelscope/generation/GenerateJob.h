@@ -37,9 +37,11 @@ std::vector<ParameterDescription> generationParameterDescriptions();
 /// Subdivides one block with a concrete style (obb, skeleton or offset; not
 /// auto): `parameters.bounds` for obb, all of `parameters` for the skeleton
 /// styles (offset: d_offset 30 m when 0, patios always subdivided).
-/// `streetWidths` (per contour edge, see StreetWidths) feed the StreetWidth rule.
+/// `streetWidths` (per contour edge, see StreetWidths) feed the StreetWidth rule;
+/// `reuse` serves the skeleton styles.
 Subdivision subdivideBlock(const Polygon& block, const std::string& style, const SkeletonParameters& parameters,
-                           std::uint64_t seed, const StreetWidths& streetWidths = {});
+                           std::uint64_t seed, const StreetWidths& streetWidths = {},
+                           const SkeletonReuse& reuse = {});
 
 /// Share of observed parcels with street access at or above which `auto` picks skeleton.
 constexpr double kAutoSkeletonAccessShare = 0.9;
@@ -143,14 +145,16 @@ struct BlockReuse {
   /// The entry's outcome under `previousPlan` (both null: nothing to reuse).
   const BlockOutcome* previous = nullptr;
   const BlockPlan* previousPlan = nullptr;
-  /// Keep the OBB splits in the outcome for the next run (see ObbSplits).
+  /// Keep the OBB splits or the skeleton layout in the outcome for the next
+  /// run (see ObbSplits and SkeletonReuse).
   bool record = false;
 };
 /// Runs `plan` on entry `entry` of `inputs` (street widths must have been measured
 /// with streetWidthsOf when the style is not obb). `minFrontage` as the analysis's.
 /// With `reuse`, an OBB plan differing from the previous one only in A_max or
-/// W_max reuses its splits, and parcels equal to the previous ones keep their
-/// metrics; the outcome is the same as without.
+/// W_max reuses its splits, a skeleton plan keeping d_offset, the street angle
+/// and the corner rule reuses the skeleton and strips, and parcels equal to
+/// the previous ones keep their metrics; the outcome is the same as without.
 BlockOutcome runBlock(const BlockInputs& inputs, std::size_t entry, const BlockPlan& plan, double minFrontage,
                       const BlockReuse& reuse = {});
 

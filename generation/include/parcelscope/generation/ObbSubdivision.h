@@ -47,6 +47,10 @@ ObbParameters obbParametersFrom(const ParameterValues& values);
 /// Vanegas et al. 2012). Opaque; shared, never changed once made.
 struct ObbSplits;
 
+/// The parameter-independent part of a skeleton subdivision (see
+/// SkeletonSubdivision.h). Opaque; shared, never changed once made.
+struct SkeletonLayout;
+
 struct Subdivision {
   std::vector<Polygon> parcels;   ///< tile the block (normalised, local metres)
   int oversize = 0;               ///< parcels above A_max or W_max with no admissible split
@@ -57,6 +61,7 @@ struct Subdivision {
   std::string fallbackReason;     ///< why, when fallback
   int patioParcels = 0;           ///< parcels that are (parts of) inner patios, without street access by design
   std::shared_ptr<const ObbSplits> obbSplits;  ///< OBB only, when asked to record them
+  std::shared_ptr<const SkeletonLayout> skeletonLayout;  ///< skeleton styles only, when asked to record it
 };
 
 /// Splits to reuse and whether to record this run's.

@@ -75,10 +75,29 @@ SkeletonParameters skeletonParametersFrom(const ParameterValues& values);
 /// holes, as in the normalised block); NaN or missing entries are unknown.
 using StreetWidths = std::vector<std::vector<double>>;
 
+/// Steps 1 to 3 (the skeleton, the strips and their corner transfers) depend
+/// on the block, its street widths, d_offset, the street angle and the corner
+/// rule only; not on the bounds, omega or the seed. A run can record them
+/// (Subdivision::skeletonLayout) and a later run of the same block with the
+/// same of those reuse them, so the bounds, omega and seed sliders move
+/// without building the skeleton again.
+struct SkeletonReuse {
+  /// Recorded by an earlier run; used only when it was made for the same
+  /// block (vertex for vertex), street widths, d_offset, street angle and
+  /// corner rule, else ignored.
+  const SkeletonLayout* previous = nullptr;
+  bool record = false;  ///< keep this run's layout (with what it reused) in Subdivision::skeletonLayout
+};
+
+/// True when a layout recorded with `recorded` serves a run with `wanted`
+/// (same d_offset, street angle and corner rule).
+bool skeletonLayoutReusable(const SkeletonParameters& recorded, const SkeletonParameters& wanted);
+
 /// Subdivides one normalised block. Deterministic for a given seed. Never throws
 /// on bad geometry: falls back to subdivideObb (fallback = true), and a block the
 /// exact kernel rejects altogether comes back whole with failed = true.
+/// With `reuse.previous`, the parcels are those a fresh run gives.
 Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& parameters, std::uint64_t seed,
-                              const StreetWidths& streetWidths = {});
+                              const StreetWidths& streetWidths = {}, const SkeletonReuse& reuse = {});
 
 }  // namespace parcelscope::generation
