@@ -1160,9 +1160,13 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
   p.bounds.wMax = std::max(p.bounds.wMax, p.bounds.wMin);
   auto layout = std::make_shared<SkeletonLayout>();
   const SkeletonLayout* previous = reuse.previous;
-  if (previous && skeletonLayoutReusable(previous->parameters, p) && sameBlock(previous->block, block) &&
-      sameWidths(previous->widths, streetWidths)) {
+  if (previous && sameBlock(previous->block, block) && sameWidths(previous->widths, streetWidths)) {
     layout->attempts = previous->attempts;
+    // The skeleton (step 1) depends on the block and widths alone; the strips
+    // also on d_offset, the street angle and the corner rule.
+    if (!skeletonLayoutReusable(previous->parameters, p)) {
+      for (LayoutAttempt& a : layout->attempts) a.strips.reset();
+    }
   }
   if (reuse.record) {
     layout->block = block;

@@ -305,8 +305,9 @@ void expectSameSubdivision(const Subdivision& a, const Subdivision& b, const std
 
 // Moving the bounds, omega and the seed while reusing the recorded skeleton
 // and strips gives, at every step, exactly the parcels a fresh run gives (to
-// the last bit, patios and street widths included); a layout recorded for
-// another block or another offset, street angle or corner rule is ignored.
+// the last bit, patios and street widths included), as does another offset,
+// street angle or corner rule (the skeleton alone reused); a layout recorded
+// for another block is ignored.
 TEST(SkeletonSubdivision, ReusedLayoutGivesWhatAFreshRunGives) {
   const std::uint64_t seed = std::random_device{}();
   SCOPED_TRACE("seed " + std::to_string(seed));
@@ -346,12 +347,19 @@ TEST(SkeletonSubdivision, ReusedLayoutGivesWhatAFreshRunGives) {
       deep += !fresh.fallback && fresh.parcels.size() > 2;
       last = reused;
     }
-    // Another offset: the layout does not serve, and the run is a fresh one.
+    // Another offset, street angle or corner rule: only the skeleton serves.
     SkeletonParameters q = p;
-    q.offset = p.offset > 0 ? 0 : 12;
-    EXPECT_FALSE(skeletonLayoutReusable(p, q));
-    expectSameSubdivision(subdivideSkeleton(block, q, s, widths, {last.skeletonLayout.get(), false}),
-                          subdivideSkeleton(block, q, s, widths), "shape " + std::to_string(i) + " other offset");
+    for (int change = 0; change < 3; ++change) {
+      const SkeletonParameters before = q;
+      if (change == 0) q.offset = q.offset > 0 ? 0 : 12;
+      if (change == 1) q.streetAngle = 10 + 40 * u(rng);
+      if (change == 2) q.corner = q.corner == CornerRule::StreetWidth ? CornerRule::StreetLength : CornerRule::StreetWidth;
+      EXPECT_FALSE(skeletonLayoutReusable(before, q));
+      const Subdivision reused = subdivideSkeleton(block, q, s, widths, {last.skeletonLayout.get(), true});
+      expectSameSubdivision(reused, subdivideSkeleton(block, q, s, widths),
+                            "shape " + std::to_string(i) + " change " + std::to_string(change));
+      last = reused;
+    }
   }
   EXPECT_GT(deep, steps / 2);
   SkeletonParameters a, b = a;

@@ -77,20 +77,22 @@ using StreetWidths = std::vector<std::vector<double>>;
 
 /// Steps 1 to 3 (the skeleton, the strips and their corner transfers) depend
 /// on the block, its street widths, d_offset, the street angle and the corner
-/// rule only; not on the bounds, omega or the seed. A run can record them
-/// (Subdivision::skeletonLayout) and a later run of the same block with the
-/// same of those reuse them, so the bounds, omega and seed sliders move
-/// without building the skeleton again.
+/// rule only; not on the bounds, omega or the seed; the skeleton itself on the
+/// block and street widths alone. A run can record them
+/// (Subdivision::skeletonLayout) and a later run of the same block reuses what
+/// still applies, so the bounds, omega and seed sliders move without building
+/// the skeleton or the strips again, and the other skeleton sliders without
+/// building the skeleton again.
 struct SkeletonReuse {
   /// Recorded by an earlier run; used only when it was made for the same
-  /// block (vertex for vertex), street widths, d_offset, street angle and
-  /// corner rule, else ignored.
+  /// block (vertex for vertex) and street widths, else ignored; its strips
+  /// only with the same d_offset, street angle and corner rule.
   const SkeletonLayout* previous = nullptr;
   bool record = false;  ///< keep this run's layout (with what it reused) in Subdivision::skeletonLayout
 };
 
-/// True when a layout recorded with `recorded` serves a run with `wanted`
-/// (same d_offset, street angle and corner rule).
+/// True when the strips of a layout recorded with `recorded` serve a run with
+/// `wanted` (same d_offset, street angle and corner rule).
 bool skeletonLayoutReusable(const SkeletonParameters& recorded, const SkeletonParameters& wanted);
 
 /// Subdivides one normalised block. Deterministic for a given seed. Never throws
