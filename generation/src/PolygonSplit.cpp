@@ -290,9 +290,19 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
   const std::size_t n = r.size();
   if (n < 3) return false;
   std::vector<signed char> side(n);
+  for (std::size_t i = 0; i < n; ++i) side[i] = static_cast<signed char>(sideOf(r[i], pivot, dir));
+  // A vertex on the line whose neighbours are both on one side (the line
+  // touches the ring there, as a split snapped to a contour vertex often does)
+  // belongs to that side's piece, unless it lies on a cut (checked below).
+  const std::vector<signed char> onLine = side;
+  std::vector<double> touches;  // their positions along the line
   std::size_t left = 0, right = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    side[i] = static_cast<signed char>(sideOf(r[i], pivot, dir));
+    const int before = onLine[(i + n - 1) % n], after = onLine[(i + 1) % n];
+    if (onLine[i] == 0 && before * after > 0) {
+      side[i] = static_cast<signed char>(before);
+      touches.push_back((r[i].x - pivot.x) * dir.x + (r[i].y - pivot.y) * dir.y);
+    }
     left += side[i] > 0;
     right += side[i] < 0;
   }
@@ -359,6 +369,11 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
     if (sideBefore(x) == sideBefore(y)) return false;
     nodes[x].partner = static_cast<int>(y);
     nodes[y].partner = static_cast<int>(x);
+    // A touching vertex on (or too near to tell) this cut would pinch a
+    // piece in two there: the exact split makes the two pieces.
+    for (const double t : touches) {
+      if (t > nodes[x].along - separation && t < nodes[y].along + separation) return false;
+    }
   }
   // Each piece: along the ring on its side; where the ring leaves that side,
   // across the cut to its other end, and on along the ring from there.

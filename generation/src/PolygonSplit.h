@@ -26,11 +26,12 @@ SplitPieces splitByLine(const Polygon& polygon, const Point& pivot, const Point&
 
 /// The same split in floating point, for a polygon without holes whose
 /// vertices on the line (exactly: the side of every vertex is certain) are
-/// crossings between opposite sides: the crossing points are computed once and
-/// shared by the pieces on both sides, and paired into cuts in their order
-/// along the line. False, with `out` untouched, for anything else (holes, a
-/// touch, an edge along the line, crossings too close along the line to order):
-/// then the exact `splitByLine` must be used.
+/// crossings between opposite sides or touches from one side away from every
+/// cut: the crossing points are computed once and shared by the pieces on
+/// both sides, and paired into cuts in their order along the line. False, with
+/// `out` untouched, for anything else (holes, a touch on a cut, an edge along
+/// the line, crossings too close along the line to order): then the exact
+/// `splitByLine` must be used.
 bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& dir, SplitPieces& out);
 
 }  // namespace parcelscope::generation::detail

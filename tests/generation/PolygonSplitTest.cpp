@@ -128,6 +128,20 @@ TEST(PolygonSplit, FourCrossingsGiveThreePieces) {
   EXPECT_TRUE(samePieces(s.right, e.right, 1e-12));
 }
 
+TEST(PolygonSplit, TouchAwayFromTheCutsStaysInItsPiece) {
+  // The line y = 5 crosses the left arm and touches the spike at (25, 5) from below.
+  const Polygon shape = poly({{0, -10}, {30, -10}, {30, 0}, {25, 5}, {20, 0}, {10, 0}, {10, 10}, {0, 10}});
+  SplitPieces s;
+  ASSERT_TRUE(splitByLineFast(shape, {15, 5}, {1, 0}, s));
+  ASSERT_EQ(s.left.size(), 1u);
+  ASSERT_EQ(s.right.size(), 1u);
+  EXPECT_DOUBLE_EQ(area(s.left[0]), 50);
+  EXPECT_DOUBLE_EQ(area(s.right[0]), 375);
+  const SplitPieces e = splitByLine(shape, {15, 5}, {1, 0});
+  EXPECT_TRUE(samePieces(s.left, e.left, 1e-12));
+  EXPECT_TRUE(samePieces(s.right, e.right, 1e-12));
+}
+
 TEST(PolygonSplit, FastSplitDeclinesWhatOnlyTheExactSplitHandles) {
   SplitPieces s;
   // A hole.
@@ -139,7 +153,8 @@ TEST(PolygonSplit, FastSplitDeclinesWhatOnlyTheExactSplitHandles) {
   // that are not crossings.
   const Polygon u = poly({{0, 0}, {30, 0}, {30, 30}, {20, 30}, {20, 10}, {10, 10}, {10, 30}, {0, 30}});
   EXPECT_FALSE(splitByLineFast(u, {15, 10}, {1, 0}, s));
-  // A line along an edge, and a line touching a vertex without crossing.
+  // A line along an edge, and a line touching a vertex on its cut (which
+  // would pinch the piece above in two).
   EXPECT_FALSE(splitByLineFast(rect(0, 0, 10, 10), {5, 0}, {1, 0}, s));
   const Polygon kite = poly({{0, 0}, {10, -5}, {20, 0}, {10, 5}});
   EXPECT_FALSE(splitByLineFast(poly({{0, 0}, {10, 0}, {10, 10}, {5, 5}, {0, 10}}), {5, 5}, {1, 0}, s));
