@@ -278,8 +278,8 @@ public:
   }
 
   // Runs every step; `memo` gives steps 1-3 when an earlier run built them
-  // for this try, and receives them when this run builds them.
-  void run(Subdivision& out, LayoutAttempt& memo) {
+  // for this try, and receives them when this run builds them and `record`.
+  void run(Subdivision& out, LayoutAttempt& memo, bool record) {
     if (memo.skeleton) {
       const SkeletonStage& k = *memo.skeleton;
       edges_ = k.edges;
@@ -290,8 +290,10 @@ public:
     } else {
       buildEdges();
       buildSkeleton();
-      memo.skeleton = std::make_shared<const SkeletonStage>(
-          SkeletonStage{edges_, ringStart_, vertices_, faces_, maxTime_});
+      if (record) {
+        memo.skeleton = std::make_shared<const SkeletonStage>(
+            SkeletonStage{edges_, ringStart_, vertices_, faces_, maxTime_});
+      }
     }
     const double depth = maxTime_;
     if (depth < p_.bounds.wMin) {
@@ -306,7 +308,7 @@ public:
         buildStrips();
         fixDiagonals();
         settle();
-        memo.strips = std::make_shared<const StripStage>(StripStage{regions_, patios_, strips_});
+        if (record) memo.strips = std::make_shared<const StripStage>(StripStage{regions_, patios_, strips_});
       }
       for (Strip& s : strips_) slice(s);
       backRegions();
@@ -1186,7 +1188,7 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
         out = Subdivision{};
         SkeletonBuilder(local, p, detail::Rng{detail::splitmix64(seed ^ 0x5EC0DE)}, streetWidths,
                         kChordTolerances[attempt])
-            .run(out, layout->attempts[attempt]);
+            .run(out, layout->attempts[attempt], reuse.record);
         break;
       } catch (const SkeletonFolds&) {
         std::size_t vertices = local.outer.size();
