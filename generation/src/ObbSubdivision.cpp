@@ -138,10 +138,13 @@ private:
   // floating point (splitByLineFast) and kept when its pieces keep the piece's
   // area and pass the checks; when they fail the cleanliness or validity
   // check, and whenever the fast path does not apply, the exact split decides.
+  // (A pinched split is refused either way.)
   std::vector<Polygon> admissibleSplit(const Polygon& piece, const Point& through, const Point& dir) const {
     detail::SplitPieces split;
     if (detail::splitByLineFast(piece, through, dir, split)) {
-      if (split.left.empty() || split.right.empty()) return {};
+      // A piece pinched at a point is never admissible: the exact split gives
+      // it as one ring touching itself, which is not clean (nor valid).
+      if (split.left.empty() || split.right.empty() || split.pinched) return {};
       std::vector<Polygon> parts = joined(split);
       double sum = 0;
       for (const Polygon& part : parts) sum += area(part);

@@ -293,15 +293,16 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
   for (std::size_t i = 0; i < n; ++i) side[i] = static_cast<signed char>(sideOf(r[i], pivot, dir));
   // A vertex on the line whose neighbours are both on one side (the line
   // touches the ring there, as a split snapped to a contour vertex often does)
-  // belongs to that side's piece, unless it lies on a cut (checked below).
+  // belongs to that side's piece. On a cut it pinches that side's piece in
+  // two there (checked below).
   const std::vector<signed char> onLine = side;
-  std::vector<double> touches;  // their positions along the line
+  std::vector<char> touch(n, 0);
   std::size_t left = 0, right = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const int before = onLine[(i + n - 1) % n], after = onLine[(i + 1) % n];
     if (onLine[i] == 0 && before * after > 0) {
       side[i] = static_cast<signed char>(before);
-      touches.push_back((r[i].x - pivot.x) * dir.x + (r[i].y - pivot.y) * dir.y);
+      touch[i] = 1;
     }
     left += side[i] > 0;
     right += side[i] < 0;
@@ -317,20 +318,26 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
   }
   // The ring with its crossings: vertices, and points inserted on edges whose
   // ends lie on opposite sides. Every vertex on the line must be a crossing
-  // too (between opposite sides); a touch or an edge along the line is left to
+  // too (between opposite sides) or a touch; an edge along the line is left to
   // the exact split.
   struct Node {
     Point p;
-    int side;         // of the vertex; 0 on the line
-    int partner = -1; // on the line: the other end of its cut
-    double along = 0; // on the line: position along it
+    int side = 0;      // of the vertex; 0 on the line
+    bool touch = false;
+    double along = 0;  // on the line (crossings and touches): position along it
+    int exit = -1;     // crossings: the other end of its cut; touches on a cut: the next stop along it
+    std::vector<int> through;  // the touches from the other side passed on the way to `exit`
   };
   std::vector<Node> nodes;
   nodes.reserve(n + 8);
   for (std::size_t i = 0; i < n; ++i) {
     const int s = side[i], next = side[(i + 1) % n];
     if (s == 0 && side[(i + n - 1) % n] * next >= 0) return false;
-    nodes.push_back({r[i], s});
+    Node vertex;
+    vertex.p = r[i];
+    vertex.side = s;
+    vertex.touch = touch[i] != 0;
+    nodes.push_back(std::move(vertex));
     if (s * next >= 0) continue;
     // The crossing, from the segment taken in x-then-y order, clamped to it.
     const Point& a = r[i];
@@ -341,24 +348,29 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
     const double dx = to.x - from.x, dy = to.y - from.y;
     const double t = std::clamp(((pivot.x - from.x) * dir.y - (pivot.y - from.y) * dir.x) / (dx * dir.y - dy * dir.x),
                                 0.0, 1.0);
-    nodes.push_back({t == 1.0 ? to : Point{from.x + dx * t, from.y + dy * t}, 0});
+    Node crossing;
+    crossing.p = t == 1.0 ? to : Point{from.x + dx * t, from.y + dy * t};
+    crossing.side = 0;
+    nodes.push_back(std::move(crossing));
   }
   const std::size_t m = nodes.size();
   auto sideBefore = [&](std::size_t k) { return nodes[(k + m - 1) % m].side; };
   auto sideAfter = [&](std::size_t k) { return nodes[(k + 1) % m].side; };
   // Cuts: the crossings in order along the line, paired first with second,
   // third with fourth, and so on; each pair must join a crossing where the ring
-  // leaves the left side to one where it comes back. Crossings too close
-  // along the line to be ordered with certainty are left to the exact split.
-  std::vector<std::size_t> crossings;
+  // leaves the left side to one where it comes back. Points on the line too
+  // close along it to be ordered with certainty are left to the exact split.
+  SplitPieces result;
+  std::vector<std::size_t> crossings, touches;
   for (std::size_t k = 0; k < m; ++k) {
-    if (nodes[k].side != 0) continue;
+    if (nodes[k].side != 0 && !nodes[k].touch) continue;
     nodes[k].along = (nodes[k].p.x - pivot.x) * dir.x + (nodes[k].p.y - pivot.y) * dir.y;
-    crossings.push_back(k);
+    (nodes[k].touch ? touches : crossings).push_back(k);
   }
   if (crossings.size() % 2 != 0) return false;
-  std::sort(crossings.begin(), crossings.end(),
-            [&](std::size_t x, std::size_t y) { return nodes[x].along < nodes[y].along; });
+  const auto byAlong = [&](std::size_t x, std::size_t y) { return nodes[x].along < nodes[y].along; };
+  std::sort(crossings.begin(), crossings.end(), byAlong);
+  std::sort(touches.begin(), touches.end(), byAlong);
   const Box b = bounds(r);
   const double separation = 1e-9 * (b.width() + b.height());
   for (std::size_t c = 0; c + 1 < crossings.size(); ++c) {
@@ -367,30 +379,65 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
   for (std::size_t c = 0; c < crossings.size(); c += 2) {
     const std::size_t x = crossings[c], y = crossings[c + 1];
     if (sideBefore(x) == sideBefore(y)) return false;
-    nodes[x].partner = static_cast<int>(y);
-    nodes[y].partner = static_cast<int>(x);
-    // A touching vertex on (or too near to tell) this cut would pinch a
-    // piece in two there: the exact split makes the two pieces.
-    for (const double t : touches) {
-      if (t > nodes[x].along - separation && t < nodes[y].along + separation) return false;
+    // The stops along the cut: its ends and the touches on it, which pinch
+    // their side's piece (one piece ends there, the next begins). A touch
+    // too near an end or another stop to order is left to the exact split.
+    std::vector<std::size_t> stops{x};
+    for (const std::size_t t : touches) {
+      const double at = nodes[t].along;
+      if (!(at > nodes[x].along - separation && at < nodes[y].along + separation)) continue;
+      if (!(at - nodes[stops.back()].along > separation && nodes[y].along - at > separation)) return false;
+      stops.push_back(t);
+      result.pinched = true;
+    }
+    stops.push_back(y);
+    // Each side's pieces run along the cut in one direction: away from the
+    // crossing where the ring leaves that side. From there, and from each of
+    // its touches (reached along the ring), to the next of its own stops.
+    for (const int s : {1, -1}) {
+      const bool forward = sideBefore(x) == s;
+      const auto at = [&](std::size_t i) { return stops[forward ? i : stops.size() - 1 - i]; };
+      for (std::size_t i = 0; i + 1 < stops.size(); ++i) {
+        const std::size_t from = at(i);
+        if (i > 0 && nodes[from].side != s) continue;
+        Node& start = nodes[from];
+        start.through.clear();
+        std::size_t j = i + 1;
+        for (; j + 1 < stops.size() && nodes[at(j)].side != s; ++j) start.through.push_back(static_cast<int>(at(j)));
+        start.exit = static_cast<int>(at(j));
+      }
     }
   }
-  // Each piece: along the ring on its side; where the ring leaves that side,
-  // across the cut to its other end, and on along the ring from there.
-  SplitPieces result;
+  // Each piece: along the ring on its side; where the ring leaves that side
+  // (at a crossing, or at a touch on a cut), along the cut to its next stop,
+  // and on along the ring from there.
   std::vector<char> visited(m, 0);
+  std::vector<int> inPiece(m, -1);  // touches: the last piece that passed them
+  int pieces = 0;
   for (const int s : {1, -1}) {
     for (std::size_t start = 0; start < m; ++start) {
-      if (nodes[start].side != s || visited[start]) continue;
+      if (nodes[start].side != s || visited[start] || nodes[start].touch) continue;
       Polygon piece;
+      const int id = pieces++;
+      // A piece that passes one of its touches twice is pinched onto itself
+      // (the exact split makes a hole of it, or a ring touching itself).
+      const auto pass = [&](std::size_t k) {
+        piece.outer.push_back(nodes[k].p);
+        visited[k] = 1;
+        if (!nodes[k].touch) return true;
+        if (inPiece[k] == id) return false;
+        inPiece[k] = id;
+        return true;
+      };
       std::size_t k = start;
       for (std::size_t steps = 0;; ++steps) {
         if (steps > 2 * m) return false;  // not a closed walk: leave it to the exact split
-        piece.outer.push_back(nodes[k].p);
-        visited[k] = 1;
-        if (nodes[k].side == 0 && sideAfter(k) == -s) {
-          k = static_cast<std::size_t>(nodes[k].partner);
-          piece.outer.push_back(nodes[k].p);
+        if (!pass(k)) return false;
+        const bool leaves = nodes[k].side == 0 ? sideAfter(k) == -s : nodes[k].touch && nodes[k].exit >= 0;
+        if (leaves) {
+          for (const int t : nodes[k].through) piece.outer.push_back(nodes[static_cast<std::size_t>(t)].p);
+          k = static_cast<std::size_t>(nodes[k].exit);
+          if (!pass(k)) return false;
         }
         k = (k + 1) % m;
         if (k == start) break;

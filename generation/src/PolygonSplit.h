@@ -21,17 +21,23 @@ bool isValidForSplit(const Polygon& polygon);
 /// direction `dir` (non-zero). Every piece is normalised.
 struct SplitPieces {
   std::vector<Polygon> left, right;
+  /// splitByLineFast only: a vertex touching the line on a cut pinched its
+  /// side's piece there, so two of that side's pieces meet at that point.
+  /// (The exact split gives such pieces as one ring touching itself.)
+  bool pinched = false;
 };
 SplitPieces splitByLine(const Polygon& polygon, const Point& pivot, const Point& dir);
 
 /// The same split in floating point, for a polygon without holes whose
 /// vertices on the line (exactly: the side of every vertex is certain) are
-/// crossings between opposite sides or touches from one side away from every
-/// cut: the crossing points are computed once and shared by the pieces on
-/// both sides, and paired into cuts in their order along the line. False, with
-/// `out` untouched, for anything else (holes, a touch on a cut, an edge along
-/// the line, crossings too close along the line to order): then the exact
-/// `splitByLine` must be used.
+/// crossings between opposite sides or touches from one side: the crossing
+/// points are computed once and shared by the pieces on both sides, and paired
+/// into cuts in their order along the line. A touch away from the cuts stays a
+/// vertex of its side's piece; a touch on a cut ends one of its side's pieces
+/// and begins the next (see SplitPieces::pinched) and is a vertex of the
+/// other side's piece. False, with `out` untouched, for anything else (holes,
+/// an edge along the line, points on the line too close along it to order, a
+/// piece pinched onto itself): then the exact `splitByLine` must be used.
 bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& dir, SplitPieces& out);
 
 }  // namespace parcelscope::generation::detail

@@ -1,7 +1,9 @@
 // Time from a change in parcelscope-gui (a slider, a block override, the
 // colouring) to views, histograms and numbers drawn, on cambridge_ma (743
 // blocks, 13,128 observed parcels). Run under Xvfb:
-//   scripts/with-xvfb.sh build/release/tests/bench/parcelscope_gui_bench [repeats]
+//   scripts/with-xvfb.sh build/release/tests/bench/parcelscope_gui_bench [repeats [filter]]
+// With a filter, only the changes whose line contains it (for example
+// "obb omega" or "W_max") are measured.
 // Prints the median, 90th percentile and largest latency of each kind of change,
 // each up to the moment every view drawn for it has been put on screen (its
 // OpenGL window's buffers swapped) and the window's other widgets painted.
@@ -125,6 +127,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   const int repeats = argc > 1 ? std::max(3, std::atoi(argv[1])) : 10;
+  const std::string filter = argc > 2 ? argv[2] : "";
   MainWindow w;
   w.resize(1600, 1000);
   w.show();
@@ -141,7 +144,15 @@ int main(int argc, char** argv) {
               w.result()->generated.parcels.size(), static_cast<double>(load.elapsed()));
 
   ScreenWatch screen(w);
+  std::string style;  // of the changes measured now
+  const auto wanted = [&](const std::string& name) {
+    if (filter.empty()) return true;
+    const auto at = filter.find(' ');
+    if (at == std::string::npos) return name.find(filter) != std::string::npos;
+    return style == filter.substr(0, at) && name.find(filter.substr(at + 1)) != std::string::npos;
+  };
   auto measure = [&](const std::string& name, int n, const std::function<void(int)>& change) {
+    if (!wanted(name)) return;
     Row row{name, {}, {}};
     for (int i = 0; i < n; ++i) {
       change(i);
@@ -179,11 +190,12 @@ int main(int argc, char** argv) {
     measure("  colour by another quantity (no regeneration)", repeats,
             [&](int i) { w.setColourBy(i % 2 ? "area" : "aspect_ratio"); });
   };
-  for (const auto& [style, outlines] : {std::pair{"obb", true}, {"skeleton", true}, {"obb", false}}) {
-    w.setStyle(style);
+  for (const auto& [s, outlines] : {std::pair{"obb", true}, {"skeleton", true}, {"obb", false}}) {
+    style = s;
+    w.setStyle(s);
     w.setOutlinesVisible(outlines);
     settle(w);
-    std::printf("style %s, parcel outlines %s\n", style, outlines ? "on" : "off");
+    std::printf("style %s, parcel outlines %s\n", s, outlines ? "on" : "off");
     if (outlines) outlined();
     localChanges();
     measure("  omega slider (every block regenerated)", std::max(3, repeats / 3), [&](int i) {
@@ -193,6 +205,7 @@ int main(int argc, char** argv) {
             [&](int i) { w.setParameter("street-angle", 20.0 + i); });
   }
   // Zoomed in 4x on the middle, where parcels of 12 m and more get outlines.
+  style = "obb";
   w.setStyle("obb");
   w.setOutlinesVisible(true);
   settle(w);
