@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -15,6 +17,13 @@
 #include "parcelscope/core/Geometry.h"
 
 namespace parcelscope::test {
+
+/// A random generator for a randomized test, its seed printed (with `what`)
+/// so that a failure can be replayed.
+inline std::mt19937_64 seededRandom(std::uint64_t seed, const char* what) {
+  std::printf("%s seed %llu\n", what, static_cast<unsigned long long>(seed));
+  return std::mt19937_64(seed);
+}
 
 inline Polygon rect(double x0, double y0, double x1, double y1) {
   return Polygon{{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, {}};

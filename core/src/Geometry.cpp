@@ -189,7 +189,7 @@ double segmentDistance(const Point& a, const Point& b, const Point& c, const Poi
 
 bool isClearlySimple(const Ring& r) {
   const std::size_t n = r.size();
-  if (n < 3 || n > 64) return false;
+  if (n < 3) return false;
   const Box b = bounds(r);
   const double eps = 1e-9 * std::max(b.width(), b.height());
   if (!(eps > 0) || std::fabs(signedArea(r)) <= eps * eps) return false;
@@ -205,20 +205,47 @@ bool isClearlySimple(const Ring& r) {
   }
   // Edge boxes grown by eps: edges whose boxes do not meet are farther apart
   // than eps, and need no distance computed.
-  Box boxes[64];
-  for (std::size_t i = 0; i < n; ++i) {
+  const auto edgeBox = [&](std::size_t i) {
     const Point& p = r[i];
     const Point& q = r[(i + 1) % n];
-    boxes[i] = Box{std::min(p.x, q.x), std::min(p.y, q.y), std::max(p.x, q.x), std::max(p.y, q.y)}.expanded(eps);
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    const Point& a = r[i];
-    const Point& a2 = r[(i + 1) % n];
-    for (std::size_t j = i + 2; j < n; ++j) {
-      if (i == 0 && j == n - 1) continue;  // adjacent through the closing vertex
-      if (!boxes[i].intersects(boxes[j])) continue;
-      if (segmentDistance(a, a2, r[j], r[(j + 1) % n]) <= eps) return false;
+    return Box{std::min(p.x, q.x), std::min(p.y, q.y), std::max(p.x, q.x), std::max(p.y, q.y)}.expanded(eps);
+  };
+  // Two edges not adjacent along the ring closer than eps.
+  const auto tooClose = [&](std::size_t i, std::size_t j) {
+    if (i > j) std::swap(i, j);
+    if (j == i + 1 || (i == 0 && j == n - 1)) return false;
+    return segmentDistance(r[i], r[(i + 1) % n], r[j], r[(j + 1) % n]) <= eps;
+  };
+  if (n <= 64) {
+    // Every pair.
+    Box boxes[64];
+    for (std::size_t i = 0; i < n; ++i) boxes[i] = edgeBox(i);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t j = i + 2; j < n; ++j) {
+        if (boxes[i].intersects(boxes[j]) && tooClose(i, j)) return false;
+      }
     }
+    return true;
+  }
+  // A sweep in x: each edge meets only the edges whose boxes are still open
+  // when its own box opens.
+  std::vector<Box> boxes(n);
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    boxes[i] = edgeBox(i);
+    order[i] = i;
+  }
+  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return boxes[x].minX < boxes[y].minX; });
+  std::vector<std::size_t> open;
+  for (const std::size_t i : order) {
+    std::size_t kept = 0;
+    for (const std::size_t j : open) {
+      if (boxes[j].maxX < boxes[i].minX) continue;  // closed before this one opens
+      open[kept++] = j;
+      if (boxes[i].intersects(boxes[j]) && tooClose(i, j)) return false;
+    }
+    open.resize(kept);
+    open.push_back(i);
   }
   return true;
 }

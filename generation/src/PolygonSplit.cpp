@@ -239,10 +239,10 @@ bool isStrictlySimple(const Ring& ring) {
 
 bool isValidForSplit(const Polygon& polygon) {
   if (polygon.outer.size() < 3) return false;
-  // A strictly simple ring is valid (toExact orients it). This test is far
-  // cheaper than the Boolean-operations validation, which still judges
-  // everything else (touching rings, holes).
-  if (polygon.holes.empty() && isStrictlySimple(polygon.outer)) return true;
+  // A strictly simple ring is valid (toExact orients it). These tests (the
+  // conservative one first) are far cheaper than the Boolean-operations
+  // validation, which still judges everything else (touching rings, holes).
+  if (polygon.holes.empty() && (isClearlySimple(polygon.outer) || isStrictlySimple(polygon.outer))) return true;
   return isValidExact(toExact(polygon));
 }
 

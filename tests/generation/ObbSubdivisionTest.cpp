@@ -142,9 +142,7 @@ TEST(ObbSubdivision, LocalEditChangesOnlyNearbyParcels) {
 constexpr int kRandomShapes = 1400 / test::kSanitizerDivisor;
 
 TEST(ObbSubdivision, RandomShapesAreTiledValidlyAndReproducibly) {
-  const std::uint64_t seed = 20261121;
-  std::printf("random shapes seed %llu\n", static_cast<unsigned long long>(seed));
-  std::mt19937_64 rng(seed);
+  std::mt19937_64 rng = test::seededRandom(20261121, "random shapes");
   std::uniform_real_distribution<double> u(0, 1);
   int shapes = 0, parcels = 0, accessExceptions = 0;
   for (int i = 0; i < kRandomShapes; ++i) {
@@ -227,9 +225,7 @@ TEST(ObbSubdivision, ReusedSplitsGiveWhatAFreshRunGives) {
 TEST(ObbSubdivision, ArbitraryPointRingsNeverThrowAndTileWhenValid) {
   // Random rings of 3 to 12 points: mostly self-intersecting, some with repeated
   // or collinear points. Invalid ones come back whole and flagged.
-  const std::uint64_t seed = 99;
-  std::printf("garbage rings seed %llu\n", static_cast<unsigned long long>(seed));
-  std::mt19937_64 rng(seed);
+  std::mt19937_64 rng = test::seededRandom(99, "garbage rings");
   std::uniform_int_distribution<int> count(3, 12), grid(0, 20);
   int failed = 0, tiled = 0;
   for (int i = 0; i < 600; ++i) {

@@ -87,9 +87,7 @@ double totalArea(const SplitPieces& s) {
 }
 
 TEST(PolygonSplit, FastSplitMatchesExactSplitOnRandomShapes) {
-  const std::uint64_t seed = 5;
-  std::printf("random shapes seed %llu\n", static_cast<unsigned long long>(seed));
-  std::mt19937_64 rng(seed);
+  std::mt19937_64 rng = test::seededRandom(5, "random shapes");
   std::uniform_real_distribution<double> u(0, 1);
   int fast = 0, declined = 0, multiple = 0, pinched = 0;
   for (int i = 0; i < 2000 / test::kSanitizerDivisor; ++i) {

@@ -247,9 +247,7 @@ SkeletonParameters randomParameters(std::mt19937_64& rng, double a, bool offset,
 }
 
 TEST(SkeletonSubdivision, RandomShapesAreTiledValidlyWithStreetAccess) {
-  const std::uint64_t seed = 20261122;
-  std::printf("random shapes seed %llu\n", static_cast<unsigned long long>(seed));
-  std::mt19937_64 rng(seed);
+  std::mt19937_64 rng = test::seededRandom(20261122, "random shapes");
   std::uniform_real_distribution<double> u(0, 1);
   int parcels = 0, fallbacks = 0, withoutAccess = 0, patios = 0;
   for (int i = 0; i < kRandomShapes; ++i) {

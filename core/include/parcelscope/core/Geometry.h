@@ -71,8 +71,9 @@ double segmentDistance(const Point& a, const Point& b, const Point& c, const Poi
 
 /// A fast, conservative validity test for one ring: true only when the ring
 /// clearly is simple (no edge comes within 1e-9 of the ring's size of a
-/// non-adjacent edge, no zero-length edge, no fold-back, non-zero area) and has
-/// at most 64 vertices. False means "not proven": ask GEOS.
+/// non-adjacent edge, no zero-length edge, no fold-back, non-zero area).
+/// False means "not proven": ask GEOS or an exact test. Rings of more than 64
+/// vertices are checked by a sweep over their edges' boxes.
 bool isClearlySimple(const Ring& ring);
 
 /// Convex hull of a point set, counter-clockwise, without collinear points.
