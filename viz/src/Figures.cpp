@@ -1,4 +1,5 @@
 #include "parcelscope/viz/Figures.h"
+
 #include "parcelscope/viz/Scenes.h"
 
 #include <vtkActor.h>
@@ -46,6 +47,7 @@
 #include <limits>
 
 #include "parcelscope/core/Error.h"
+#include "parcelscope/core/Parallel.h"
 
 namespace parcelscope::viz {
 
@@ -738,6 +740,7 @@ void MapLayer::setShapes(const std::vector<const Polygon*>& shapes, const std::v
   Impl& m = *impl_;
   m.rebuilt = 0;
   std::array<std::vector<std::size_t>, kLayerParts> members;
+  std::vector<std::size_t> stale;  // parts to build again
   for (std::size_t k = 0; k < shapes.size(); ++k) {
     // Without groups, runs of consecutive shapes.
     const std::size_t part = groups.empty() ? k * kLayerParts / shapes.size()
@@ -759,9 +762,11 @@ void MapLayer::setShapes(const std::vector<const Polygon*>& shapes, const std::v
     p.members = std::move(members[i]);
     p.hash = hash;
     p.values = std::move(partValues);
-    p.rebuild(shapes, m.metresPerPixel);
-    ++m.rebuilt;
+    stale.push_back(i);
   }
+  // The parts share nothing: they are triangulated side by side.
+  parallelFor(stale.size(), [&](std::size_t i) { m.parts[stale[i]].rebuild(shapes, m.metresPerPixel); });
+  m.rebuilt = stale.size();
   m.shapes = shapes.size();
 }
 
