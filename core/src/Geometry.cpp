@@ -312,8 +312,9 @@ OrientedBox smallestBoxAlongEdges(const Ring& hull, const Ring& edges) {
   return best;
 }
 
-OrientedBox minimumAreaBox(const Ring& ring) {
-  const Ring hull = convexHull(ring);
+OrientedBox minimumAreaBox(const Ring& ring) { return minimumAreaBoxOfHull(convexHull(ring)); }
+
+OrientedBox minimumAreaBoxOfHull(const Ring& hull) {
   if (hull.size() >= 3) return smallestBoxAlongEdges(hull, hull);
   OrientedBox best;  // degenerate: a segment or a point
   if (hull.size() == 2) {

@@ -77,8 +77,9 @@ using Node = ObbSplits::Node;
 using NodePtr = std::shared_ptr<const Node>;
 
 // The OBB of Vanegas et al.: the smallest box with a side along one of the
-// ring's own edges (edge-aligned, so small edits elsewhere do not turn it).
-OrientedBox edgeAlignedBox(const Ring& ring) { return smallestBoxAlongEdges(convexHull(ring), ring); }
+// ring's own edges (edge-aligned, so small edits elsewhere do not turn it),
+// given the ring's convex hull.
+OrientedBox edgeAlignedBox(const Ring& ring, const Ring& hull) { return smallestBoxAlongEdges(hull, ring); }
 
 constexpr std::size_t kMaxParcelsPerBlock = 200000;
 
@@ -169,7 +170,14 @@ private:
   enum class Verdict { Admissible, TooSmall, Unclean };
   Verdict judge(const std::vector<Polygon>& parts, const Point& through, const Point& dir) const {
     for (const Polygon& part : parts) {
-      if (area(part) < p_.aMin || minimumAreaBox(part.outer).width < p_.wMin) return Verdict::TooSmall;
+      const double a = area(part);
+      if (a < p_.aMin) return Verdict::TooSmall;
+      // A shape of area A and diameter D is at least A / D wide (its hull lies
+      // in a strip of its least width, at most D long), and so is every box
+      // around it: when that bound clears W_min, no box is needed.
+      const Box b = bounds(part);
+      if (a >= p_.wMin * norm(b.width(), b.height()) * (1 + 1e-9)) continue;
+      if (minimumAreaBox(part.outer).width < p_.wMin) return Verdict::TooSmall;
     }
     for (const Polygon& part : parts) {
       if (!cutIsClean(part, through, dir)) return Verdict::Unclean;
@@ -221,9 +229,9 @@ private:
   // The split of a piece that does not fit: its parts in a fixed order (along
   // the OBB axes, so seeds follow position) with their access; no parts when
   // no candidate is admissible.
-  ObbSplits::Split split(const Polygon& piece, bool access, bool wantAccess, double shiftAcross,
+  ObbSplits::Split split(const Polygon& piece, const Ring& hull, bool access, bool wantAccess, double shiftAcross,
                          double shiftAlong) const {
-    const OrientedBox box = edgeAlignedBox(piece.outer);
+    const OrientedBox box = edgeAlignedBox(piece.outer, hull);
     const Point u = box.u, v{-box.u.y, box.u.x};
     std::vector<Candidate> candidates = {{false, 0.25 * box.length * shiftAcross}};
     bool accessTried = false;
@@ -288,7 +296,8 @@ private:
 
   NodePtr recurse(const Polygon& piece, std::uint64_t seed, bool access, int depth, const NodePtr& previous) {
     const double a = area(piece);
-    const OrientedBox measured = minimumAreaBox(piece.outer);
+    const Ring hull = convexHull(piece.outer);  // for the fit test and the split's box
+    const OrientedBox measured = minimumAreaBoxOfHull(hull);
     const bool fits = a <= p_.aMax && measured.width <= p_.wMax;
     // Safety nets against pathological bounds: recursion depth and a budget of
     // parcels per block.
@@ -307,7 +316,7 @@ private:
     if (previous && previous->split) {
       node->split = previous->split;
     } else {
-      node->split = std::make_shared<const ObbSplits::Split>(split(piece, access, wantAccess, shiftAcross, shiftAlong));
+      node->split = std::make_shared<const ObbSplits::Split>(split(piece, hull, access, wantAccess, shiftAcross, shiftAlong));
     }
     const ObbSplits::Split& chosen = *node->split;
     if (chosen.parts.empty()) {

@@ -100,4 +100,7 @@ OrientedBox smallestBoxAlongEdges(const Ring& hull, const Ring& edges);
 /// first hull edge, so the result is deterministic.
 OrientedBox minimumAreaBox(const Ring& ring);
 
+/// minimumAreaBox of a ring whose convex hull (as convexHull gives it) is `hull`.
+OrientedBox minimumAreaBoxOfHull(const Ring& hull);
+
 }  // namespace parcelscope
