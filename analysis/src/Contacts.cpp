@@ -302,6 +302,7 @@ double sharedLength(const Polygon& a, const Polygon& b, double tolerance) {
 
 std::vector<double> lengthAlong(const std::vector<const Polygon*>& polygons, const std::vector<Ring>& rings,
                                 double tolerance) {
+  constexpr std::ptrdiff_t kScanCutoff = 1000;
   std::vector<EdgeInfo> edges, ringEdges;
   std::vector<EdgeBox> boxes, ringBoxes;
   for (std::size_t i = 0; i < polygons.size(); ++i) {
@@ -309,15 +310,17 @@ std::vector<double> lengthAlong(const std::vector<const Polygon*>& polygons, con
   }
   for (const Ring& r : rings) addRingEdges(r, -1, 0.5 * tolerance, ringEdges, ringBoxes);
   std::vector<Cover> covers;
-  CGAL::box_intersection_d(boxes.begin(), boxes.end(), ringBoxes.begin(), ringBoxes.end(),
-                           [&](const EdgeBox& x, const EdgeBox& y) {
-                             const EdgeInfo& e = edges[x.info()];
-                             const EdgeInfo& f = ringEdges[y.info()];
-                             double lo = 0, hi = 0;
-                             if (coveredInterval(*e.p, *e.q, *f.p, *f.q, tolerance, lo, hi)) {
-                               covers.push_back({x.info(), -1, lo, hi});
-                             }
-                           });
+  // One block's edges at a time: below kScanCutoff boxes a side, CGAL scans
+  // them sorted along x (its segment tree costs more than it saves there).
+  CGAL::box_intersection_d(
+      boxes.begin(), boxes.end(), ringBoxes.begin(), ringBoxes.end(),
+      [&](const EdgeBox& x, const EdgeBox& y) {
+        const EdgeInfo& e = edges[x.info()];
+        const EdgeInfo& f = ringEdges[y.info()];
+        double lo = 0, hi = 0;
+        if (coveredInterval(*e.p, *e.q, *f.p, *f.q, tolerance, lo, hi)) covers.push_back({x.info(), -1, lo, hi});
+      },
+      kScanCutoff);
   std::vector<double> out(polygons.size(), 0.0);
   sumCovers(covers, edges, [&](int measured, int, double length) { out[measured] += length; });
   return out;
