@@ -182,10 +182,10 @@ private:
     for (const Polygon& part : parts) {
       if (!cutIsClean(part, through, dir)) return Verdict::Unclean;
       // GEOS validity, skipped for rings proven simple (a ring with no holes
-      // and non-zero area is valid when simple): the conservative test, and
-      // for long rings it doubts the exact sweep too.
-      const bool simple = part.holes.empty() && (isClearlySimple(part.outer) ||
-                                                 (part.outer.size() > 16 && detail::isStrictlySimple(part.outer)));
+      // and non-zero area is valid when simple): the conservative test for
+      // short rings, the exact sweep (after the conservative test) for long ones.
+      const bool simple = part.holes.empty() && (part.outer.size() <= 16 ? isClearlySimple(part.outer)
+                                                                          : detail::isStrictlySimple(part.outer));
       if (!simple && !io::isValid(part)) return Verdict::Unclean;
     }
     return Verdict::Admissible;

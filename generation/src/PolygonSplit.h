@@ -10,7 +10,8 @@
 namespace parcelscope::generation::detail {
 
 /// True when the ring is simple: no two edges meet except neighbours at their
-/// shared vertex (exact predicates on the doubles, a sweep: fast on long rings).
+/// shared vertex (isClearlySimple first; else exact predicates on the doubles,
+/// a sweep: fast on long rings).
 bool isStrictlySimple(const Ring& ring);
 
 /// True when CGAL accepts the polygon as a valid polygon with holes (simple
