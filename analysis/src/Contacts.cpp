@@ -44,6 +44,12 @@ void addEdges(const Polygon& polygon, int index, double grow, std::vector<EdgeIn
   for (const auto& h : polygon.holes) addRingEdges(h, index, grow, edges, boxes);
 }
 
+// Closed boxes meet (CGAL's default topology for box_intersection_d).
+bool closedBoxesMeet(const EdgeBox& a, const EdgeBox& b) {
+  return a.min_coord(0) <= b.max_coord(0) && b.min_coord(0) <= a.max_coord(0) && a.min_coord(1) <= b.max_coord(1) &&
+         b.min_coord(1) <= a.max_coord(1);
+}
+
 // (edge of the measured polygon, other polygon, interval) records, grouped to
 // take the union of intervals per edge and polygon pair.
 struct Cover {
@@ -303,6 +309,7 @@ double sharedLength(const Polygon& a, const Polygon& b, double tolerance) {
 std::vector<double> lengthAlong(const std::vector<const Polygon*>& polygons, const std::vector<Ring>& rings,
                                 double tolerance) {
   constexpr std::ptrdiff_t kScanCutoff = 1000;
+  constexpr std::size_t kEveryPairUpTo = 16384;
   std::vector<EdgeInfo> edges, ringEdges;
   std::vector<EdgeBox> boxes, ringBoxes;
   for (std::size_t i = 0; i < polygons.size(); ++i) {
@@ -310,17 +317,25 @@ std::vector<double> lengthAlong(const std::vector<const Polygon*>& polygons, con
   }
   for (const Ring& r : rings) addRingEdges(r, -1, 0.5 * tolerance, ringEdges, ringBoxes);
   std::vector<Cover> covers;
-  // One block's edges at a time: below kScanCutoff boxes a side, CGAL scans
-  // them sorted along x (its segment tree costs more than it saves there).
-  CGAL::box_intersection_d(
-      boxes.begin(), boxes.end(), ringBoxes.begin(), ringBoxes.end(),
-      [&](const EdgeBox& x, const EdgeBox& y) {
-        const EdgeInfo& e = edges[x.info()];
-        const EdgeInfo& f = ringEdges[y.info()];
-        double lo = 0, hi = 0;
-        if (coveredInterval(*e.p, *e.q, *f.p, *f.q, tolerance, lo, hi)) covers.push_back({x.info(), -1, lo, hi});
-      },
-      kScanCutoff);
+  auto cover = [&](const EdgeBox& x, const EdgeBox& y) {
+    const EdgeInfo& e = edges[x.info()];
+    const EdgeInfo& f = ringEdges[y.info()];
+    double lo = 0, hi = 0;
+    if (coveredInterval(*e.p, *e.q, *f.p, *f.q, tolerance, lo, hi)) covers.push_back({x.info(), -1, lo, hi});
+  };
+  if (boxes.size() * ringBoxes.size() <= kEveryPairUpTo) {
+    // A generated block's parcels against its outline: testing every pair of
+    // boxes costs less than sorting them. The pairs are those CGAL reports.
+    for (const EdgeBox& x : boxes) {
+      for (const EdgeBox& y : ringBoxes) {
+        if (closedBoxesMeet(x, y)) cover(x, y);
+      }
+    }
+  } else {
+    // One block's edges at a time: below kScanCutoff boxes a side, CGAL scans
+    // them sorted along x (its segment tree costs more than it saves there).
+    CGAL::box_intersection_d(boxes.begin(), boxes.end(), ringBoxes.begin(), ringBoxes.end(), cover, kScanCutoff);
+  }
   std::vector<double> out(polygons.size(), 0.0);
   sumCovers(covers, edges, [&](int measured, int, double length) { out[measured] += length; });
   return out;

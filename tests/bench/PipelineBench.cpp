@@ -283,6 +283,7 @@ void SessionUpdate(benchmark::State& state) {
   session.update(request);
   int i = 0;
   std::size_t regenerated = 0;
+  double generateMs = 0, metricsMs = 0;
   for (auto _ : state) {
     if (wMax) {
       request.parameters["w-max"] = ++i % 2 ? 25.0 : 35.0;
@@ -292,9 +293,16 @@ void SessionUpdate(benchmark::State& state) {
     } else {
       request.overrides[100].parameters["a-max"] = ++i % 2 ? 400.0 : 600.0;
     }
-    regenerated = session.update(request).blocksRegenerated;
+    const auto update = session.update(request);
+    regenerated = update.blocksRegenerated;
+    for (const auto& [stage, seconds] : update.result->seconds) {
+      if (stage == "generate") generateMs += 1e3 * seconds;
+      if (stage == "metrics") metricsMs += 1e3 * seconds;
+    }
   }
   state.counters["blocks_regenerated"] = static_cast<double>(regenerated);
+  state.counters["generate_ms"] = benchmark::Counter(generateMs, benchmark::Counter::kAvgIterations);
+  state.counters["metrics_ms"] = benchmark::Counter(metricsMs, benchmark::Counter::kAvgIterations);
   state.SetLabel(request.style + (wMax     ? ", W_max for every block"
                                   : global ? ", omega for every block"
                                            : ", one block's A_max"));

@@ -1,0 +1,91 @@
+// Candidate pairs and frontage lengths take a short path for small inputs
+// (one block) and CGAL's box intersection for large ones; both must find the
+// same pairs and lengths.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+#include "BoxPairs.h"
+#include "Contacts.h"
+#include "TestUtil.h"
+
+using namespace parcelscope;
+
+namespace {
+// Boxes on a coarse integer grid, so that many only touch along a side or a corner.
+std::vector<Box> randomBoxes(std::mt19937_64& rng, std::size_t n, int extent) {
+  std::uniform_int_distribution<int> at(0, extent), size(0, 4);
+  std::vector<Box> boxes(n);
+  for (Box& b : boxes) {
+    const double x = at(rng), y = at(rng);
+    b = {x, y, x + size(rng), y + size(rng)};
+  }
+  return boxes;
+}
+}  // namespace
+
+TEST(BoxPairs, EveryMeetingPairOnceSortedAtEverySize) {
+  auto rng = test::seededRandom(20261121, "BoxPairs");
+  // Up to one block every pair is tested, then CGAL searches one slab of the
+  // plane per core (from 20,000 boxes).
+  for (std::size_t n : {0, 1, 2, 7, 64, 128, 129, 300, 2000, 30000}) {
+    const std::vector<Box> boxes = randomBoxes(rng, n, static_cast<int>(std::sqrt(double(n)) * 3) + 1);
+    // Expected: boxes in order of minX, each against those starting before it ends.
+    std::vector<std::size_t> order(n);
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return boxes[a].minX < boxes[b].minX; });
+    std::vector<std::pair<int, int>> expected;
+    for (std::size_t k = 0; k < n; ++k) {
+      const Box& a = boxes[order[k]];
+      for (std::size_t l = k + 1; l < n && boxes[order[l]].minX <= a.maxX; ++l) {
+        if (a.intersects(boxes[order[l]])) {
+          expected.emplace_back(int(std::min(order[k], order[l])), int(std::max(order[k], order[l])));
+        }
+      }
+    }
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(analysis::detail::intersectingPairs(boxes), expected) << n << " boxes";
+    if (n >= 64) {
+      EXPECT_GT(expected.size(), n / 4) << "the boxes should crowd";
+    }
+  }
+}
+
+TEST(LengthAlong, SameLengthsWhetherEveryEdgePairIsTestedOrCgalScans) {
+  std::mt19937 rng(7);
+  // Lots of a 3 x 3 grid with jittered corners, along the grid's outer square.
+  const std::vector<Polygon> lots = test::jitteredGrid(rng, 3, 3, 1.0);
+  const Ring square = {{0, 0}, {30, 0}, {30, 30}, {0, 30}};
+  std::vector<const Polygon*> one;
+  for (const Polygon& p : lots) one.push_back(&p);
+  const std::vector<double> alone = analysis::detail::lengthAlong(one, {square}, 0.5);
+  ASSERT_EQ(alone.size(), lots.size());
+  int fronting = 0;
+  for (double f : alone) fronting += f > 1.0;
+  EXPECT_EQ(fronting, 8) << "every lot but the middle one fronts the square";
+  EXPECT_EQ(alone[4], 0.0);
+
+  // 30 copies 100 m apart: too many edge pairs to test every one.
+  constexpr int kCopies = 30;
+  std::vector<Polygon> copies;
+  std::vector<Ring> squares;
+  for (int c = 0; c < kCopies; ++c) {
+    for (Polygon p : lots) {
+      for (Point& q : p.outer) q.x += 100.0 * c;
+      copies.push_back(p);
+    }
+    Ring r = square;
+    for (Point& q : r) q.x += 100.0 * c;
+    squares.push_back(r);
+  }
+  std::vector<const Polygon*> all;
+  for (const Polygon& p : copies) all.push_back(&p);
+  const std::vector<double> together = analysis::detail::lengthAlong(all, squares, 0.5);
+  ASSERT_EQ(together.size(), copies.size());
+  for (std::size_t i = 0; i < copies.size(); ++i) {
+    EXPECT_NEAR(together[i], alone[i % lots.size()], 1e-9) << "lot " << i;
+  }
+}
