@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <exception>
 #include <mutex>
 #include <thread>
@@ -40,6 +41,9 @@ void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
     if (!error) error = e;
     stop = true;
   };
+  // The ticking thread sleeps between ticks until the last item is done.
+  std::mutex finishedMutex;
+  std::condition_variable finished;
   auto work = [&] {
     const InsideLoop inside;
     for (std::size_t i; !stop && (i = next.fetch_add(1)) < n;) {
@@ -48,7 +52,10 @@ void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
       } catch (...) {
         fail(std::current_exception());
       }
-      done.fetch_add(1);
+      if (done.fetch_add(1) + 1 == n) {
+        std::lock_guard<std::mutex> lock(finishedMutex);
+        finished.notify_all();
+      }
     }
   };
   const unsigned threads = static_cast<unsigned>(std::min<std::size_t>(workerCount(), n));
@@ -63,7 +70,8 @@ void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
       } catch (...) {
         fail(std::current_exception());
       }
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      std::unique_lock<std::mutex> lock(finishedMutex);
+      finished.wait_for(lock, std::chrono::milliseconds(5), [&] { return stop || done.load() >= n; });
     }
   } else {
     work();

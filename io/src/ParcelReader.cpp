@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <limits>
 #include <sstream>
+#include <string_view>
 #include <unordered_map>
 
 #include "OgrConvert.h"
@@ -293,7 +294,15 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
   // Pass 1: read features, collapse exact duplicate geometries, find the extent.
   const GIntBig total = layer->GetFeatureCount(FALSE);
   std::vector<Feature> features;
-  std::unordered_map<std::string, std::size_t> byGeometry;
+  // Features by the hash of their WKB; the bytes are compared again (exported
+  // anew) only when hashes meet, so no copy of every geometry is kept.
+  std::unordered_multimap<std::size_t, std::size_t> byHash;
+  std::string wkb, earlier;
+  auto exportWkb = [](const OGRGeometry& g, std::string& out) {
+    out.resize(static_cast<std::size_t>(g.WkbSize()));
+    g.exportToWkb(wkbNDR, reinterpret_cast<unsigned char*>(out.data()), wkbVariantIso);
+  };
+  if (total > 0) byHash.reserve(static_cast<std::size_t>(total));
   Envelope env;
   layer->ResetReading();
   for (auto& feature : *layer) {
@@ -307,13 +316,16 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
       ++report.nullOrEmpty;
       continue;
     }
-    std::string wkb(static_cast<std::size_t>(g->WkbSize()), '\0');
-    g->exportToWkb(wkbNDR, reinterpret_cast<unsigned char*>(wkb.data()), wkbVariantIso);
-    auto [it, inserted] = byGeometry.emplace(std::move(wkb), features.size());
-    if (!inserted) {
-      Feature& original = features[it->second];
-      if (original.stackCount == 1) ++report.duplicateStacks;
-      ++original.stackCount;
+    exportWkb(*g, wkb);
+    const std::size_t hash = std::hash<std::string_view>{}(wkb);
+    Feature* original = nullptr;
+    for (auto [it, end] = byHash.equal_range(hash); it != end && !original; ++it) {
+      exportWkb(*features[it->second].geometry, earlier);
+      if (earlier == wkb) original = &features[it->second];
+    }
+    if (original) {
+      if (original->stackCount == 1) ++report.duplicateStacks;
+      ++original->stackCount;
       ++report.duplicatesCollapsed;
       continue;
     }
@@ -331,6 +343,7 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
       values.push_back(idx >= 0 && feature->IsFieldSetAndNotNull(idx) ? feature->GetFieldAsDouble(idx)
                                                                     : std::numeric_limits<double>::quiet_NaN());
     }
+    byHash.emplace(hash, features.size());
     features.push_back(
         {feature->GetFID(), std::unique_ptr<OGRGeometry>(feature->StealGeometry()), 1, std::move(values)});
   }
