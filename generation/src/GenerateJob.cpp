@@ -282,8 +282,11 @@ BlockOutcome runBlock(const BlockInputs& inputs, std::size_t entry, const BlockP
     const bool reusable = previous && previous->subdivision.obbSplits && reuse.previousPlan->style == "obb" &&
                           reuse.previousPlan->seed == plan.seed &&
                           obbSplitsReusable(reuse.previousPlan->parameters.bounds, plan.parameters.bounds);
+    // A block an earlier OBB run subdivided passed the validity check then.
+    const bool checked = previous && reuse.previousPlan->style == "obb" && !previous->subdivision.failed &&
+                         !previous->subdivision.fallback;
     o.subdivision = subdivideObb(inputs.entries[entry].shape, plan.parameters.bounds, plan.seed,
-                                 {reusable ? previous->subdivision.obbSplits.get() : nullptr, reuse.record});
+                                 {reusable ? previous->subdivision.obbSplits.get() : nullptr, reuse.record, checked});
   } else {
     // The layout checks for itself that it was made for this block and these parameters.
     const SkeletonLayout* layout = previous ? previous->subdivision.skeletonLayout.get() : nullptr;

@@ -208,11 +208,21 @@ private:
         const Point& p = r[i];
         const Point& q = r[(i + 1) % n];
         if (offLine(p) > onLine || offLine(q) > onLine) continue;  // not a cut edge
+        // Edges whose boxes stay farther than the clearance from the cut
+        // edge's box are farther from the edge itself.
+        const Box near = Box{std::min(p.x, q.x), std::min(p.y, q.y), std::max(p.x, q.x), std::max(p.y, q.y)}
+                             .expanded(clearance);
         for (std::size_t rj = 0; rj < rings.size(); ++rj) {
           const Ring& t = *rings[rj];
           for (std::size_t j = 0, m = t.size(); j < m; ++j) {
             if (rj == ri && (j == i || j == (i + 1) % n || (j + 1) % m == i)) continue;  // itself, neighbours
-            if (segmentDistance(p, q, t[j], t[(j + 1) % m]) <= clearance) return false;
+            const Point& c = t[j];
+            const Point& d = t[(j + 1) % m];
+            if (std::max(c.x, d.x) < near.minX || std::min(c.x, d.x) > near.maxX || std::max(c.y, d.y) < near.minY ||
+                std::min(c.y, d.y) > near.maxY) {
+              continue;
+            }
+            if (segmentDistance(p, q, c, d) <= clearance) return false;
           }
         }
         // Fold-back at either end: the neighbouring edge returns along the cut.
@@ -356,7 +366,7 @@ Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, 
   const Point o = detail::exactShiftOrigin(block);
   Polygon local = detail::translated(block, -o.x, -o.y);
   try {
-    if (!normalise(local) || !detail::isValidForSplit(local)) {
+    if (!normalise(local) || (!reuse.blockChecked && !detail::isValidForSplit(local))) {
       out.failed = true;
       out.failure = "block is not a valid polygon with holes for exact splitting";
     } else {

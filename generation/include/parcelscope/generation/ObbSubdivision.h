@@ -70,6 +70,9 @@ struct ObbReuse {
   /// parameters pass obbSplitsReusable; nullptr: split afresh.
   const ObbSplits* previous = nullptr;
   bool record = false;  ///< keep this run's splits (with those reused) in Subdivision::obbSplits
+  /// The block passed the validity check in an earlier run that did not fail:
+  /// the check is skipped.
+  bool blockChecked = false;
 };
 
 /// True when splits recorded with `recorded` serve a run with `wanted`: every
