@@ -418,12 +418,15 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
   for (const int s : {1, -1}) {
     for (std::size_t start = 0; start < m; ++start) {
       if (nodes[start].side != s || visited[start] || nodes[start].touch) continue;
-      Polygon piece;
+      // The walk collects the ring in a buffer kept across pieces, copied out
+      // once at its size.
+      thread_local Ring walked;
+      walked.clear();
       const int id = pieces++;
       // A piece that passes one of its touches twice is pinched onto itself
       // (the exact split makes a hole of it, or a ring touching itself).
       const auto pass = [&](std::size_t k) {
-        piece.outer.push_back(nodes[k].p);
+        walked.push_back(nodes[k].p);
         visited[k] = 1;
         if (!nodes[k].touch) return true;
         if (inPiece[k] == id) return false;
@@ -436,7 +439,7 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
         if (!pass(k)) return false;
         const bool leaves = nodes[k].side == 0 ? sideAfter(k) == -s : nodes[k].touch && nodes[k].exit >= 0;
         if (leaves) {
-          for (const int t : nodes[k].through) piece.outer.push_back(nodes[static_cast<std::size_t>(t)].p);
+          for (const int t : nodes[k].through) walked.push_back(nodes[static_cast<std::size_t>(t)].p);
           k = static_cast<std::size_t>(nodes[k].exit);
           if (!pass(k)) return false;
         }
@@ -444,10 +447,13 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
         if (k == start) break;
       }
       // Start at the lowest vertex in x-then-y order.
-      Ring& ring = piece.outer;
-      std::rotate(ring.begin(), std::min_element(ring.begin(), ring.end(), [](const Point& p, const Point& q) {
-                    return p.x < q.x || (p.x == q.x && p.y < q.y);
-                  }), ring.end());
+      Polygon piece;
+      const auto lowest = std::min_element(walked.begin(), walked.end(), [](const Point& p, const Point& q) {
+        return p.x < q.x || (p.x == q.x && p.y < q.y);
+      });
+      piece.outer.reserve(walked.size());
+      piece.outer.insert(piece.outer.end(), lowest, walked.end());
+      piece.outer.insert(piece.outer.end(), walked.begin(), lowest);
       if (normalise(piece)) (s > 0 ? result.left : result.right).push_back(std::move(piece));
     }
   }
