@@ -146,7 +146,7 @@ private:
       // A piece pinched at a point is never admissible: the exact split gives
       // it as one ring touching itself, which is not clean (nor valid).
       if (split.left.empty() || split.right.empty() || split.pinched) return {};
-      std::vector<Polygon> parts = joined(split);
+      std::vector<Polygon> parts = joined(std::move(split));
       double sum = 0;
       for (const Polygon& part : parts) sum += area(part);
       if (std::fabs(sum - area(piece)) <= 1e-9 * area(piece)) {
@@ -157,13 +157,13 @@ private:
     }
     split = detail::splitByLine(piece, through, dir);
     if (split.left.empty() || split.right.empty()) return {};
-    std::vector<Polygon> parts = joined(split);
+    std::vector<Polygon> parts = joined(std::move(split));
     return judge(parts, through, dir) == Verdict::Admissible ? parts : std::vector<Polygon>{};
   }
 
-  static std::vector<Polygon> joined(const detail::SplitPieces& split) {
-    std::vector<Polygon> parts = split.left;
-    parts.insert(parts.end(), split.right.begin(), split.right.end());
+  static std::vector<Polygon> joined(detail::SplitPieces&& split) {
+    std::vector<Polygon> parts = std::move(split.left);
+    parts.insert(parts.end(), std::make_move_iterator(split.right.begin()), std::make_move_iterator(split.right.end()));
     return parts;
   }
 

@@ -95,9 +95,11 @@ struct OrientedBox {
 /// Vanegas et al. 2012, 4.3.
 OrientedBox smallestBoxAlongEdges(const Ring& hull, const Ring& edges);
 
-/// Minimum-area enclosing rectangle of a ring (rotating calipers over the convex
-/// hull: the optimum has a side on a hull edge). Ties are broken towards the
-/// first hull edge, so the result is deterministic.
+/// Minimum-area enclosing rectangle of a ring: the optimum has a side on a hull
+/// edge, and every hull edge is tried against every hull point (hulls of
+/// parcels are small; rotating calipers saved under 2 % of the OBB style's
+/// instructions on cambridge_ma). Ties are broken towards the first hull edge,
+/// so the result is deterministic.
 OrientedBox minimumAreaBox(const Ring& ring);
 
 /// minimumAreaBox of a ring whose convex hull (as convexHull gives it) is `hull`.
