@@ -415,12 +415,12 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
   std::vector<char> visited(m, 0);
   std::vector<int> inPiece(m, -1);  // touches: the last piece that passed them
   int pieces = 0;
+  // Each walk collects its ring in a buffer kept across pieces and calls, then
+  // copies it out once at its size.
+  thread_local Ring walked;
   for (const int s : {1, -1}) {
     for (std::size_t start = 0; start < m; ++start) {
       if (nodes[start].side != s || visited[start] || nodes[start].touch) continue;
-      // The walk collects the ring in a buffer kept across pieces, copied out
-      // once at its size.
-      thread_local Ring walked;
       walked.clear();
       const int id = pieces++;
       // A piece that passes one of its touches twice is pinched onto itself
