@@ -140,17 +140,19 @@ private:
   // area and pass the checks; when they fail the cleanliness or validity
   // check, and whenever the fast path does not apply, the exact split decides.
   // (A pinched split is refused either way.)
-  std::vector<Polygon> admissibleSplit(const Polygon& piece, const Point& through, const Point& dir) const {
+  std::vector<Polygon> admissibleSplit(const Polygon& piece, double pieceArea, const Point& through,
+                                       const Point& dir) const {
     detail::SplitPieces split;
+    std::vector<double> areas;
     if (detail::splitByLineFast(piece, through, dir, split)) {
       // A piece pinched at a point is never admissible: the exact split gives
       // it as one ring touching itself, which is not clean (nor valid).
       if (split.left.empty() || split.right.empty() || split.pinched) return {};
       std::vector<Polygon> parts = joined(std::move(split));
       double sum = 0;
-      for (const Polygon& part : parts) sum += area(part);
-      if (std::fabs(sum - area(piece)) <= 1e-9 * area(piece)) {
-        const Verdict v = judge(parts, through, dir);
+      for (const Polygon& part : parts) sum += areas.emplace_back(area(part));
+      if (std::fabs(sum - pieceArea) <= 1e-9 * pieceArea) {
+        const Verdict v = judge(parts, areas, through, dir);
         if (v == Verdict::Admissible) return parts;
         if (v == Verdict::TooSmall) return {};
       }
@@ -158,7 +160,9 @@ private:
     split = detail::splitByLine(piece, through, dir);
     if (split.left.empty() || split.right.empty()) return {};
     std::vector<Polygon> parts = joined(std::move(split));
-    return judge(parts, through, dir) == Verdict::Admissible ? parts : std::vector<Polygon>{};
+    areas.clear();
+    for (const Polygon& part : parts) areas.push_back(area(part));
+    return judge(parts, areas, through, dir) == Verdict::Admissible ? parts : std::vector<Polygon>{};
   }
 
   static std::vector<Polygon> joined(detail::SplitPieces&& split) {
@@ -168,9 +172,12 @@ private:
   }
 
   enum class Verdict { Admissible, TooSmall, Unclean };
-  Verdict judge(const std::vector<Polygon>& parts, const Point& through, const Point& dir) const {
-    for (const Polygon& part : parts) {
-      const double a = area(part);
+  // `areas[k]` is the area of parts[k].
+  Verdict judge(const std::vector<Polygon>& parts, const std::vector<double>& areas, const Point& through,
+                const Point& dir) const {
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      const Polygon& part = parts[k];
+      const double a = areas[k];
       if (a < p_.aMin) return Verdict::TooSmall;
       // A shape of area A and diameter D is at least A / D wide (its hull lies
       // in a strip of its least width, at most D long), and so is every box
@@ -239,8 +246,8 @@ private:
   // The split of a piece that does not fit: its parts in a fixed order (along
   // the OBB axes, so seeds follow position) with their access; no parts when
   // no candidate is admissible.
-  ObbSplits::Split split(const Polygon& piece, const Ring& hull, bool access, bool wantAccess, double shiftAcross,
-                         double shiftAlong) const {
+  ObbSplits::Split split(const Polygon& piece, double pieceArea, const Ring& hull, bool access, bool wantAccess,
+                         double shiftAcross, double shiftAlong) const {
     const OrientedBox box = edgeAlignedBox(piece.outer, hull);
     const Point u = box.u, v{-box.u.y, box.u.x};
     std::vector<Candidate> candidates = {{false, 0.25 * box.length * shiftAcross}};
@@ -261,7 +268,7 @@ private:
       bool admissible = false;
       const Point snapped = snap(pivot, dir, near);
       for (const Point& through : {snapped, pivot}) {
-        parts = admissibleSplit(piece, through, dir);
+        parts = admissibleSplit(piece, pieceArea, through, dir);
         admissible = !parts.empty();
         if (admissible || (through.x == pivot.x && through.y == pivot.y)) break;
       }
@@ -326,7 +333,8 @@ private:
     if (previous && previous->split) {
       node->split = previous->split;
     } else {
-      node->split = std::make_shared<const ObbSplits::Split>(split(piece, hull, access, wantAccess, shiftAcross, shiftAlong));
+      node->split =
+          std::make_shared<const ObbSplits::Split>(split(piece, a, hull, access, wantAccess, shiftAcross, shiftAlong));
     }
     const ObbSplits::Split& chosen = *node->split;
     if (chosen.parts.empty()) {
