@@ -115,8 +115,7 @@ Json readJson(const std::string& path) {
 
 void writePolygonLayer(const std::string& path, const std::string& layerName,
                        const std::vector<std::vector<Polygon>>& geometries, const Table& attributes,
-                       const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex,
-                       const std::function<void()>& rowsWritten) {
+                       const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex) {
   detail::ensureGdalRegistered();
   detail::QuietErrors quiet;
   CPLErrorReset();
@@ -196,7 +195,6 @@ void writePolygonLayer(const std::string& path, const std::string& layerName,
       }
     }
   }
-  if (rowsWritten) rowsWritten();
   if (!geojson && ds->CommitTransaction() != OGRERR_NONE) throw fail("cannot commit");
   ds.reset();  // flush and close before the caller renames the file
   if (CPLGetLastErrorType() == CE_Failure) throw fail("closing failed");

@@ -483,30 +483,8 @@ analysis::JobOutcome runCompare(const CompareRequest& request, const std::string
   std::vector<std::string> outputs = {parcelsFile,             "blocks.gpkg", "observed_parcels.csv",
                                       "generated_parcels.csv", "blocks.csv",  "summary.csv",
                                       "distances.csv"};
-  // The generated layer goes first, alone with its geometry conversion: its
-  // inserts and then its R-tree (SQLite, one thread) are the longest chain.
-  // Once its rows are in, the block layer (on a thread of its own) and the
-  // tables are written while it builds the index.
-  std::vector<std::vector<Polygon>> geometries;
-  const Table generatedTable = generatedTableOf(r, &geometries);
-  const std::string parcelsGpkg = out.stage(parcelsFile);
-  std::promise<void> rowsIn;
-  std::future<void> parcelWriting = std::async(std::launch::async, [&] {
-    bool told = false;
-    auto tell = [&] {
-      if (!told) rowsIn.set_value();
-      told = true;
-    };
-    try {
-      io::writePolygonLayer(parcelsGpkg, "parcels", geometries, generatedTable, r.observed->layer.frame,
-                            r.observed->layer.crs, spatialIndex, tell);
-    } catch (...) {
-      tell();
-      throw;
-    }
-    tell();
-  });
-  rowsIn.get_future().wait();
+  // The two layers (SQLite inserts, one thread each) are written while this
+  // thread formats and writes the tables.
   const Table blocks = analysis::blockComparisonTable(r.blocks);
   std::vector<std::vector<Polygon>> outlines;
   for (const Block& b : a.blocks) outlines.push_back(b.parts);
@@ -514,6 +492,13 @@ analysis::JobOutcome runCompare(const CompareRequest& request, const std::string
   std::future<void> blockWriting = std::async(std::launch::async, [&] {
     io::writePolygonLayer(blocksGpkg, "blocks", outlines, blocks, r.observed->layer.frame, r.observed->layer.crs,
                           spatialIndex);
+  });
+  std::vector<std::vector<Polygon>> geometries;
+  const Table generatedTable = generatedTableOf(r, &geometries);
+  const std::string parcelsGpkg = out.stage(parcelsFile);
+  std::future<void> parcelWriting = std::async(std::launch::async, [&] {
+    io::writePolygonLayer(parcelsGpkg, "parcels", geometries, generatedTable, r.observed->layer.frame,
+                          r.observed->layer.crs, spatialIndex);
   });
   io::writeCsv(blocksCsv, blocks);
   io::writeCsv(out.stage("generated_parcels.csv"), generatedTable);

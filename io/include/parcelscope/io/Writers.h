@@ -2,7 +2,6 @@
 // Writing tables, vector layers and run records. Every writer writes to the path
 // it is given; atomicity comes from OutputDirectory (write into its staging
 // folder, then commit).
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -33,13 +32,10 @@ Json readJson(const std::string& path);
 /// A GeoPackage layer gets an R-tree spatial index unless `spatialIndex` is
 /// false: GIS tools draw large layers faster with it, and SQLite takes about
 /// 10 microseconds per feature to build it (3 s for 350,000 parcels).
-/// `rowsWritten`, when given, is called once every feature is inserted, before
-/// the index is built and the file closed (on this thread), so that a caller
-/// can start other work for the second core then. Throws Error(IO) on failure.
+/// Throws Error(IO) on failure.
 void writePolygonLayer(const std::string& path, const std::string& layerName,
                        const std::vector<std::vector<Polygon>>& geometries, const Table& attributes,
-                       const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex = true,
-                       const std::function<void()>& rowsWritten = {});
+                       const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex = true);
 
 /// The GDAL version string, for run records.
 std::string gdalVersion();
