@@ -3,6 +3,7 @@
 // geometry fetched). Target: the pipeline within 3x of the plain read.
 // 2) OBB subdivision of every block. 3) The whole `compare` job, stage by stage
 // (figures only when an X server answers: run under scripts/with-xvfb.sh).
+// 4) The application's session update and its procedural view's geometry.
 //   build/release/tests/bench/parcelscope_bench
 //   scripts/with-xvfb.sh build/release/tests/bench/parcelscope_bench --benchmark_filter=Compare
 #include <benchmark/benchmark.h>
@@ -12,6 +13,7 @@
 #include <cpl_json.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <chrono>
 #include <cstdio>
@@ -24,6 +26,7 @@
 #include "parcelscope/generation/GenerateJob.h"
 #include "parcelscope/viz/CompareJob.h"
 #include "parcelscope/viz/CompareSession.h"
+#include "parcelscope/viz/Scenes.h"
 
 namespace {
 
@@ -316,5 +319,40 @@ BENCHMARK(SessionUpdate)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(3.0);
+
+// The display geometry behind the procedural view after an omega change on
+// cambridge_ma: every generated parcel triangulated again and handed to VTK,
+// grouped by block as the application does (MapLayer::setShapes).
+void MapLayerUpdate(benchmark::State& state) {
+  if (!haveData(state)) return;
+  parcelscope::viz::CompareRequest request;
+  request.input.path = kCambridge;
+  request.input.where = "ML <> 'ROAD'";
+  request.style = "obb";
+  request.parameters = parcelscope::defaultValues(parcelscope::viz::compareParameters());
+  request.parameters["figures"] = 0;
+  request.explicitParameters.insert("omega");
+  parcelscope::viz::CompareSession session;
+  std::array<std::shared_ptr<const parcelscope::viz::CompareResult>, 2> results;
+  for (int k = 0; k < 2; ++k) {
+    request.parameters["omega"] = k == 0 ? 0.25 : 0.35;
+    results[static_cast<std::size_t>(k)] = session.update(request).result;
+  }
+  parcelscope::viz::MapLayer layer;
+  std::size_t i = 0, shapes = 0;
+  for (auto _ : state) {
+    const parcelscope::viz::CompareResult& r = *results[++i % 2];
+    std::vector<const parcelscope::Polygon*> polygons;
+    std::vector<int> blocks(r.generated.parcels.size(), -1);
+    for (std::size_t b = 0; b < r.generated.blocks.size(); ++b) {
+      for (int p : r.generated.blocks[b].parcels) blocks[static_cast<std::size_t>(p)] = static_cast<int>(b);
+    }
+    for (const auto& parcel : r.generated.parcels) polygons.push_back(&parcel);
+    layer.setShapes(polygons, std::vector<double>(polygons.size(), 1.0), blocks);
+    shapes = polygons.size();
+  }
+  state.counters["shapes"] = static_cast<double>(shapes);
+}
+BENCHMARK(MapLayerUpdate)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
 BENCHMARK_MAIN();

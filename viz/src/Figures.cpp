@@ -7,7 +7,7 @@
 #include <vtkBrush.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
-#include <vtkCellData.h>
+#include <vtkPointData.h>
 #include <vtkChartLegend.h>
 #include <vtkChartXY.h>
 #include <vtkContextScene.h>
@@ -23,6 +23,7 @@
 #include <vtkPlotLine.h>
 #include <vtkPoints.h>
 #include <vtkIdList.h>
+#include <vtkIdTypeArray.h>
 #include <vtkPolyData.h>
 #include <vtkPolygon.h>
 #include <vtkPolyDataMapper.h>
@@ -46,6 +47,7 @@
 #include <filesystem>
 #include <limits>
 
+#include "EarClip.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
 
@@ -194,7 +196,8 @@ bool isConvex(const Ring& ring) {
 
 // Triangles of a shape as cells (count, point ids...) with ids relative to the
 // shape's first point, by a hash of the shape's coordinates: a map redrawn with
-// mostly the same shapes triangulates only the new ones.
+// mostly the same shapes triangulates only the new ones (those VTK
+// triangulates; fans and ear clipping cost less than the lookup).
 using TriangleCache = std::unordered_map<std::uint64_t, std::vector<vtkIdType>>;
 
 std::uint64_t shapeHash(const Polygon& shape) {
@@ -218,17 +221,13 @@ std::uint64_t shapeHash(const Polygon& shape) {
 }
 
 // Triangle cells of one shape whose rings were appended from point 0 (outer
-// ring, then holes), ids relative to that point.
+// ring, then holes), ids relative to that point: VTK's ear cut for a ring
+// too large for earClip or refused by it, VTK's contour triangulator for a
+// shape with holes.
 std::vector<vtkIdType> triangulate(const Polygon& shape, vtkPolygon* earCut, vtkIdList* earIds) {
   std::vector<vtkIdType> cells;
   const auto n = static_cast<vtkIdType>(shape.outer.size());
-  // A convex shape without holes (most parcels) is a triangle fan.
-  if (shape.holes.empty() && isConvex(shape.outer)) {
-    for (vtkIdType i = 1; i + 1 < n; ++i) cells.insert(cells.end(), {3, 0, i, i + 1});
-    return cells;
-  }
   if (shape.holes.empty()) {
-    // Ear cutting of one simple ring (vtkPolygon), reusing its buffers.
     earCut->GetPoints()->SetNumberOfPoints(n);
     earCut->GetPointIds()->SetNumberOfIds(n);
     for (vtkIdType i = 0; i < n; ++i) {
@@ -271,62 +270,111 @@ std::vector<vtkIdType> triangulate(const Polygon& shape, vtkPolygon* earCut, vtk
   return cells;
 }
 
-// Triangles filling every shape (holes left open), one cell value per
-// triangle, and the rings of shapes at least `minOutlined` across
-// (outlineSize) as closed polylines. With `cache`, shapes found in it are not
-// triangulated again, and it is left holding this panel's shapes.
-void buildPanel(const MapPanel& panel, PanelGeometry& g, std::vector<vtkIdType>* trianglesPerShape = nullptr,
+// Triangles filling every shape (holes left open), each shape's points
+// carrying its value (a point value, not a cell value per triangle: a cell
+// value costs VTK a colour texture rebuilt and read per pixel), and the rings
+// of shapes at least `minOutlined` across (outlineSize) as closed polylines.
+// A convex shape without holes is a fan, another ring of up to
+// kEarClipMaxVertices is clipped into ears; with `cache`, the other shapes
+// (large or with holes) found in it are not triangulated again, and it is
+// left holding this panel's such shapes. The arrays are filled directly,
+// sized in advance: a view redrawn after every slider move builds them for
+// every procedural parcel. `pointsPerShape` receives each shape's count of
+// points.
+void buildPanel(const MapPanel& panel, PanelGeometry& g, std::vector<vtkIdType>* pointsPerShape = nullptr,
                 TriangleCache* cache = nullptr, double minOutlined = 0) {
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  vtkNew<vtkCellArray> lines, triangles;
-  vtkNew<vtkDoubleArray> values;
-  values->SetName("value");
+  vtkIdType pointCount = 0;
+  for (const Polygon* shape : panel.shapes) {
+    pointCount += static_cast<vtkIdType>(shape->outer.size());
+    for (const Ring& hole : shape->holes) pointCount += static_cast<vtkIdType>(hole.size());
+  }
+  vtkNew<vtkDoubleArray> coordinates;
+  coordinates->SetNumberOfComponents(3);
+  coordinates->SetNumberOfTuples(pointCount);
+  double* xyz = coordinates->GetPointer(0);
+  std::vector<vtkIdType> lineOffsets{0}, lineIds, triangleIds;
+  std::vector<double> values;
+  triangleIds.reserve(3 * static_cast<std::size_t>(pointCount));
+  values.reserve(static_cast<std::size_t>(pointCount));
   vtkNew<vtkPolygon> earCut;
   vtkNew<vtkIdList> earIds;
+  std::vector<int> ears;
   TriangleCache next;
+  vtkIdType offset = 0;
   for (std::size_t k = 0; k < panel.shapes.size(); ++k) {
     const Polygon& shape = *panel.shapes[k];
-    const vtkIdType offset = points->GetNumberOfPoints();
     const bool outlined = minOutlined <= 0 || outlineSize(shape) >= minOutlined;
+    vtkIdType first = offset;
     auto addRing = [&](const Ring& ring) {
-      const vtkIdType first = points->GetNumberOfPoints();
-      for (const Point& p : ring) points->InsertNextPoint(p.x, p.y, 0.0);
-      if (!outlined) return;
-      lines->InsertNextCell(static_cast<int>(ring.size() + 1));
-      for (std::size_t v = 0; v < ring.size(); ++v) lines->InsertCellPoint(first + static_cast<vtkIdType>(v));
-      lines->InsertCellPoint(first);
+      for (const Point& p : ring) {
+        *xyz++ = p.x;
+        *xyz++ = p.y;
+        *xyz++ = 0.0;
+      }
+      const auto size = static_cast<vtkIdType>(ring.size());
+      if (outlined) {
+        for (vtkIdType v = 0; v < size; ++v) lineIds.push_back(first + v);
+        lineIds.push_back(first);
+        lineOffsets.push_back(static_cast<vtkIdType>(lineIds.size()));
+      }
+      first += size;
     };
     addRing(shape.outer);
     for (const Ring& hole : shape.holes) addRing(hole);
-    std::vector<vtkIdType> fresh;
-    const std::vector<vtkIdType>* cells = nullptr;
-    std::uint64_t hash = 0;
-    if (cache) {
-      hash = shapeHash(shape);
-      if (const auto it = cache->find(hash); it != cache->end()) cells = &it->second;
+    ears.clear();
+    if (shape.holes.empty() && isConvex(shape.outer)) {
+      // Most parcels: a triangle fan.
+      for (vtkIdType i = 1; i + 1 < static_cast<vtkIdType>(shape.outer.size()); ++i) {
+        triangleIds.insert(triangleIds.end(), {offset, offset + i, offset + i + 1});
+      }
+    } else if (shape.holes.empty() && detail::earClip(shape.outer, ears)) {
+      for (int v : ears) triangleIds.push_back(offset + v);
+    } else {
+      std::vector<vtkIdType> fresh;
+      const std::vector<vtkIdType>* cells = nullptr;
+      std::uint64_t hash = 0;
+      if (cache) {
+        hash = shapeHash(shape);
+        if (const auto it = cache->find(hash); it != cache->end()) cells = &it->second;
+      }
+      if (!cells) {
+        fresh = triangulate(shape, earCut, earIds);
+        cells = &fresh;
+      }
+      // Cells are (size, ids...); both triangulations give triangles only.
+      for (std::size_t c = 0; c < cells->size(); c += static_cast<std::size_t>((*cells)[c]) + 1) {
+        if ((*cells)[c] != 3) continue;
+        for (std::size_t i = 1; i <= 3; ++i) triangleIds.push_back(offset + (*cells)[c + i]);
+      }
+      if (cache) next.emplace(hash, *cells);
     }
-    if (!cells) {
-      fresh = triangulate(shape, earCut, earIds);
-      cells = &fresh;
-    }
-    vtkIdType count = 0;
-    for (std::size_t c = 0; c < cells->size(); c += static_cast<std::size_t>((*cells)[c]) + 1) {
-      const vtkIdType size = (*cells)[c];
-      triangles->InsertNextCell(static_cast<int>(size));
-      for (vtkIdType i = 1; i <= size; ++i) triangles->InsertCellPoint(offset + (*cells)[c + i]);
-      values->InsertNextValue(panel.values[k]);
-      ++count;
-    }
-    if (cache) next.emplace(hash, *cells);
-    if (trianglesPerShape) trianglesPerShape->push_back(count);
+    values.insert(values.end(), static_cast<std::size_t>(first - offset), panel.values[k]);
+    if (pointsPerShape) pointsPerShape->push_back(first - offset);
+    offset = first;
   }
   if (cache) *cache = std::move(next);
+  const auto idArray = [](const std::vector<vtkIdType>& ids) {
+    vtkNew<vtkIdTypeArray> a;
+    a->SetNumberOfValues(static_cast<vtkIdType>(ids.size()));
+    if (!ids.empty()) std::memcpy(a->GetPointer(0), ids.data(), ids.size() * sizeof(vtkIdType));
+    return vtkSmartPointer<vtkIdTypeArray>(a.GetPointer());
+  };
+  std::vector<vtkIdType> triangleOffsets(triangleIds.size() / 3 + 1);
+  for (std::size_t t = 0; t < triangleOffsets.size(); ++t) triangleOffsets[t] = static_cast<vtkIdType>(3 * t);
+  vtkNew<vtkCellArray> lines, triangles;
+  lines->SetData(idArray(lineOffsets), idArray(lineIds));
+  triangles->SetData(idArray(triangleOffsets), idArray(triangleIds));
+  vtkNew<vtkPoints> points;
+  points->SetData(coordinates);
+  vtkNew<vtkDoubleArray> pointValues;
+  pointValues->SetName("value");
+  pointValues->SetNumberOfValues(static_cast<vtkIdType>(values.size()));
+  if (!values.empty()) std::memcpy(pointValues->GetPointer(0), values.data(), values.size() * sizeof(double));
   g.rings->SetPoints(points);
   g.rings->SetLines(lines);
   g.fill->SetPoints(points);
   g.fill->SetPolys(triangles);
-  g.fill->GetCellData()->SetScalars(values);
+  g.fill->GetPointData()->SetScalars(pointValues);
 }
 
 // A round length (1, 2 or 5 times a power of ten) of at most `limit` metres.
@@ -450,7 +498,7 @@ void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, c
     vtkNew<vtkPolyDataMapper> fillMapper;
     fillMapper->SetInputData(geometry[i].fill);
     fillMapper->SetLookupTable(lut);
-    fillMapper->SetScalarModeToUseCellData();
+    fillMapper->SetScalarModeToUsePointData();
     fillMapper->UseLookupTableScalarRangeOn();
     fillMapper->ScalarVisibilityOn();
     vtkNew<vtkActor> fill;
@@ -613,7 +661,7 @@ struct LayerPart {
   std::vector<std::size_t> members;  // the layer's shapes drawn here, in order
   std::uint64_t hash = 0;            // of those shapes
   std::vector<double> values;
-  std::vector<vtkIdType> trianglesPerShape;
+  std::vector<vtkIdType> pointsPerShape;
   TriangleCache triangles;
   // Every member's rings (cells ringStart[k] to ringStart[k + 1]), its size
   // across, and the sizes sorted: the outlined members are those at least
@@ -655,8 +703,8 @@ struct LayerPart {
     for (std::size_t k : members) panel.shapes.push_back(shapes[k]);
     panel.values = values;
     PanelGeometry fresh;
-    trianglesPerShape.clear();
-    buildPanel(panel, fresh, &trianglesPerShape, &triangles);
+    pointsPerShape.clear();
+    buildPanel(panel, fresh, &pointsPerShape, &triangles);
     geometry.fill->ShallowCopy(fresh.fill);
     geometry.rings->ShallowCopy(fresh.rings);
     allRings = fresh.rings->GetLines();
@@ -682,13 +730,13 @@ struct LayerPart {
     vtkNew<vtkDoubleArray> scalars;
     scalars->SetName("value");
     vtkIdType total = 0;
-    for (vtkIdType n : trianglesPerShape) total += n;
+    for (vtkIdType n : pointsPerShape) total += n;
     scalars->SetNumberOfValues(total);
     vtkIdType next = 0;
     for (std::size_t k = 0; k < values.size(); ++k) {
-      for (vtkIdType t = 0; t < trianglesPerShape[k]; ++t) scalars->SetValue(next++, values[k]);
+      for (vtkIdType t = 0; t < pointsPerShape[k]; ++t) scalars->SetValue(next++, values[k]);
     }
-    geometry.fill->GetCellData()->SetScalars(scalars);
+    geometry.fill->GetPointData()->SetScalars(scalars);
     geometry.fill->Modified();
   }
 };
@@ -706,7 +754,7 @@ MapLayer::MapLayer() : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   for (LayerPart& p : m.parts) {
     p.fillMapper->SetInputData(p.geometry.fill);
-    p.fillMapper->SetScalarModeToUseCellData();
+    p.fillMapper->SetScalarModeToUsePointData();
     p.fillMapper->UseLookupTableScalarRangeOn();
     p.fillMapper->ScalarVisibilityOn();
     p.fillMapper->SetLookupTable(m.lut);
