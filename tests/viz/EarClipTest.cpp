@@ -1,13 +1,16 @@
 // Ear clipping of map shapes (viz/src/EarClip.h): random simple rings of every
-// size it takes, both orientations, with collinear and reflex vertices, are
-// covered by their triangles exactly once, checked at sample points.
+// size it takes, both orientations, with collinear and reflex vertices, and the
+// parcels of two shared real datasets are covered by their triangles exactly
+// once, checked at sample points.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
 #include <cmath>
 #include <random>
 
 #include "EarClip.h"
+#include "parcelscope/io/ParcelReader.h"
 
 namespace parcelscope::viz::detail {
 namespace {
@@ -101,6 +104,46 @@ TEST(EarClip, RandomSimpleRingsAreCoveredExactlyOnceInBothOrientations) {
     std::reverse(ring.begin(), ring.end());
     expectExactCover(ring, rng);
   }
+}
+
+// Every parcel ring (without holes, up to kEarClipMaxVertices) of cambridge_ma
+// (curved lots) and Paris 18e (cadastre, many vertices) is clipped; every
+// 25th is also checked point by point.
+TEST(EarClip, RealParcelRingsAreCoveredExactlyOnce) {
+  const std::string root = PARCELSCOPE_SHARED_DATASETS;
+  std::mt19937 rng(1);
+  int datasets = 0;
+  for (const char* file :
+       {"cambridge_ma/ASSESSING_ParcelsFY2014.topojson", "paris_18e/cadastre-75118-parcelles.json"}) {
+    io::ReadOptions in;
+    in.path = root + "/" + file;
+    if (!std::ifstream(in.path)) continue;
+    ++datasets;
+    const io::ParcelLayer layer = io::readParcels(in);
+    std::size_t clipped = 0;
+    for (const Parcel& p : layer.parcels) {
+      if (!p.shape.holes.empty() || p.shape.outer.size() > kEarClipMaxVertices) continue;
+      if (++clipped % 25 == 0) {
+        expectExactCover(p.shape.outer, rng);
+        continue;
+      }
+      const Ring& ring = p.shape.outer;
+      const auto at = [&](int v) { return ring[static_cast<std::size_t>(v)]; };
+      std::vector<int> t;
+      ASSERT_TRUE(earClip(ring, t)) << file << ": parcel of source feature " << p.sourceFid;
+      const double ringArea = signedArea(ring);
+      double sum = 0;
+      for (std::size_t i = 0; i < t.size(); i += 3) {
+        const double a = cross(at(t[i]), at(t[i + 1]), at(t[i + 2])) / 2;
+        ASSERT_GE(a * (ringArea > 0 ? 1 : -1), -1e-9) << file << ": parcel of source feature " << p.sourceFid;
+        sum += std::abs(a);
+      }
+      ASSERT_NEAR(sum, std::abs(ringArea), 1e-9 * std::abs(ringArea))
+          << file << ": parcel of source feature " << p.sourceFid;
+    }
+    EXPECT_GT(clipped, 5000u) << file;  // 6,800 to 13,000 rings each
+  }
+  if (datasets == 0) GTEST_SKIP() << "shared datasets not found under " << root;
 }
 
 TEST(EarClip, RefusesWhatItCannotClipAndLeavesTheOutputAlone) {

@@ -17,7 +17,8 @@ bool earClip(const Ring& ring, std::vector<int>& triangles) {
   const auto n = static_cast<int>(ring.size());
   if (n < 3 || ring.size() > kEarClipMaxVertices) return false;
   double area = 0;
-  for (int i = 0; i < n; ++i) area += cross(ring[0], ring[static_cast<std::size_t>(i)], ring[static_cast<std::size_t>((i + 1) % n)]);
+  const auto at = [&](int i) -> const Point& { return ring[static_cast<std::size_t>(i)]; };
+  for (int i = 0; i < n; ++i) area += cross(at(0), at(i), at((i + 1) % n));
   if (area == 0) return false;
   // Every turn measured as if the ring went counter-clockwise.
   const double turn = area > 0 ? 1.0 : -1.0;
@@ -30,7 +31,6 @@ bool earClip(const Ring& ring, std::vector<int>& triangles) {
     next[static_cast<std::size_t>(i)] = (i + 1) % n;
   }
   const std::size_t start = triangles.size();
-  const auto at = [&](int i) -> const Point& { return ring[static_cast<std::size_t>(i)]; };
   // b is an ear when it turns strictly left and no other remaining vertex lies
   // in or on the triangle (a, b, c); vertices at the triangle's corners (a
   // ring touching itself) are passed over.

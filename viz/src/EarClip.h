@@ -13,12 +13,12 @@ namespace parcelscope::viz::detail {
 /// are left to VTK.
 constexpr std::size_t kEarClipMaxVertices = 256;
 
-/// Appends to `triangles` the ring's triangles as triples of vertex indices
-/// (ring.size() - 2 triangles, none turning against the ring, together
-/// covering it exactly once; collinear vertices may give triangles without area). Returns false, leaving `triangles` as it
-/// was, when the ring has fewer than 3 or more than kEarClipMaxVertices
-/// vertices, no area, or a pass over its vertices finds no ear (a ring that is
-/// not simple).
+/// Appends to `triangles` the ring's triangles as triples of vertex indices:
+/// ring.size() - 2 triangles, none turning against the ring, together covering
+/// it exactly once (collinear vertices may give triangles without area).
+/// Returns false, leaving `triangles` as it was, when the ring has fewer than 3
+/// or more than kEarClipMaxVertices vertices, no area, or a pass over its
+/// vertices finds no ear (a ring that is not simple).
 bool earClip(const Ring& ring, std::vector<int>& triangles);
 
 }  // namespace parcelscope::viz::detail
