@@ -246,26 +246,26 @@ PairMeasure measureEdges(const std::vector<NearEdge>& ea, const std::vector<Near
 }
 
 PairMeasure measurePair(const Polygon& a, const Polygon& b, const Box& boxA, const Box& boxB, double closeTolerance,
-                        double sharedTolerance, bool closeness = true) {
+                        double sharedTolerance, bool closeness = true, double enough = HUGE_VAL) {
   thread_local std::vector<NearEdge> ea, eb;
   const double grow = 0.5 * closeTolerance;
   edgesNear(a, grow, boxB, ea);
   edgesNear(b, grow, boxA, eb);
-  return measureEdges(ea, eb, closeTolerance, sharedTolerance, closeness);
+  return measureEdges(ea, eb, closeTolerance, sharedTolerance, closeness, enough);
 }
 
 }  // namespace
 
 std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons, double tolerance,
-                              double sharedTolerance) {
+                              double sharedTolerance, double enough) {
   std::vector<Box> boxes(polygons.size());
   for (std::size_t i = 0; i < polygons.size(); ++i) boxes[i] = contactBox(*polygons[i], tolerance);
-  return contacts(polygons, intersectingPairs(boxes), tolerance, sharedTolerance);
+  return contacts(polygons, intersectingPairs(boxes), tolerance, sharedTolerance, enough);
 }
 
 std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons,
                               const std::vector<std::pair<int, int>>& candidates, double tolerance,
-                              double sharedTolerance) {
+                              double sharedTolerance, double enough) {
   if (sharedTolerance < 0 || sharedTolerance > tolerance) sharedTolerance = tolerance;
   std::vector<Box> boxes(polygons.size());
   for (std::size_t i = 0; i < polygons.size(); ++i) boxes[i] = contactBox(*polygons[i], tolerance);
@@ -273,7 +273,8 @@ std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons,
   auto measureRange = [&](std::size_t from, std::size_t to) {
     for (std::size_t k = from; k < to; ++k) {
       const auto [i, j] = candidates[k];
-      measured[k] = measurePair(*polygons[i], *polygons[j], boxes[i], boxes[j], tolerance, sharedTolerance);
+      measured[k] =
+          measurePair(*polygons[i], *polygons[j], boxes[i], boxes[j], tolerance, sharedTolerance, true, enough);
     }
   };
   // Small inputs (one block, one parcel pair) stay on the calling thread.
@@ -294,7 +295,7 @@ std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons,
     c.close = true;
     // Both sides measure the same shared stretch; take the smaller (digitising
     // differences can make one side's edges overlap the other's twice).
-    c.shared = std::min(measured[k].sharedA, measured[k].sharedB);
+    c.shared = measured[k].enough ? enough : std::min(measured[k].sharedA, measured[k].sharedB);
     out.push_back(c);
   }
   return out;

@@ -4,6 +4,7 @@
 // the edges that reach the other polygon's box, so that cost grows with the
 // number of nearby edge pairs, not with the product of polygon sizes (a street
 // network stored as one parcel has tens of thousands of edges).
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -23,15 +24,19 @@ Box contactBox(const Polygon& polygon, double tolerance);
 
 /// Contacts between every pair of `polygons` whose boundaries come within
 /// `closeTolerance` m, sorted by (a, b). Shared lengths count edges within
-/// `sharedTolerance` (<= closeTolerance; negative means the same).
+/// `sharedTolerance` (<= closeTolerance; negative means the same). With a
+/// finite `enough` (for counting neighbours), a pair stops being measured once
+/// one pair of its edges covers `enough` m on both sides; its `shared` is then
+/// `enough`, which the whole shared length reaches too. Otherwise `shared` is
+/// the whole length.
 std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons, double closeTolerance,
-                              double sharedTolerance = -1);
+                              double sharedTolerance = -1, double enough = HUGE_VAL);
 /// The same, given the candidate pairs: every pair (i, j), i < j, sorted,
 /// whose contact boxes meet, at least (intersectingPairs of the contactBox
 /// of each polygon); pairs are measured in parallel.
 std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons,
                               const std::vector<std::pair<int, int>>& candidates, double closeTolerance,
-                              double sharedTolerance = -1);
+                              double sharedTolerance = -1, double enough = HUGE_VAL);
 
 /// The shared length `contacts({&a, &b}, tolerance)` gives for the pair
 /// (min of both sides' covered lengths), computed directly: the same edge pairs

@@ -311,7 +311,9 @@ std::vector<ParcelMetrics> measureParcels(const std::vector<Polygon>& shapes, co
   });
   std::vector<const Polygon*> all;
   for (const Polygon& s : shapes) all.push_back(&s);
-  countNeighbours(detail::contacts(all, std::max(tolerance, 1e-6), sharedTolerance(tolerance)), metrics);
+  // Only whether each pair shares kMinSharedBoundary counts here.
+  countNeighbours(detail::contacts(all, std::max(tolerance, 1e-6), sharedTolerance(tolerance), kMinSharedBoundary),
+                  metrics);
   parallelFor(blocks.size(), [&](std::size_t b) { measureFrontage(blocks[b], all, tolerance, minFrontage, metrics); });
   return metrics;
 }

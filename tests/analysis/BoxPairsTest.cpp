@@ -89,3 +89,43 @@ TEST(LengthAlong, SameLengthsWhetherEveryEdgePairIsTestedOrCgalScans) {
     EXPECT_NEAR(together[i], alone[i % lots.size()], 1e-9) << "lot " << i;
   }
 }
+
+// Neighbours are counted from contacts measured only until one edge pair
+// covers the threshold: the decision must be the one the whole length gives.
+TEST(Contacts, StoppingAtEnoughDecidesAsTheWholeLength) {
+  auto rng = test::seededRandom(20261122, "Contacts");
+  std::uniform_real_distribution<double> width(0.3, 6.0), shift(-2.0, 2.0), split(0.1, 0.9);
+  // Rows of lots of random widths, each row shifted, so that lots of
+  // neighbouring rows share anything from nothing to several metres; every
+  // lot's long sides are split at a random point, so that a shared stretch of
+  // more than 1 m may be made of edge pairs of less than 1 m each.
+  std::vector<Polygon> lots;
+  for (int row = 0; row < 12; ++row) {
+    double x = shift(rng);
+    const double y = 3.0 * row;
+    for (int k = 0; k < 12; ++k) {
+      const double w = width(rng);
+      const double sb = x + split(rng) * w, st = x + split(rng) * w;
+      lots.push_back(Polygon{{{x, y}, {sb, y}, {x + w, y}, {x + w, y + 3.0}, {st, y + 3.0}, {x, y + 3.0}}, {}});
+      x += w;
+    }
+  }
+  std::vector<const Polygon*> all;
+  for (const Polygon& p : lots) all.push_back(&p);
+  const auto whole = analysis::detail::contacts(all, 0.05, 0.05);
+  const auto stopped = analysis::detail::contacts(all, 0.05, 0.05, 1.0);
+  ASSERT_EQ(whole.size(), stopped.size());
+  int shortContacts = 0, longContacts = 0;
+  for (std::size_t k = 0; k < whole.size(); ++k) {
+    ASSERT_EQ(whole[k].a, stopped[k].a);
+    ASSERT_EQ(whole[k].b, stopped[k].b);
+    EXPECT_EQ(whole[k].shared >= 1.0, stopped[k].shared >= 1.0) << whole[k].a << "-" << whole[k].b;
+    if (stopped[k].shared < 1.0) {
+      EXPECT_EQ(stopped[k].shared, whole[k].shared);
+    }
+    (whole[k].shared >= 1.0 ? longContacts : shortContacts) += 1;
+  }
+  // Both kinds occur.
+  EXPECT_GT(shortContacts, 20);
+  EXPECT_GT(longContacts, 100);
+}
