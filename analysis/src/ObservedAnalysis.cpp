@@ -174,7 +174,9 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
   for (std::size_t i = 0; i < n; ++i) shapes[i] = &parcels[i].shape;
   // Overlapping boxes also find parcels lying inside others without touching them.
   const auto pairs = detail::intersectingPairs(boxes);
-  const auto touching = detail::contacts(shapes, pairs, contactTolerance, sharedTolerance(tol));
+  // Used for neighbours (shared at least kMinSharedBoundary) and closeness
+  // only: measuring a pair stops at that length.
+  const auto touching = detail::contacts(shapes, pairs, contactTolerance, sharedTolerance(tol), kMinSharedBoundary);
   countNeighbours(touching, out.metrics);
   reportProgress(progress, 0.3, "neighbours");
 
