@@ -19,16 +19,6 @@ double cross(const Point& a, const Point& b, const Point& c) {
   return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
 }
 
-// Even-odd crossing test; the sample points never lie on an edge in practice.
-bool inside(const Ring& ring, const Point& p) {
-  bool in = false;
-  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
-    const Point &a = ring[i], &b = ring[j];
-    if ((a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x) in = !in;
-  }
-  return in;
-}
-
 bool inTriangle(const Point& a, const Point& b, const Point& c, const Point& p) {
   const double d1 = cross(a, b, p), d2 = cross(b, c, p), d3 = cross(c, a, p);
   return (d1 > 0 && d2 > 0 && d3 > 0) || (d1 < 0 && d2 < 0 && d3 < 0);
@@ -90,7 +80,7 @@ void expectExactCover(const Ring& ring, std::mt19937& rng) {
       covering += inTriangle(ring[static_cast<std::size_t>(t[i])], ring[static_cast<std::size_t>(t[i + 1])],
                              ring[static_cast<std::size_t>(t[i + 2])], p);
     }
-    ASSERT_EQ(covering, inside(ring, p) ? 1 : 0) << "at (" << p.x << ", " << p.y << "), " << ring.size() << " vertices";
+    ASSERT_EQ(covering, pointInRing(p, ring) ? 1 : 0) << "at (" << p.x << ", " << p.y << "), " << ring.size() << " vertices";
   }
 }
 

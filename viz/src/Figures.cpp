@@ -341,7 +341,8 @@ void buildPanel(const MapPanel& panel, PanelGeometry& g, std::vector<vtkIdType>*
         fresh = triangulate(shape, earCut, earIds);
         cells = &fresh;
       }
-      // Cells are (size, ids...); both triangulations give triangles only.
+      // Cells are (size, ids...); both triangulations give triangles, the only
+      // cells the three-id layout below can hold.
       for (std::size_t c = 0; c < cells->size(); c += static_cast<std::size_t>((*cells)[c]) + 1) {
         if ((*cells)[c] != 3) continue;
         for (std::size_t i = 1; i <= 3; ++i) triangleIds.push_back(offset + (*cells)[c + i]);
