@@ -41,11 +41,13 @@
 #include <vtkRenderer.h>
 
 #include <cmath>
+#include <utility>
 
 #include "MapView.h"
 #include "ParameterPanel.h"
 #include "parcelscope/analysis/Comparison.h"
 #include "parcelscope/core/Error.h"
+#include "parcelscope/core/Parallel.h"
 #include "parcelscope/generation/GenerateJob.h"
 #include "parcelscope/io/ParcelReader.h"
 #include "parcelscope/viz/Scenes.h"
@@ -606,10 +608,11 @@ void MainWindow::showReport(const UpdateReport& report) {
 void MainWindow::drawReport(const UpdateReport& report) {
   if (report.partial && report.serial != pendingSerial_) return;  // superseded already
   const bool first = !result_ || report.reloaded;
-  result_ = report.result;
+  // The result replaced is freed in the background, not before drawing.
+  releaseInBackground(std::exchange(result_, report.result));
   shownRequest_ = report.request;
   if (!report.partial) {
-    finalResult_ = report.result;
+    releaseInBackground(std::exchange(finalResult_, report.result));
     finalRequest_ = report.request;
     shownSerial_ = report.serial;
     progress_->setVisible(false);

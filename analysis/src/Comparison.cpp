@@ -32,8 +32,8 @@ struct CdfDistances {
 // One walk over the pooled sorted values: between consecutive distinct values
 // both empirical distribution functions are constant, so the supremum of their
 // difference (KS) and the integral of its absolute value (W1) are exact sums.
-CdfDistances cdfDistances(const std::vector<double>& aIn, const std::vector<double>& bIn) {
-  const std::vector<double> a = finiteSorted(aIn), b = finiteSorted(bIn);
+// `a` and `b` are sorted and finite.
+CdfDistances cdfDistancesOfSorted(const std::vector<double>& a, const std::vector<double>& b) {
   if (a.empty() || b.empty()) return {};
   const double na = static_cast<double>(a.size()), nb = static_cast<double>(b.size());
   std::size_t i = 0, j = 0;
@@ -52,34 +52,37 @@ CdfDistances cdfDistances(const std::vector<double>& aIn, const std::vector<doub
   return d;
 }
 
-double share(std::int64_t count, std::size_t total) {
-  return total == 0 ? kNaN : static_cast<double>(count) / static_cast<double>(total);
+CdfDistances cdfDistances(const std::vector<double>& a, const std::vector<double>& b) {
+  return cdfDistancesOfSorted(finiteSorted(a), finiteSorted(b));
 }
 
-}  // namespace
-
-double ksStatistic(const std::vector<double>& a, const std::vector<double>& b) { return cdfDistances(a, b).ks; }
-
-double wasserstein1(const std::vector<double>& a, const std::vector<double>& b) {
-  return cdfDistances(a, b).wasserstein;
+// The k-th smallest (0-based) of two sorted samples together; k < a.size() + b.size().
+double pooledAt(const std::vector<double>& a, const std::vector<double>& b, std::size_t k) {
+  std::size_t i = 0, j = 0;
+  for (;;) {
+    const bool fromA = j >= b.size() || (i < a.size() && a[i] <= b[j]);
+    const double x = fromA ? a[i] : b[j];
+    if (i + j == k) return x;
+    (fromA ? i : j)++;
+  }
 }
 
-SharedHistogram sharedHistogram(const std::vector<double>& aIn, const std::vector<double>& bIn, int bins,
-                                double upperQuantile) {
+// sharedHistogram of two sorted, finite samples.
+SharedHistogram sharedHistogramOfSorted(const std::vector<double>& a, const std::vector<double>& b, int bins,
+                                        double upperQuantile) {
   if (bins < 1) throw usageError("histogram: at least one bin is needed (got " + std::to_string(bins) + ")");
   if (!(upperQuantile > 0 && upperQuantile <= 1)) {
     throw usageError("histogram: the upper quantile must lie in (0, 1] (got " + std::to_string(upperQuantile) + ")");
   }
   SharedHistogram h;
-  const std::vector<double> a = finiteSorted(aIn), b = finiteSorted(bIn);
-  std::vector<double> pooled(a.size() + b.size());
-  std::merge(a.begin(), a.end(), b.begin(), b.end(), pooled.begin());
-  if (pooled.empty()) return h;
-  const double lo = pooled.front();
+  const std::size_t pooled = a.size() + b.size();
+  if (pooled == 0) return h;
+  const double lo = a.empty() ? b.front() : b.empty() ? a.front() : std::min(a.front(), b.front());
+  const double top = a.empty() ? b.back() : b.empty() ? a.back() : std::max(a.back(), b.back());
   // Nearest-rank quantile; when it equals the minimum, fall back to the maximum.
-  const auto rank = static_cast<std::size_t>(std::ceil(upperQuantile * static_cast<double>(pooled.size())));
-  double hi = pooled[std::min(pooled.size(), std::max<std::size_t>(rank, 1)) - 1];
-  if (hi <= lo) hi = pooled.back();
+  const auto rank = static_cast<std::size_t>(std::ceil(upperQuantile * static_cast<double>(pooled)));
+  double hi = pooledAt(a, b, std::min(pooled, std::max<std::size_t>(rank, 1)) - 1);
+  if (hi <= lo) hi = top;
   if (hi <= lo) {
     bins = 1;
     hi = lo + 1;
@@ -100,6 +103,23 @@ SharedHistogram sharedHistogram(const std::vector<double>& aIn, const std::vecto
   count(a, h.a, h.aOverflow);
   count(b, h.b, h.bOverflow);
   return h;
+}
+
+double share(std::int64_t count, std::size_t total) {
+  return total == 0 ? kNaN : static_cast<double>(count) / static_cast<double>(total);
+}
+
+}  // namespace
+
+double ksStatistic(const std::vector<double>& a, const std::vector<double>& b) { return cdfDistances(a, b).ks; }
+
+double wasserstein1(const std::vector<double>& a, const std::vector<double>& b) {
+  return cdfDistances(a, b).wasserstein;
+}
+
+SharedHistogram sharedHistogram(const std::vector<double>& a, const std::vector<double>& b, int bins,
+                                double upperQuantile) {
+  return sharedHistogramOfSorted(finiteSorted(a), finiteSorted(b), bins, upperQuantile);
 }
 
 double histogramIntersection(const SharedHistogram& h) {
@@ -216,26 +236,38 @@ Distances& Comparison::distances(ComparedMetric m) {
   return const_cast<Distances&>(static_cast<const Comparison&>(*this).distances(m));
 }
 
-Comparison compareSets(const std::vector<ParcelMetrics>& observed, const std::vector<ParcelMetrics>& generated,
-                       int bins, double upperQuantile, std::vector<SharedHistogram>* histograms) {
+PreparedSet prepareSet(const std::vector<ParcelMetrics>& metrics) {
+  PreparedSet p;
+  p.summary = summarizeSet(metrics);
+  for (std::size_t k = 0; k < std::size(kComparedMetrics); ++k) {
+    p.sorted[k] = metricSample(metrics, kComparedMetrics[k]);  // finite values only
+    std::sort(p.sorted[k].begin(), p.sorted[k].end());
+  }
+  return p;
+}
+
+Comparison compareSets(const PreparedSet& observed, const PreparedSet& generated, int bins, double upperQuantile,
+                       std::vector<SharedHistogram>* histograms) {
   Comparison c;
   if (histograms) histograms->clear();
-  c.observed = summarizeSet(observed);
-  c.generated = summarizeSet(generated);
-  for (ComparedMetric m : kComparedMetrics) {
-    // Sorted once here; the distances and the histogram then only copy them.
-    std::vector<double> a = metricSample(observed, m), b = metricSample(generated, m);
-    std::sort(a.begin(), a.end());
-    std::sort(b.begin(), b.end());
-    const CdfDistances d = cdfDistances(a, b);
-    Distances& out = c.distances(m);
+  c.observed = observed.summary;
+  c.generated = generated.summary;
+  for (std::size_t k = 0; k < std::size(kComparedMetrics); ++k) {
+    const std::vector<double>&a = observed.sorted[k], &b = generated.sorted[k];
+    const CdfDistances d = cdfDistancesOfSorted(a, b);
+    Distances& out = c.distances(kComparedMetrics[k]);
     out.ks = d.ks;
     out.wasserstein = d.wasserstein;
-    SharedHistogram h = sharedHistogram(a, b, bins, upperQuantile);
+    SharedHistogram h = sharedHistogramOfSorted(a, b, bins, upperQuantile);
     out.intersection = histogramIntersection(h);
     if (histograms) histograms->push_back(std::move(h));
   }
   return c;
+}
+
+Comparison compareSets(const std::vector<ParcelMetrics>& observed, const std::vector<ParcelMetrics>& generated,
+                       int bins, double upperQuantile, std::vector<SharedHistogram>* histograms) {
+  return compareSets(prepareSet(observed), prepareSet(generated), bins, upperQuantile, histograms);
 }
 
 Table blockComparisonTable(const std::vector<BlockComparison>& blocks) {

@@ -4,10 +4,14 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <deque>
 #include <exception>
 #include <mutex>
 #include <thread>
 #include <vector>
+
+#include <sys/resource.h>
+#include <unistd.h>
 
 namespace parcelscope {
 
@@ -79,5 +83,79 @@ void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
   for (auto& t : pool) t.join();
   if (error) std::rethrow_exception(error);
 }
+
+namespace {
+
+// One background thread, started on first use and joined at exit (after
+// dropping what is still queued).
+class Releaser {
+public:
+  ~Releaser() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      quit_ = true;
+    }
+    wake_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+
+  void release(std::shared_ptr<const void> garbage) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (quit_ || queue_.size() >= kMaxWaitingReleases) {
+      lock.unlock();
+      garbage.reset();
+      return;
+    }
+    if (!thread_.joinable()) thread_ = std::thread([this] { run(); });
+    queue_.push_back(std::move(garbage));
+    ++queued_;
+    lock.unlock();
+    wake_.notify_all();
+  }
+
+  void wait() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    const std::size_t target = queued_;
+    wake_.wait(lock, [&] { return released_ >= target; });
+  }
+
+private:
+  void run() {
+    // Lowest priority for this thread only (Linux gives each thread its own nice value).
+    setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 19);
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      wake_.wait(lock, [&] { return quit_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // quitting, nothing left
+      std::shared_ptr<const void> garbage = std::move(queue_.front());
+      queue_.pop_front();
+      lock.unlock();
+      garbage.reset();
+      lock.lock();
+      ++released_;
+      wake_.notify_all();
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::shared_ptr<const void>> queue_;
+  std::size_t queued_ = 0, released_ = 0;
+  bool quit_ = false;
+  std::thread thread_;
+};
+
+Releaser& releaser() {
+  static Releaser r;
+  return r;
+}
+
+}  // namespace
+
+void releaseInBackground(std::shared_ptr<const void> garbage) {
+  if (garbage) releaser().release(std::move(garbage));
+}
+
+void waitForBackgroundReleases() { releaser().wait(); }
 
 }  // namespace parcelscope

@@ -2,9 +2,14 @@
 // edge cases: empty sets, identical sets (distance 0), disjoint sets (KS 1).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
+#include <numeric>
 #include <random>
+#include <string>
+#include <tuple>
 
 #include "parcelscope/analysis/Comparison.h"
 #include "parcelscope/core/Error.h"
@@ -78,6 +83,57 @@ TEST(SharedHistogram, UpperQuantileSendsTheTailToTheLastBin) {
   EXPECT_EQ(h.b, (std::vector<int>{1, 3}));
   EXPECT_EQ(h.aOverflow, 1);
   EXPECT_EQ(h.bOverflow, 1);
+}
+
+// Random samples with ties, one side sometimes empty, infinities and NaN left
+// out: the last edge is the pooled nearest-rank quantile (the largest value
+// when that equals the smallest), every finite value is counted once, and
+// those above the last edge are the overflow.
+TEST(SharedHistogram, LastEdgeIsThePooledNearestRankQuantileOnRandomSamples) {
+  const unsigned seed = std::random_device{}();
+  std::mt19937 rng(seed);
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  const double quantiles[] = {1.0, 0.99, 0.75, 0.5, 0.01};
+  for (int round = 0; round < 200; ++round) {
+    std::vector<double> a(rng() % 40), b(rng() % 40);
+    for (auto* v : {&a, &b}) {
+      for (double& x : *v) {
+        const auto r = rng() % 20;
+        x = r == 0 ? kInf : r == 1 ? std::nan("") : static_cast<double>(rng() % 12);  // many ties
+      }
+    }
+    std::vector<double> pooled;
+    for (const auto* v : {&a, &b}) {
+      for (double x : *v) {
+        if (std::isfinite(x)) pooled.push_back(x);
+      }
+    }
+    std::sort(pooled.begin(), pooled.end());
+    const double q = quantiles[rng() % std::size(quantiles)];
+    const int bins = 1 + static_cast<int>(rng() % 6);
+    const SharedHistogram h = sharedHistogram(a, b, bins, q);
+    if (pooled.empty()) {
+      EXPECT_TRUE(h.edges.empty());
+      continue;
+    }
+    const auto rank = static_cast<std::size_t>(std::ceil(q * static_cast<double>(pooled.size())));
+    double hi = pooled[std::max<std::size_t>(rank, 1) - 1];
+    if (hi <= pooled.front()) hi = pooled.back();
+    if (hi <= pooled.front()) hi = pooled.front() + 1;
+    ASSERT_FALSE(h.edges.empty());
+    EXPECT_EQ(h.edges.front(), pooled.front()) << "round " << round;
+    EXPECT_EQ(h.edges.back(), hi) << "round " << round;
+    for (const auto& [values, counts, overflow] :
+         {std::tuple{&a, &h.a, h.aOverflow}, std::tuple{&b, &h.b, h.bOverflow}}) {
+      int finite = 0, above = 0;
+      for (double x : *values) {
+        finite += std::isfinite(x);
+        above += std::isfinite(x) && x > hi;
+      }
+      EXPECT_EQ(std::accumulate(counts->begin(), counts->end(), 0), finite) << "round " << round;
+      EXPECT_EQ(overflow, above) << "round " << round;
+    }
+  }
 }
 
 TEST(SharedHistogram, EqualValuesShareOneBinAndBadArgumentsAreRefused) {

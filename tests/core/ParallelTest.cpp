@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <future>
+#include <memory>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -65,6 +68,44 @@ TEST(Progress, ScaledProgressMapsOntoParentRange) {
   };
   scaledProgress(parent, 0.4, 0.8)(0.5, "x");
   EXPECT_DOUBLE_EQ(seen, 0.6);
+}
+
+// A reference handed over is dropped on another thread; waiting returns once
+// it has been. When the queue is full (the background thread held up), the
+// next one is dropped on the calling thread instead of piling up.
+TEST(ReleaseInBackground, DropsOnAnotherThreadAndFallsBackWhenTheQueueIsFull) {
+  const std::thread::id caller = std::this_thread::get_id();
+  std::promise<std::thread::id> firstDroppedOn;
+  std::promise<void> letFirstFinish;
+  std::shared_future<void> go = letFirstFinish.get_future().share();
+  std::promise<void> firstStarted;
+  releaseInBackground(std::shared_ptr<const void>(new int(1), [&, go](const int* p) {
+    delete p;
+    firstDroppedOn.set_value(std::this_thread::get_id());
+    firstStarted.set_value();
+    go.wait();
+  }));
+  firstStarted.get_future().wait();  // the background thread is held up in the first drop
+  std::atomic<int> droppedHere{0}, droppedElsewhere{0};
+  auto counted = [&] {
+    return std::shared_ptr<const void>(new int(2), [&, caller](const int* p) {
+      delete p;
+      (std::this_thread::get_id() == caller ? droppedHere : droppedElsewhere)++;
+    });
+  };
+  for (int i = 0; i < 20; ++i) releaseInBackground(counted());
+  // The queue holds up to kMaxWaitingReleases; the others were dropped at once, here.
+  EXPECT_EQ(droppedHere.load(), 20 - static_cast<int>(kMaxWaitingReleases));
+  EXPECT_EQ(droppedElsewhere.load(), 0);
+  letFirstFinish.set_value();
+  waitForBackgroundReleases();
+  EXPECT_EQ(droppedElsewhere.load(), static_cast<int>(kMaxWaitingReleases));
+  EXPECT_NE(firstDroppedOn.get_future().get(), caller);
+  // A reference still held elsewhere only loses one owner.
+  auto kept = std::make_shared<int>(3);
+  releaseInBackground(kept);
+  waitForBackgroundReleases();
+  EXPECT_EQ(kept.use_count(), 1);
 }
 
 }  // namespace

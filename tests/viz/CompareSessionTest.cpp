@@ -84,6 +84,9 @@ TEST(CompareSession, RegeneratesOnlyTheBlocksAnEditTouches) {
   const auto same = session.update(request);
   EXPECT_FALSE(same.reloaded);
   EXPECT_EQ(same.blocksRegenerated, 0u);
+  const auto* observedSides = same.result->observedSides.get();
+  ASSERT_NE(observedSides, nullptr);
+  EXPECT_EQ(observedSides->size(), same.result->blocks.size() + 1);  // every block, then the city
 
   // One block's own bounds: that block alone.
   request.overrides[3].parameters = {{"a-max", 300.0}, {"a-min", 100.0}};
@@ -100,6 +103,7 @@ TEST(CompareSession, RegeneratesOnlyTheBlocksAnEditTouches) {
   const auto all = session.update(request);
   EXPECT_EQ(all.blocksRegenerated, 10u);
   expectSameResult(*all.result, compare(request));
+  EXPECT_EQ(all.result->observedSides.get(), observedSides);  // the observed side prepared once
 
   // A skeleton-only parameter does not touch OBB blocks.
   request.parameters["street-angle"] = 40;
@@ -114,6 +118,7 @@ TEST(CompareSession, RegeneratesOnlyTheBlocksAnEditTouches) {
   const auto tolerance = session.update(request);
   EXPECT_TRUE(tolerance.reloaded);
   expectSameResult(*tolerance.result, compare(request));
+  EXPECT_NE(tolerance.result->observedSides, all.result->observedSides);  // other blocks: prepared again
 }
 
 // Random edit sequences (style, overrides, bounds, seed) end where a fresh

@@ -134,21 +134,34 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
     }
     for (int i : r.generated.blocks[k].parcels) generatedIn[id].push_back(i);
   }
+  if (!r.observedSides) {
+    auto sides = std::make_shared<std::vector<analysis::PreparedSet>>(a.blocks.size() + 1);
+    parallelFor(sides->size(), [&](std::size_t b) {
+      (*sides)[b] = analysis::prepareSet(b < a.blocks.size() ? pick(a.metrics, a.blocks[b].parcels) : r.observedLots);
+    });
+    r.observedSides = std::move(sides);
+  }
+  const std::vector<analysis::PreparedSet>& observedSides = *r.observedSides;
   const bool reuse = keep && keep->size() == a.blocks.size() && r.blocks.size() == a.blocks.size();
   if (!reuse) r.blocks.assign(a.blocks.size(), {});
   std::vector<std::size_t> todo;
   for (std::size_t b = 0; b < a.blocks.size(); ++b) {
     if (!reuse || !(*keep)[b]) todo.push_back(b);
   }
-  parallelFor(todo.size(), [&](std::size_t t) {
-    const std::size_t b = todo[t];
+  // The city-wide comparison (the largest item) first, beside the blocks.
+  parallelFor(todo.size() + 1, [&](std::size_t t) {
+    if (t == 0) {
+      r.city = analysis::compareSets(observedSides.back(), analysis::prepareSet(r.generated.metrics), bins, quantile,
+                                     &r.histograms);
+      return;
+    }
+    const std::size_t b = todo[t - 1];
     analysis::BlockComparison& c = r.blocks[b];
     c.blockId = a.blocks[b].id;
     c.blockArea = a.statistics[b].blockArea;
-    c.comparison = analysis::compareSets(pick(a.metrics, a.blocks[b].parcels),
-                                         pick(r.generated.metrics, generatedIn[b]), bins, quantile);
+    c.comparison = analysis::compareSets(observedSides[b], analysis::prepareSet(pick(r.generated.metrics, generatedIn[b])),
+                                         bins, quantile);
   });
-  r.city = analysis::compareSets(r.observedLots, r.generated.metrics, bins, quantile, &r.histograms);
 }
 
 }  // namespace detail

@@ -7,6 +7,7 @@
 // values (the infinite aspect ratio of a zero-width sliver) are left out of the
 // distances; an empty sample gives NaN, never a made-up 0.
 #include <cstdint>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -112,6 +113,18 @@ struct Comparison {
 /// those shared histograms are also returned, in the order of kComparedMetrics.
 Comparison compareSets(const std::vector<ParcelMetrics>& observed, const std::vector<ParcelMetrics>& generated,
                        int bins, double upperQuantile, std::vector<SharedHistogram>* histograms = nullptr);
+
+/// One set of parcels made ready to be compared: its summary and the sorted
+/// finite values of each compared metric. A set compared many times (the
+/// observed side of every update of an interactive session) is prepared once.
+struct PreparedSet {
+  SetSummary summary;
+  std::vector<double> sorted[std::size(kComparedMetrics)];  ///< in the order of kComparedMetrics
+};
+PreparedSet prepareSet(const std::vector<ParcelMetrics>& metrics);
+/// compareSets on prepared sets: the same numbers as on their metrics.
+Comparison compareSets(const PreparedSet& observed, const PreparedSet& generated, int bins, double upperQuantile,
+                       std::vector<SharedHistogram>* histograms = nullptr);
 
 struct BlockComparison {
   std::int64_t blockId = -1;

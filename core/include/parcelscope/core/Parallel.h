@@ -3,6 +3,7 @@
 // per-index slots so that the outcome does not depend on scheduling.
 #include <cstddef>
 #include <functional>
+#include <memory>
 
 namespace parcelscope {
 
@@ -16,5 +17,18 @@ unsigned workerCount();
 /// parallelFor's body, it runs the loop on the calling thread, in order.
 void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
                  const std::function<void(std::size_t done)>& tick = {});
+
+/// Drops `garbage` on a background thread of the lowest scheduling priority
+/// (nice 19), so that freeing a large structure (the replaced state of an
+/// interactive update, say) does not delay the caller. When many releases are
+/// already waiting, it is dropped on the calling thread instead, so that
+/// memory cannot pile up while every core is busy.
+void releaseInBackground(std::shared_ptr<const void> garbage);
+/// How many releases may wait at once.
+constexpr std::size_t kMaxWaitingReleases = 8;
+
+/// Returns once everything handed to releaseInBackground before the call has
+/// been dropped.
+void waitForBackgroundReleases();
 
 }  // namespace parcelscope

@@ -59,6 +59,10 @@ struct CompareResult {
   /// One per observed block, in block order; generated parcels are matched to
   /// blocks by block id (a multipart block's parts are one block).
   std::vector<analysis::BlockComparison> blocks;
+  /// The observed side of every comparison, prepared once per observed data
+  /// and shared between successive results of a CompareSession: one per
+  /// observed block, in block order, then the city's (observedLots).
+  std::shared_ptr<const std::vector<analysis::PreparedSet>> observedSides;
   /// City-wide histograms on shared bins, in the order of analysis::kComparedMetrics.
   std::vector<analysis::SharedHistogram> histograms;
   /// Seconds per stage: "read" (read, project, clean), "blocks" (observed
