@@ -308,22 +308,33 @@ GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<Bl
   GeneratedParcels out;
   out.source = inputs.source;
   out.seed = seed;
-  std::size_t total = 0;
-  for (const BlockOutcome* o : outcomes) total += o->subdivision.parcels.size();
-  out.parcels.reserve(total);
-  out.metrics.reserve(total);
-  for (std::size_t k = 0; k < inputs.entries.size(); ++k) {
+  const std::size_t n = inputs.entries.size();
+  std::vector<std::size_t> first(n + 1, 0);  // index of each entry's first parcel
+  for (std::size_t k = 0; k < n; ++k) first[k + 1] = first[k] + outcomes[k]->subdivision.parcels.size();
+  // The copies, entry by entry in parallel into their own slots.
+  out.parcels.resize(first[n]);
+  out.metrics.resize(first[n]);
+  out.blocks.resize(n);
+  parallelFor(n, [&](std::size_t k) {
+    const BlockOutcome& o = *outcomes[k];
+    if (o.metrics.size() != o.subdivision.parcels.size()) {
+      throw std::logic_error("assembleParcels: block entry " + std::to_string(k) + " is not measured");
+    }
+    Block& block = out.blocks[k];
+    block.id = static_cast<int>(k);
+    block.parts = {inputs.entries[k].shape};
+    block.parcels.resize(o.subdivision.parcels.size());
+    for (std::size_t i = 0; i < o.subdivision.parcels.size(); ++i) {
+      block.parcels[i] = static_cast<int>(first[k] + i);
+      out.parcels[first[k] + i] = o.subdivision.parcels[i];
+    }
+    std::copy(o.metrics.begin(), o.metrics.end(), out.metrics.begin() + static_cast<std::ptrdiff_t>(first[k]));
+  });
+  out.blockIds.reserve(n);
+  out.blockStyles.reserve(n);
+  for (std::size_t k = 0; k < n; ++k) {
     const Subdivision& s = outcomes[k]->subdivision;
     const std::int64_t id = inputs.entries[k].blockId;
-    Block block;
-    block.id = static_cast<int>(out.blocks.size());
-    block.parts = {inputs.entries[k].shape};
-    for (const Polygon& parcel : s.parcels) {
-      block.parcels.push_back(static_cast<int>(out.parcels.size()));
-      out.parcels.push_back(parcel);
-    }
-    out.metrics.insert(out.metrics.end(), outcomes[k]->metrics.begin(), outcomes[k]->metrics.end());
-    out.blocks.push_back(std::move(block));
     out.blockIds.push_back(id);
     out.blockStyles.push_back(s.fallback ? "obb" : plans[k].style);
     out.oversize += s.oversize;

@@ -314,8 +314,8 @@ private:
   NodePtr recurse(const Polygon& piece, std::uint64_t seed, bool access, int depth, const NodePtr& previous) {
     const double a = area(piece);
     const Ring hull = convexHull(piece.outer);  // for the fit test and the split's box
-    const OrientedBox measured = minimumAreaBoxOfHull(hull);
-    const bool fits = a <= p_.aMax && measured.width <= p_.wMax;
+    // The width is measured only when the area fits.
+    const bool fits = a <= p_.aMax && minimumAreaBoxOfHull(hull).width <= p_.wMax;
     // Safety nets against pathological bounds: recursion depth and a budget of
     // parcels per block.
     if (fits || depth > 60 || out_.parcels.size() >= kMaxParcelsPerBlock) {
