@@ -253,6 +253,30 @@ TEST(CompareSession, OverrideOfAMissingBlockIsAUsageError) {
   EXPECT_THROW(session.update(request), Error);
 }
 
+// The histograms of the compared metrics come with the comparison; they are
+// what the quantity's own samples give on the same bins, and a request with
+// other bins gets its own.
+TEST(QuantityHistogram, ComparedMetricsReuseTheComparisonsHistogramsOnTheSameBinsOnly) {
+  const CompareRequest request = sampleRequest();
+  const CompareResult r = compare(request);
+  const int bins = static_cast<int>(request.parameters.at("bins"));
+  const double quantile = request.parameters.at("histogram-quantile");
+  for (const char* name : {"area", "width", "aspect_ratio", "p_angle"}) {
+    SCOPED_TRACE(name);
+    const auto& q = analysis::parcelQuantity(name);
+    const analysis::SharedHistogram expected = analysis::sharedHistogram(
+        analysis::quantitySample(r.observedLots, q), analysis::quantitySample(r.generated.metrics, q), bins, quantile);
+    const QuantityHistogram h = quantityHistogram(r, request, name);
+    EXPECT_EQ(h.edges, expected.edges);
+    ASSERT_EQ(h.series.size(), 2u);
+    EXPECT_EQ(h.series[0].counts, expected.a);
+    EXPECT_EQ(h.series[1].counts, expected.b);
+  }
+  CompareRequest other = request;
+  other.parameters["bins"] = 7;
+  EXPECT_EQ(quantityHistogram(r, other, "area").edges.size(), 8u);
+}
+
 TEST(SessionFile, RoundTripsInputParametersOverridesAndSeed) {
   TempDir dir;
   CompareRequest request = sampleRequest("skeleton");

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <future>
+#include <iterator>
 #include <numeric>
 #include <optional>
 
@@ -153,6 +154,8 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
     if (t == 0) {
       r.city = analysis::compareSets(observedSides.back(), analysis::prepareSet(r.generated.metrics), bins, quantile,
                                      &r.histograms);
+      r.histogramBins = bins;
+      r.histogramQuantile = quantile;
       return;
     }
     const std::size_t b = todo[t - 1];
@@ -315,9 +318,20 @@ void renderQuantityMap(const CompareResult& r, const CompareRequest& request, co
 QuantityHistogram quantityHistogram(const CompareResult& r, const CompareRequest& request,
                                     const std::string& quantity) {
   const analysis::ParcelQuantity& q = analysis::parcelQuantity(quantity);
-  const analysis::SharedHistogram h = analysis::sharedHistogram(
-      analysis::quantitySample(r.observedLots, q), analysis::quantitySample(r.generated.metrics, q),
-      static_cast<int>(value(request, "bins")), value(request, "histogram-quantile"));
+  const int bins = static_cast<int>(value(request, "bins"));
+  const double quantile = value(request, "histogram-quantile");
+  // The compared metrics' histograms were made with the comparison, on the same bins.
+  const analysis::SharedHistogram* made = nullptr;
+  for (std::size_t k = 0; k < std::size(analysis::kComparedMetrics); ++k) {
+    if (q.name == analysis::metricName(analysis::kComparedMetrics[k]) && r.histograms.size() > k &&
+        r.histogramBins == bins && r.histogramQuantile == quantile) {
+      made = &r.histograms[k];
+    }
+  }
+  const analysis::SharedHistogram h =
+      made ? *made
+           : analysis::sharedHistogram(analysis::quantitySample(r.observedLots, q),
+                                       analysis::quantitySample(r.generated.metrics, q), bins, quantile);
   QuantityHistogram out;
   out.edges = h.edges;
   out.xTitle = q.title;

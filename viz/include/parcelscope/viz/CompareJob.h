@@ -63,8 +63,11 @@ struct CompareResult {
   /// and shared between successive results of a CompareSession: one per
   /// observed block, in block order, then the city's (observedLots).
   std::shared_ptr<const std::vector<analysis::PreparedSet>> observedSides;
-  /// City-wide histograms on shared bins, in the order of analysis::kComparedMetrics.
+  /// City-wide histograms on shared bins, in the order of analysis::kComparedMetrics,
+  /// made with `histogramBins` bins up to the pooled `histogramQuantile`.
   std::vector<analysis::SharedHistogram> histograms;
+  int histogramBins = 0;
+  double histogramQuantile = 0;
   /// Seconds per stage: "read" (read, project, clean), "blocks" (observed
   /// metrics, blocks, statistics), "generate" (subdivision), "metrics"
   /// (measuring the generated parcels and comparing).
