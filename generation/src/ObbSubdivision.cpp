@@ -144,6 +144,7 @@ private:
                                        const Point& dir) const {
     detail::SplitPieces split;
     std::vector<double> areas;
+    areas.reserve(4);
     if (detail::splitByLineFast(piece, through, dir, split)) {
       // A piece pinched at a point is never admissible: the exact split gives
       // it as one ring touching itself, which is not clean (nor valid).
@@ -250,7 +251,9 @@ private:
                          double shiftAcross, double shiftAlong) const {
     const OrientedBox box = edgeAlignedBox(piece.outer, hull);
     const Point u = box.u, v{-box.u.y, box.u.x};
-    std::vector<Candidate> candidates = {{false, 0.25 * box.length * shiftAcross}};
+    std::vector<Candidate> candidates;
+    candidates.reserve(13);  // the first, the access rotation, the 11 fallbacks
+    candidates.push_back({false, 0.25 * box.length * shiftAcross});
     bool accessTried = false;
     auto addFallbacks = [&] {
       for (double f : {0.0, 0.15, -0.15, 0.3, -0.3}) candidates.push_back({false, f * box.length});

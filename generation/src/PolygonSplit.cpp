@@ -290,14 +290,17 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
   const Ring& r = polygon.outer;
   const std::size_t n = r.size();
   if (n < 3) return false;
-  std::vector<signed char> side(n);
+  // Scratch kept across calls on this thread (no allocation once grown).
+  thread_local std::vector<signed char> side, onLine;
+  thread_local std::vector<char> touch;
+  side.resize(n);
   for (std::size_t i = 0; i < n; ++i) side[i] = static_cast<signed char>(sideOf(r[i], pivot, dir));
   // A vertex on the line whose neighbours are both on one side (the line
   // touches the ring there, as a split snapped to a contour vertex often does)
   // belongs to that side's piece. On a cut it pinches that side's piece in
   // two there (checked below).
-  const std::vector<signed char> onLine = side;
-  std::vector<char> touch(n, 0);
+  onLine = side;
+  touch.assign(n, 0);
   std::size_t left = 0, right = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const int before = onLine[(i + n - 1) % n], after = onLine[(i + 1) % n];
@@ -329,7 +332,8 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
     int exit = -1;     // crossings: the other end of its cut; touches on a cut: the next stop along it
     std::vector<int> through;  // the touches from the other side passed on the way to `exit`
   };
-  std::vector<Node> nodes;
+  thread_local std::vector<Node> nodes;
+  nodes.clear();
   nodes.reserve(n + 8);
   for (std::size_t i = 0; i < n; ++i) {
     const int s = side[i], next = side[(i + 1) % n];
@@ -362,7 +366,9 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
   // leaves the left side to one where it comes back. Points on the line too
   // close along it to be ordered with certainty are left to the exact split.
   SplitPieces result;
-  std::vector<std::size_t> crossings, touches;
+  thread_local std::vector<std::size_t> crossings, touches;
+  crossings.clear();
+  touches.clear();
   for (std::size_t k = 0; k < m; ++k) {
     if (nodes[k].side != 0 && !nodes[k].touch) continue;
     nodes[k].along = (nodes[k].p.x - pivot.x) * dir.x + (nodes[k].p.y - pivot.y) * dir.y;
@@ -412,8 +418,10 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
   // Each piece: along the ring on its side; where the ring leaves that side
   // (at a crossing, or at a touch on a cut), along the cut to its next stop,
   // and on along the ring from there.
-  std::vector<char> visited(m, 0);
-  std::vector<int> inPiece(m, -1);  // touches: the last piece that passed them
+  thread_local std::vector<char> visited;
+  thread_local std::vector<int> inPiece;  // touches: the last piece that passed them
+  visited.assign(m, 0);
+  inPiece.assign(m, -1);
   int pieces = 0;
   // Each walk collects its ring in a buffer kept across pieces and calls, then
   // copies it out once at its size.
