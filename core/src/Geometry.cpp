@@ -3,6 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>  // part of every x86-64 processor
+#endif
 
 namespace parcelscope {
 
@@ -276,6 +281,15 @@ OrientedBox smallestBoxAlongEdges(const Ring& hull, const Ring& edges) {
   if (hull.empty()) return best;
   best.center = hull[0];
   const Point o = hull[0];  // projections relative to a hull point keep precision
+  // The hull relative to o, once (the same differences for every edge).
+  thread_local std::vector<double> dxs, dys;
+  const std::size_t m = hull.size();
+  dxs.resize(m);
+  dys.resize(m);
+  for (std::size_t j = 0; j < m; ++j) {
+    dxs[j] = hull[j].x - o.x;
+    dys[j] = hull[j].y - o.y;
+  }
   double bestArea = std::numeric_limits<double>::max();
   for (std::size_t i = 0, n = edges.size(); i < n; ++i) {
     const Point& a = edges[i];
@@ -283,20 +297,47 @@ OrientedBox smallestBoxAlongEdges(const Ring& hull, const Ring& edges) {
     const double l = norm(b.x - a.x, b.y - a.y);
     if (l == 0) continue;
     const Point e{(b.x - a.x) / l, (b.y - a.y) / l};
-    double minE = std::numeric_limits<double>::max(), maxE = std::numeric_limits<double>::lowest();
-    double minN = minE, maxN = maxE;
-    for (const Point& p : hull) {
-      const double pe = (p.x - o.x) * e.x + (p.y - o.y) * e.y;
-      const double pn = -(p.x - o.x) * e.y + (p.y - o.y) * e.x;
-      minE = std::min(minE, pe);
-      maxE = std::max(maxE, pe);
-      minN = std::min(minN, pn);
-      maxN = std::max(maxN, pn);
+    // The extents of the projections along e and its normal, two points at a
+    // time. Each projection is computed as one point at a time would, and the
+    // extremes of a set do not depend on the order they are taken in.
+    double minE1 = std::numeric_limits<double>::max(), maxE1 = std::numeric_limits<double>::lowest();
+    double minN1 = minE1, maxN1 = maxE1;
+    std::size_t j = 0;
+#if defined(__SSE2__)
+    const __m128d ex = _mm_set1_pd(e.x), ey = _mm_set1_pd(e.y), sign = _mm_set1_pd(-0.0);
+    __m128d minE = _mm_set1_pd(std::numeric_limits<double>::max()), maxE = _mm_set1_pd(std::numeric_limits<double>::lowest());
+    __m128d minN = minE, maxN = maxE;
+    for (; j + 2 <= m; j += 2) {
+      const __m128d dx = _mm_loadu_pd(&dxs[j]), dy = _mm_loadu_pd(&dys[j]);
+      const __m128d pe = _mm_add_pd(_mm_mul_pd(dx, ex), _mm_mul_pd(dy, ey));
+      const __m128d pn = _mm_add_pd(_mm_mul_pd(_mm_xor_pd(dx, sign), ey), _mm_mul_pd(dy, ex));
+      minE = _mm_min_pd(pe, minE);
+      maxE = _mm_max_pd(pe, maxE);
+      minN = _mm_min_pd(pn, minN);
+      maxN = _mm_max_pd(pn, maxN);
     }
-    const double w = maxE - minE, h = maxN - minN;
+    double lo[2], hi[2], loN[2], hiN[2];
+    _mm_storeu_pd(lo, minE);
+    _mm_storeu_pd(hi, maxE);
+    _mm_storeu_pd(loN, minN);
+    _mm_storeu_pd(hiN, maxN);
+    minE1 = std::min(lo[0], lo[1]);
+    maxE1 = std::max(hi[0], hi[1]);
+    minN1 = std::min(loN[0], loN[1]);
+    maxN1 = std::max(hiN[0], hiN[1]);
+#endif
+    for (; j < m; ++j) {
+      const double pe = dxs[j] * e.x + dys[j] * e.y;
+      const double pn = -dxs[j] * e.y + dys[j] * e.x;
+      minE1 = std::min(minE1, pe);
+      maxE1 = std::max(maxE1, pe);
+      minN1 = std::min(minN1, pn);
+      maxN1 = std::max(maxN1, pn);
+    }
+    const double w = maxE1 - minE1, h = maxN1 - minN1;
     if (w * h < bestArea * (1 - 1e-9)) {
       bestArea = w * h;
-      const double ce = 0.5 * (minE + maxE), cn = 0.5 * (minN + maxN);
+      const double ce = 0.5 * (minE1 + maxE1), cn = 0.5 * (minN1 + maxN1);
       best.center = {o.x + ce * e.x - cn * e.y, o.y + ce * e.y + cn * e.x};
       if (w >= h) {
         best.u = e;
