@@ -305,8 +305,7 @@ OrientedBox smallestBoxAlongEdges(const Ring& hull, const Ring& edges) {
     std::size_t j = 0;
 #if defined(__SSE2__)
     const __m128d ex = _mm_set1_pd(e.x), ey = _mm_set1_pd(e.y), sign = _mm_set1_pd(-0.0);
-    __m128d minE = _mm_set1_pd(std::numeric_limits<double>::max()), maxE = _mm_set1_pd(std::numeric_limits<double>::lowest());
-    __m128d minN = minE, maxN = maxE;
+    __m128d minE = _mm_set1_pd(minE1), maxE = _mm_set1_pd(maxE1), minN = minE, maxN = maxE;
     for (; j + 2 <= m; j += 2) {
       const __m128d dx = _mm_loadu_pd(&dxs[j]), dy = _mm_loadu_pd(&dys[j]);
       const __m128d pe = _mm_add_pd(_mm_mul_pd(dx, ex), _mm_mul_pd(dy, ey));
