@@ -162,8 +162,8 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
     analysis::BlockComparison& c = r.blocks[b];
     c.blockId = a.blocks[b].id;
     c.blockArea = a.statistics[b].blockArea;
-    c.comparison = analysis::compareSets(observedSides[b], analysis::prepareSet(pick(r.generated.metrics, generatedIn[b])),
-                                         bins, quantile);
+    const analysis::PreparedSet generated = analysis::prepareSet(pick(r.generated.metrics, generatedIn[b]));
+    c.comparison = analysis::compareSets(observedSides[b], generated, bins, quantile);
   });
 }
 
@@ -326,6 +326,7 @@ QuantityHistogram quantityHistogram(const CompareResult& r, const CompareRequest
     if (q.name == analysis::metricName(analysis::kComparedMetrics[k]) && r.histograms.size() > k &&
         r.histogramBins == bins && r.histogramQuantile == quantile) {
       made = &r.histograms[k];
+      break;
     }
   }
   const analysis::SharedHistogram h =
