@@ -27,6 +27,7 @@
 #include <QTimer>
 #include <QStatusBar>
 #include <QTableWidget>
+#include <QTextBrowser>
 #include <QToolBar>
 #include <QVBoxLayout>
 #include <QVTKOpenGLStereoWidget.h>
@@ -292,10 +293,15 @@ QWidget* MainWindow::buildControls() {
 
   auto* block = new QGroupBox("Block");
   auto* b = new QVBoxLayout(block);
-  blockInfo_ = new QLabel("Click a block in either view.");
+  // A text view of a fixed height, not a label: a label whose text changes
+  // makes Qt lay out the whole window again (each label's rich text several
+  // times) before the views reach the screen, after every update.
+  blockInfo_ = new QTextBrowser;
   blockInfo_->setObjectName("blockInfo");
-  blockInfo_->setWordWrap(true);
-  blockInfo_->setTextFormat(Qt::RichText);
+  blockInfo_->setFrameShape(QFrame::NoFrame);
+  blockInfo_->viewport()->setAutoFillBackground(false);
+  blockInfo_->setFixedHeight(blockInfo_->fontMetrics().lineSpacing() * 10);
+  blockInfo_->setPlainText("Click a block in either view.");
   b->addWidget(blockInfo_);
   auto* overrides = new QFormLayout;
   blockStyle_ = new QComboBox;
@@ -775,31 +781,50 @@ void MainWindow::fillNumbers() {
   };
   const int rows = static_cast<int>(summary.rows.size() + distances.rows.size());
   const int columns = static_cast<int>(std::max(summary.columns.size(), distances.columns.size()));
-  numbers_->clear();
-  numbers_->setRowCount(rows + 1);
-  numbers_->setColumnCount(columns);
+  // Cells are written in place, and only those whose text changed: a table
+  // cleared and filled again is laid out and painted whole after every update.
+  bool resized = false;
+  if (numbers_->rowCount() != rows + 1 || numbers_->columnCount() != columns) {
+    numbers_->clear();
+    numbers_->setRowCount(rows + 1);
+    numbers_->setColumnCount(columns);
+    resized = true;
+  }
+  bool longer = false;  // a text grew: the columns are fitted again
+  const auto put = [&](int row, int column, const QString& value, bool bold) {
+    QTableWidgetItem* item = numbers_->item(row, column);
+    if (!item) {
+      item = new QTableWidgetItem(value);
+      if (bold) {
+        QFont f = item->font();
+        f.setBold(true);
+        item->setFont(f);
+      }
+      numbers_->setItem(row, column, item);
+      longer = true;
+    } else if (item->text() != value) {
+      longer = longer || value.size() > item->text().size();
+      item->setText(value);
+    }
+  };
   QStringList header;
   for (const auto& c : summary.columns) header << QString::fromStdString(c.name);
   while (header.size() < columns) header << QString();
-  numbers_->setHorizontalHeaderLabels(header);
+  if (resized) numbers_->setHorizontalHeaderLabels(header);
   int row = 0;
   for (const auto& r : summary.rows) {
-    for (std::size_t c = 0; c < r.size(); ++c) numbers_->setItem(row, static_cast<int>(c), new QTableWidgetItem(text(r[c])));
+    for (std::size_t c = 0; c < r.size(); ++c) put(row, static_cast<int>(c), text(r[c]), false);
     ++row;
   }
   for (std::size_t c = 0; c < distances.columns.size(); ++c) {
-    auto* item = new QTableWidgetItem(QString::fromStdString(distances.columns[c].name));
-    QFont f = item->font();
-    f.setBold(true);
-    item->setFont(f);
-    numbers_->setItem(row, static_cast<int>(c), item);
+    put(row, static_cast<int>(c), QString::fromStdString(distances.columns[c].name), true);
   }
   ++row;
   for (const auto& r : distances.rows) {
-    for (std::size_t c = 0; c < r.size(); ++c) numbers_->setItem(row, static_cast<int>(c), new QTableWidgetItem(text(r[c])));
+    for (std::size_t c = 0; c < r.size(); ++c) put(row, static_cast<int>(c), text(r[c]), false);
     ++row;
   }
-  numbers_->resizeColumnsToContents();
+  if (resized || longer) numbers_->resizeColumnsToContents();
 }
 
 void MainWindow::showBlock() {
@@ -807,7 +832,7 @@ void MainWindow::showBlock() {
   if (!result_ || selected_ < 0) {
     observedView_->outline().setShapes(outline);
     proceduralView_->outline().setShapes(outline);
-    blockInfo_->setText("Click a block in either view.");
+    setBlockInfo("Click a block in either view.");
     return;
   }
   const viz::CompareResult& r = *result_;
@@ -824,7 +849,7 @@ void MainWindow::showBlock() {
     }
   }
   const bool overridden = request_.overrides.count(block.id) > 0;
-  blockInfo_->setText(
+  setBlockInfo(
       QString("<b>Block %1</b> (%2 m&sup2;; subdivided with %3%4)<br>"
               "<table cellspacing=4><tr><th></th><th>observed</th><th>procedural</th></tr>"
               "<tr><td>parcels</td><td>%5</td><td>%6</td></tr>"
@@ -845,6 +870,12 @@ void MainWindow::showBlock() {
 }
 
 QString MainWindow::lastError() const { return errorBar_->isVisible() ? errorBar_->text() : QString(); }
+
+void MainWindow::setBlockInfo(const QString& html) {
+  if (html == blockInfoHtml_) return;
+  blockInfoHtml_ = html;
+  blockInfo_->setHtml(html);
+}
 
 void MainWindow::showError(const QString& message) {
   errorBar_->setText(message);

@@ -28,6 +28,7 @@ class QMenu;
 class QProgressBar;
 class QPushButton;
 class QTableWidget;
+class QTextBrowser;
 class QVTKOpenGLStereoWidget;
 class vtkChartXY;
 class vtkContextView;
@@ -114,6 +115,7 @@ private:
   /// The request of the result shown, with the colouring chosen now.
   viz::CompareRequest shown() const;
   void showError(const QString& message);
+  void setBlockInfo(const QString& html);
   /// Recolours the views; returns whether the observed view changed (it is
   /// drawn again only then). `observedChanged`: its data changed.
   bool recolour(bool observedChanged);
@@ -162,7 +164,8 @@ private:
   QComboBox* colourBy_;
   QCheckBox* perBlockBounds_;
   ParameterPanel* panel_;
-  QLabel* blockInfo_;
+  QTextBrowser* blockInfo_;
+  QString blockInfoHtml_;  // what blockInfo_ shows
   QComboBox* blockStyle_;
   std::map<std::string, std::pair<QCheckBox*, QDoubleSpinBox*>> blockParameters_;
   QMenu* recentMenu_;

@@ -8,6 +8,7 @@
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
 #include <vtkCoordinate.h>
+#include <vtkCullerCollection.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkInteractorStyleTrackballCamera.h>
 #include <vtkObjectFactory.h>
@@ -83,6 +84,10 @@ MapView::MapView(const QString& title, bool withColourBar, QWidget* parent) : QW
   // The map above, a legend band below (the same in both views, so that
   // linked views show the same extent).
   renderer_->SetBackground(1, 1, 1);
+  // No frustum culling: the layer is a few dozen actors, nearly always all
+  // in view, and culling computes every changed part's bounds cell by cell
+  // before each frame.
+  renderer_->GetCullers()->RemoveAllItems();
   renderer_->SetViewport(0, kLegendBand, 1, 1);
   legend_->SetBackground(1, 1, 1);
   legend_->SetViewport(0, 0, 1, kLegendBand);

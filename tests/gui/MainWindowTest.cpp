@@ -16,6 +16,7 @@
 #include <QTableWidget>
 #include <QTemporaryDir>
 #include <QTest>
+#include <QTextBrowser>
 #include <QVTKOpenGLStereoWidget.h>
 
 #include <cmath>
@@ -151,9 +152,10 @@ private slots:
     QVERIFY(after->blocks[4].comparison.generated.parcels > before);
     QCOMPARE(after->blocks[3].comparison.generated.parcels, r->blocks[3].comparison.generated.parcels);
     QCOMPARE(static_cast<int>(after->generated.parcels.size()), libraryParcelCount());
-    auto* info = window_->findChild<QLabel*>("blockInfo");
-    QVERIFY(info->text().contains("Block 4"));
-    QVERIFY(info->text().contains("overridden"));
+    auto* info = window_->findChild<QTextBrowser*>("blockInfo");
+    QVERIFY(info);
+    QVERIFY(info->toPlainText().contains("Block 4"));
+    QVERIFY(info->toPlainText().contains("overridden"));
   }
 
   void exportsFiguresTablesParcelsAndSession() {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -275,6 +276,41 @@ TEST(QuantityHistogram, ComparedMetricsReuseTheComparisonsHistogramsOnTheSameBin
   CompareRequest other = request;
   other.parameters["bins"] = 7;
   EXPECT_EQ(quantityHistogram(r, other, "area").edges.size(), 8u);
+}
+
+TEST(QuantityScale, ObservedParcelsSetTheRangeWhateverIsGenerated) {
+  const CompareRequest request = sampleRequest();
+  const CompareResult r = compare(request);
+  const double quantile = request.parameters.at("histogram-quantile");
+  for (const char* name : {"area", "width", "p_area"}) {
+    SCOPED_TRACE(name);
+    const auto& q = analysis::parcelQuantity(name);
+    std::vector<double> observed = analysis::quantitySample(r.observedLots, q);
+    ASSERT_FALSE(observed.empty());
+    std::sort(observed.begin(), observed.end());
+    const auto rank = static_cast<std::size_t>(std::ceil(quantile * static_cast<double>(observed.size())));
+    const ColourScale scale = quantityScale(r, request, name);
+    EXPECT_EQ(scale.minimum, observed.front());
+    EXPECT_EQ(scale.maximum, observed[std::max<std::size_t>(rank, 1) - 1]);
+    // Other generated parcels (every value scaled up): the same scale.
+    CompareResult other = r;
+    for (auto& m : other.generated.metrics) {
+      m.area *= 3;
+      m.width *= 3;
+      m.pArea *= 3;
+    }
+    const ColourScale same = quantityScale(other, request, name);
+    EXPECT_EQ(same.minimum, scale.minimum);
+    EXPECT_EQ(same.maximum, scale.maximum);
+    EXPECT_EQ(same.title, scale.title);
+    // No observed value: the generated parcels set it.
+    other.observedLots.clear();
+    std::vector<double> generated = analysis::quantitySample(other.generated.metrics, q);
+    ASSERT_FALSE(generated.empty());
+    EXPECT_EQ(quantityScale(other, request, name).minimum, *std::min_element(generated.begin(), generated.end()));
+  }
+  EXPECT_EQ(quantityScale(r, request, "aspect_ratio").minimum, 1.0);
+  EXPECT_EQ(quantityScale(r, request, "street_access").maximum, 1.0);
 }
 
 TEST(SessionFile, RoundTripsInputParametersOverridesAndSeed) {

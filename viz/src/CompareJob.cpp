@@ -270,25 +270,25 @@ ColourScale quantityScale(const CompareResult& r, const CompareRequest& request,
     scale.maximum = 1;
     return scale;
   }
-  std::vector<double> pooled = analysis::quantitySample(r.observedLots, q);
-  const std::vector<double> generated = analysis::quantitySample(r.generated.metrics, q);
-  pooled.insert(pooled.end(), generated.begin(), generated.end());
-  if (pooled.empty()) {
+  // The observed parcels set the range, so that a change to the generated
+  // parcels (a slider) leaves the scale, and the observed view, as they were;
+  // the generated parcels set it only when no observed parcel has a value.
+  std::vector<double> sample = analysis::quantitySample(r.observedLots, q);
+  if (sample.empty()) sample = analysis::quantitySample(r.generated.metrics, q);
+  if (sample.empty()) {
     scale.minimum = 0;
     scale.maximum = 1;
     return scale;
   }
-  std::sort(pooled.begin(), pooled.end());
+  std::sort(sample.begin(), sample.end());
   const double quantile = value(request, "histogram-quantile");
-  scale.minimum = pooled.front();
+  scale.minimum = sample.front();
   // The nearest-rank quantile, as the histograms' bins (analysis::sharedHistogram).
-  const auto rank = static_cast<std::size_t>(std::ceil(quantile * static_cast<double>(pooled.size())));
-  scale.maximum = pooled[std::min(pooled.size(), std::max<std::size_t>(rank, 1)) - 1];
+  const auto rank = static_cast<std::size_t>(std::ceil(quantile * static_cast<double>(sample.size())));
+  scale.maximum = sample[std::min(sample.size(), std::max<std::size_t>(rank, 1)) - 1];
   if (!(scale.maximum > scale.minimum)) scale.maximum = scale.minimum + 1;
-  if (quantile < 1 && pooled.back() > scale.maximum) {
-    std::snprintf(title, sizeof title, "; %.4g and above drawn darkest", scale.maximum);
-    scale.title += title;
-  }
+  std::snprintf(title, sizeof title, "; %.4g and above drawn darkest", scale.maximum);
+  scale.title += title;
   return scale;
 }
 

@@ -26,6 +26,8 @@
 #include <vtkIdTypeArray.h>
 #include <vtkPolyData.h>
 #include <vtkPolygon.h>
+#include <vtkOpenGLPolyDataMapper.h>
+#include <vtkOpenGLVertexBufferObject.h>
 #include <vtkPolyDataMapper.h>
 #include <vtkProperty.h>
 #include <vtkRenderWindow.h>
@@ -754,6 +756,14 @@ struct MapLayer::Impl {
 MapLayer::MapLayer() : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   for (LayerPart& p : m.parts) {
+    // The coordinates are local metres around the data's centre: no shift
+    // and scale is needed, and VTK would otherwise scan every point for it
+    // each time a part is sent again.
+    for (vtkPolyDataMapper* mapper : {p.fillMapper.GetPointer(), p.ringMapper.GetPointer()}) {
+      if (auto* gl = vtkOpenGLPolyDataMapper::SafeDownCast(mapper)) {
+        gl->SetVBOShiftScaleMethod(vtkOpenGLVertexBufferObject::DISABLE_SHIFT_SCALE);
+      }
+    }
     p.fillMapper->SetInputData(p.geometry.fill);
     p.fillMapper->SetScalarModeToUsePointData();
     p.fillMapper->UseLookupTableScalarRangeOn();

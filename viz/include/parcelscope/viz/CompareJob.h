@@ -76,8 +76,11 @@ struct CompareResult {
 
 /// The colour scale of parcel quantity `quantity`, shared by both sets: aspect
 /// ratio red (1:1) to green (map-aspect-ratio-max, Vanegas et al. 2012, Figure 1);
-/// street access 0 to 1; the others pale to dark from the smallest value of
-/// both sets to their pooled histogram-quantile. Throws Error(Usage) for an unknown quantity.
+/// street access 0 to 1; the others pale to dark from the smallest observed
+/// value to the observed histogram-quantile (nearest rank), values beyond
+/// either end drawn at that end. The generated parcels set the range only when
+/// no observed parcel has a value, so the scale stays put while generation
+/// parameters change. Throws Error(Usage) for an unknown quantity.
 ColourScale quantityScale(const CompareResult& result, const CompareRequest& request, const std::string& quantity);
 
 /// The overlaid histograms of parcel quantity `quantity` on shared bins, with
