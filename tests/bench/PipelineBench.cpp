@@ -339,6 +339,9 @@ void MapLayerUpdate(benchmark::State& state) {
     results[static_cast<std::size_t>(k)] = session.update(request).result;
   }
   parcelscope::viz::MapLayer layer;
+  // The scale drawn at: 0 exact; 9 m per pixel is the whole city in the
+  // application's view (shapes simplified to half a pixel).
+  layer.setMetresPerPixel(static_cast<double>(state.range(0)));
   std::size_t i = 0, shapes = 0;
   for (auto _ : state) {
     const parcelscope::viz::CompareResult& r = *results[++i % 2];
@@ -352,7 +355,8 @@ void MapLayerUpdate(benchmark::State& state) {
     shapes = polygons.size();
   }
   state.counters["shapes"] = static_cast<double>(shapes);
+  state.counters["points"] = static_cast<double>(layer.pointsDrawn());
 }
-BENCHMARK(MapLayerUpdate)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+BENCHMARK(MapLayerUpdate)->Arg(0)->Arg(9)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
 BENCHMARK_MAIN();

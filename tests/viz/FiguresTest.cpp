@@ -285,6 +285,47 @@ TEST(MapLayer, RebuildsOnlyChangedPartsAndDrawsWhatAFreshLayerDraws) {
   EXPECT_FALSE(draw(old, extent) == a);
 }
 
+// Squares of 20 m in a row whose shared sides carry 9 points each, up to 0.3 m
+// off the straight side: drawn with fewer points when a pixel is metres wide,
+// with every point again when zoomed in, and alike however the scale was reached.
+TEST(MapLayer, DrawsFewerPointsAtCoarseScalesAndEveryPointZoomedIn) {
+  std::vector<Polygon> squares(4);
+  for (std::size_t i = 0; i < squares.size(); ++i) {
+    const double x0 = 20.0 * static_cast<double>(i), x1 = x0 + 20;
+    Ring& r = squares[i].outer;
+    r.push_back({x0, 0});
+    r.push_back({x1, 0});
+    for (int k = 1; k <= 9; ++k) r.push_back({x1 + 0.3 * std::sin(k * (static_cast<double>(i) + 1)), 2.0 * k});
+    r.push_back({x1, 20});
+    r.push_back({x0, 20});
+    if (i > 0) {  // the left neighbour's right side, run downwards
+      for (int k = 9; k >= 1; --k) r.push_back({x0 + 0.3 * std::sin(k * static_cast<double>(i)), 2.0 * k});
+    }
+  }
+  std::vector<const Polygon*> shapes;
+  std::size_t total = 0;
+  for (const Polygon& s : squares) {
+    shapes.push_back(&s);
+    total += s.outer.size();
+  }
+  const std::vector<double> values(shapes.size(), 1.0);
+  const std::vector<int> blocks(shapes.size(), 0);  // one group: the sides are shared
+  MapLayer layer;
+  layer.setShapes(shapes, values, blocks);
+  EXPECT_EQ(layer.pointsDrawn(), total);
+  layer.setMetresPerPixel(8.0);  // 4 m: the squares' corners only
+  EXPECT_EQ(layer.pointsDrawn(), 4u * shapes.size());
+  layer.setMetresPerPixel(0.01);
+  EXPECT_EQ(layer.pointsDrawn(), total);
+  layer.setMetresPerPixel(8.0);
+  MapLayer fresh;
+  fresh.setMetresPerPixel(8.0);
+  fresh.setShapes(shapes, values, blocks);
+  EXPECT_EQ(fresh.pointsDrawn(), layer.pointsDrawn());
+  const Box extent{0, 0, 80, 20};
+  EXPECT_TRUE(draw(layer, extent) == draw(fresh, extent));
+}
+
 TEST(RenderMaps, RefusesMismatchedValuesAndEmptyMaps) {
   TempDir dir;
   const Polygon square = rect(0, 0, 1, 1);

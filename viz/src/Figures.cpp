@@ -50,6 +50,7 @@
 #include <limits>
 
 #include "EarClip.h"
+#include "Simplify.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
 
@@ -305,6 +306,10 @@ void buildPanel(const MapPanel& panel, PanelGeometry& g, std::vector<vtkIdType>*
   vtkIdType offset = 0;
   for (std::size_t k = 0; k < panel.shapes.size(); ++k) {
     const Polygon& shape = *panel.shapes[k];
+    if (shape.outer.size() < 3) {  // nothing to draw (a shape simplified away)
+      if (pointsPerShape) pointsPerShape->push_back(0);
+      continue;
+    }
     const bool outlined = minOutlined <= 0 || outlineSize(shape) >= minOutlined;
     vtkIdType first = offset;
     auto addRing = [&](const Ring& ring) {
@@ -666,6 +671,7 @@ struct LayerPart {
   std::vector<double> values;
   std::vector<vtkIdType> pointsPerShape;
   TriangleCache triangles;
+  std::vector<Polygon> simple;  // the members as drawn, when simplified (memory reused)
   // Every member's rings (cells ringStart[k] to ringStart[k + 1]), its size
   // across, and the sizes sorted: the outlined members are those at least
   // kMinOutlinedPixels * metresPerPixel across.
@@ -701,9 +707,18 @@ struct LayerPart {
     geometry.rings->SetLines(some);
   }
 
-  void rebuild(const std::vector<const Polygon*>& shapes, double metresPerPixel) {
+  // Builds the part again from its members, simplified for `tolerance`
+  // (metres; 0: as they are).
+  void rebuild(const std::vector<const Polygon*>& shapes, double metresPerPixel, double tolerance) {
     MapPanel panel;
     for (std::size_t k : members) panel.shapes.push_back(shapes[k]);
+    const std::vector<const Polygon*> original = panel.shapes;
+    // The parts hold whole groups (blocks), whose parcels share no boundary
+    // with other groups: each part is simplified on its own.
+    if (tolerance > 0) {
+      detail::simplifyShared(original, tolerance, simple);
+      for (std::size_t i = 0; i < simple.size(); ++i) panel.shapes[i] = &simple[i];
+    }
     panel.values = values;
     PanelGeometry fresh;
     pointsPerShape.clear();
@@ -713,9 +728,12 @@ struct LayerPart {
     allRings = fresh.rings->GetLines();
     ringStart.assign(1, 0);
     size.clear();
-    for (const Polygon* shape : panel.shapes) {
-      ringStart.push_back(ringStart.back() + 1 + static_cast<vtkIdType>(shape->holes.size()));
-      size.push_back(outlineSize(*shape));
+    for (std::size_t i = 0; i < panel.shapes.size(); ++i) {
+      const Polygon& drawn = *panel.shapes[i];
+      // The rings buildPanel outlined, all of them (outlines are chosen below).
+      const vtkIdType outlines = drawn.outer.size() < 3 ? 0 : 1 + static_cast<vtkIdType>(drawn.holes.size());
+      ringStart.push_back(ringStart.back() + outlines);
+      size.push_back(outlineSize(*original[i]));
     }
     sortedSize = size;
     std::sort(sortedSize.begin(), sortedSize.end());
@@ -744,9 +762,19 @@ struct LayerPart {
   }
 };
 
+// How far a drawn boundary may stray from the shape's (metres) at a scale:
+// half a pixel, rounded down to a power of two, so that the layer is built
+// again only when the scale halves or doubles. 0 (no scale yet): exact.
+double drawingTolerance(double metresPerPixel) {
+  if (!(metresPerPixel > 0) || !std::isfinite(metresPerPixel)) return 0;
+  return std::exp2(std::floor(std::log2(0.5 * metresPerPixel)));
+}
+
 struct MapLayer::Impl {
   std::array<LayerPart, kLayerParts> parts;
   std::size_t shapes = 0;
+  std::vector<const Polygon*> drawn;  // the last setShapes's shapes
+  double tolerance = 0;               // drawingTolerance of the scale they were built for
   vtkSmartPointer<vtkLookupTable> lut = lookupTable(ColourScale{});
   vtkNew<vtkScalarBarActor> bar;
   double metresPerPixel = 0;
@@ -824,17 +852,36 @@ void MapLayer::setShapes(const std::vector<const Polygon*>& shapes, const std::v
     stale.push_back(i);
   }
   // The parts share nothing: they are triangulated side by side.
-  parallelFor(stale.size(), [&](std::size_t i) { m.parts[stale[i]].rebuild(shapes, m.metresPerPixel); });
+  parallelFor(stale.size(), [&](std::size_t i) { m.parts[stale[i]].rebuild(shapes, m.metresPerPixel, m.tolerance); });
   m.rebuilt = stale.size();
   m.shapes = shapes.size();
+  m.drawn = shapes;
 }
 
 void MapLayer::setMetresPerPixel(double metresPerPixel) {
-  impl_->metresPerPixel = metresPerPixel;
-  for (LayerPart& p : impl_->parts) p.selectOutlines(metresPerPixel, false);
+  Impl& m = *impl_;
+  m.metresPerPixel = metresPerPixel;
+  const double tolerance = drawingTolerance(metresPerPixel);
+  if (tolerance != m.tolerance) {
+    // Another level of detail: every part is built again for it.
+    m.tolerance = tolerance;
+    parallelFor(m.parts.size(), [&](std::size_t i) {
+      if (!m.parts[i].members.empty()) m.parts[i].rebuild(m.drawn, metresPerPixel, tolerance);
+    });
+    return;
+  }
+  for (LayerPart& p : m.parts) p.selectOutlines(metresPerPixel, false);
 }
 
 std::size_t MapLayer::partsRebuilt() const { return impl_->rebuilt; }
+
+std::size_t MapLayer::pointsDrawn() const {
+  std::size_t n = 0;
+  for (const LayerPart& p : impl_->parts) {
+    for (vtkIdType k : p.pointsPerShape) n += static_cast<std::size_t>(k);
+  }
+  return n;
+}
 
 std::size_t MapLayer::outlinedShapes() const {
   std::size_t n = 0;

@@ -27,6 +27,13 @@ public:
   /// one of the layer's parts: only the parts whose shapes changed are built
   /// again, so give the block of each parcel. Throws Error(Usage) when the
   /// counts differ.
+  ///
+  /// The layer draws the shapes simplified for the scale it is drawn at
+  /// (setMetresPerPixel): vertices within half a pixel of the drawn boundary
+  /// are left out, and boundaries that shapes of one group share stay shared
+  /// (detail::simplifyShared), so no gap opens between neighbours. It reads
+  /// the shapes again when the scale halves or doubles: they must stay alive
+  /// until the next setShapes.
   void setShapes(const std::vector<const Polygon*>& shapes, const std::vector<double>& values,
                  const std::vector<int>& groups = {});
   /// Replaces only the values (same shapes as the last setShapes), without
@@ -37,10 +44,13 @@ public:
   /// Shows or hides the grey outlines (on by default).
   void setOutlinesVisible(bool visible);
   /// The scale drawn at (metres per pixel): only shapes at least
-  /// kMinOutlinedPixels across get an outline. 0 (the default): every shape.
+  /// kMinOutlinedPixels across get an outline, and the shapes are simplified
+  /// for it. 0 (the default): every shape, exact.
   void setMetresPerPixel(double metresPerPixel);
   /// How many shapes have an outline at the current scale.
   std::size_t outlinedShapes() const;
+  /// How many points the filled shapes are drawn with (after simplification).
+  std::size_t pointsDrawn() const;
   /// How many of the layer's parts the last setShapes built again.
   std::size_t partsRebuilt() const;
   /// The scale's colour bar (horizontal), for the caller to place.
