@@ -54,12 +54,20 @@ struct ObbSplits {
   struct Split {
     std::vector<Polygon> parts;  ///< empty: no admissible split (the piece stays, oversize)
     std::vector<char> access;
+    std::vector<double> areas;  ///< of the parts (area())
   };
-  /// A piece that did not fit: its split and what became of each part (null:
-  /// the part fitted and was never split).
+  struct Node;
+  /// What became of a part: its node (null: it fitted and was never split) and
+  /// the minimum-area box width of its hull once measured (NaN before): a run
+  /// reusing the split tests the part's fit without measuring it again.
+  struct Child {
+    std::shared_ptr<const Node> node;
+    double width = std::numeric_limits<double>::quiet_NaN();
+  };
+  /// A piece that did not fit: its split and what became of each part.
   struct Node {
     std::shared_ptr<const Split> split;
-    std::vector<std::shared_ptr<const Node>> children;
+    std::vector<Child> children;
   };
   std::shared_ptr<const Node> root;  ///< null: the block fitted as it is
 };
@@ -97,7 +105,8 @@ public:
   /// Subdivides the block, reusing the splits of `previous` (may be null);
   /// returns the splits made and reused when recording.
   NodePtr run(std::uint64_t seed, const NodePtr& previous) {
-    return recurse(block_, seed, hasAccess(block_), 0, previous);
+    double width = std::numeric_limits<double>::quiet_NaN();
+    return recurse(block_, area(block_), width, seed, hasAccess(block_), 0, previous);
   }
 
 private:
@@ -141,9 +150,9 @@ private:
   // check, and whenever the fast path does not apply, the exact split decides.
   // (A pinched split is refused either way.)
   std::vector<Polygon> admissibleSplit(const Polygon& piece, double pieceArea, const Point& through,
-                                       const Point& dir) const {
+                                       const Point& dir, std::vector<double>& areas) const {
     detail::SplitPieces split;
-    std::vector<double> areas;
+    areas.clear();
     areas.reserve(4);
     if (detail::splitByLineFast(piece, through, dir, split)) {
       // A piece pinched at a point is never admissible: the exact split gives
@@ -268,10 +277,11 @@ private:
       // The snapped line first; if it makes an inadmissible split (for example a
       // sliver along a contour edge parallel to it), the line as drawn.
       std::vector<Polygon> parts;
+      std::vector<double> areas;
       bool admissible = false;
       const Point snapped = snap(pivot, dir, near);
       for (const Point& through : {snapped, pivot}) {
-        parts = admissibleSplit(piece, pieceArea, through, dir);
+        parts = admissibleSplit(piece, pieceArea, through, dir, areas);
         admissible = !parts.empty();
         if (admissible || (through.x == pivot.x && through.y == pivot.y)) break;
       }
@@ -308,17 +318,28 @@ private:
       for (std::size_t k : order) {
         out.parts.push_back(std::move(parts[k]));
         out.access.push_back(partAccess[k]);
+        out.areas.push_back(areas[k]);
       }
       return out;
     }
     return {};
   }
 
-  NodePtr recurse(const Polygon& piece, std::uint64_t seed, bool access, int depth, const NodePtr& previous) {
-    const double a = area(piece);
-    const Ring hull = convexHull(piece.outer);  // for the fit test and the split's box
+  // `a` is the piece's area; `width` its hull's minimum-area box width when
+  // known (NaN otherwise), set here when measured.
+  NodePtr recurse(const Polygon& piece, double a, double& width, std::uint64_t seed, bool access, int depth,
+                  const NodePtr& previous) {
+    Ring hull;  // for the fit test and the split's box, made when first needed
+    const auto hullOf = [&]() -> const Ring& {
+      if (hull.empty()) hull = convexHull(piece.outer);
+      return hull;
+    };
     // The width is measured only when the area fits.
-    const bool fits = a <= p_.aMax && minimumAreaBoxOfHull(hull).width <= p_.wMax;
+    bool fits = a <= p_.aMax;
+    if (fits) {
+      if (std::isnan(width)) width = minimumAreaBoxOfHull(hullOf()).width;
+      fits = width <= p_.wMax;
+    }
     // Safety nets against pathological bounds: recursion depth and a budget of
     // parcels per block.
     if (fits || depth > 60 || out_.parcels.size() >= kMaxParcelsPerBlock) {
@@ -333,11 +354,13 @@ private:
     const std::uint64_t childBase = rng.next();
 
     auto node = std::make_shared<Node>();
-    if (previous && previous->split) {
+    const bool reused = previous && previous->split;
+    if (reused) {
       node->split = previous->split;
+      node->children = previous->children;  // their nodes and widths, replaced below
     } else {
-      node->split =
-          std::make_shared<const ObbSplits::Split>(split(piece, a, hull, access, wantAccess, shiftAcross, shiftAlong));
+      node->split = std::make_shared<const ObbSplits::Split>(
+          split(piece, a, hullOf(), access, wantAccess, shiftAcross, shiftAlong));
     }
     const ObbSplits::Split& chosen = *node->split;
     if (chosen.parts.empty()) {
@@ -346,8 +369,10 @@ private:
     }
     node->children.resize(chosen.parts.size());
     for (std::size_t k = 0; k < chosen.parts.size(); ++k) {
-      const NodePtr below = previous && k < previous->children.size() ? previous->children[k] : nullptr;
-      node->children[k] = recurse(chosen.parts[k], splitmix64(childBase + k), chosen.access[k] != 0, depth + 1, below);
+      ObbSplits::Child& child = node->children[k];
+      const NodePtr below = std::move(child.node);
+      child.node = recurse(chosen.parts[k], chosen.areas[k], child.width, splitmix64(childBase + k),
+                           chosen.access[k] != 0, depth + 1, below);
     }
     return record_ ? NodePtr(std::move(node)) : nullptr;
   }
