@@ -67,6 +67,23 @@ vtkStandardNewMacro(ChartStyle);
 
 namespace {
 
+// Milliseconds since the last call (the first: since construction), for
+// MainWindow::UpdateTimings.
+class Laps {
+public:
+  Laps() { timer_.start(); }
+  double operator()() {
+    const double now = total(), ms = now - last_;
+    last_ = now;
+    return ms;
+  }
+  double total() const { return static_cast<double>(timer_.nsecsElapsed()) / 1e6; }
+
+private:
+  QElapsedTimer timer_;
+  double last_ = 0;
+};
+
 // Parameters the panel shows first (the list), then every other
 // parameter of compare except the figure settings, which only exports use.
 const char* kFirst[] = {"k", "a-min", "a-max", "w-min", "w-max", "omega", "xi", "offset", "seed"};
@@ -543,13 +560,17 @@ void MainWindow::setColourBy(const QString& quantity) {
     colourBy_->setCurrentText(quantity);
   }
   if (!result_) return;
-  QElapsedTimer t;
-  t.start();
+  Laps lap;
+  UpdateTimings timings;
   recolour(false);
+  timings.layers = lap();
   drawHistogram();
+  timings.histogram = lap();
   observedView_->render();
   proceduralView_->render();
-  lastLatencyMs_ = static_cast<double>(t.nsecsElapsed()) / 1e6;
+  timings.views = lap();
+  lastTimings_ = timings;
+  lastLatencyMs_ = lap.total();
   lastFirstViewMs_ = lastLatencyMs_;
   emit viewsUpdated(shownSerial_);
 }
@@ -614,6 +635,11 @@ void MainWindow::showReport(const UpdateReport& report) {
 void MainWindow::drawReport(const UpdateReport& report) {
   if (report.partial && report.serial != pendingSerial_) return;  // superseded already
   const bool first = !result_ || report.reloaded;
+  Laps lap;
+  UpdateTimings timings;
+  if (const auto it = started_.find(report.serial); it != started_.end()) {
+    timings.library = static_cast<double>(it->second.nsecsElapsed()) / 1e6;
+  }
   // The result replaced is freed in the background, not before drawing.
   releaseInBackground(std::exchange(result_, report.result));
   shownRequest_ = report.request;
@@ -658,6 +684,7 @@ void MainWindow::drawReport(const UpdateReport& report) {
   }
   const bool observedChanged = recolour(first || selectionChanged_);
   selectionChanged_ = false;
+  timings.layers = lap();
   if (first) {
     Box extent{1e300, 1e300, -1e300, -1e300};
     for (const Block& b : a.blocks) {
@@ -670,10 +697,14 @@ void MainWindow::drawReport(const UpdateReport& report) {
     observedView_->fit(extent);
   }
   drawHistogram();
+  timings.histogram = lap();
   fillNumbers();
   showBlock();
+  timings.text = lap();
   if (observedChanged || first) observedView_->render();
   proceduralView_->render();
+  timings.views = lap();
+  lastTimings_ = timings;
 
   const auto it = started_.find(report.serial);
   if (report.partial) {

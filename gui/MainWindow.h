@@ -92,6 +92,14 @@ public:
   /// Milliseconds from the last completed change to the first views drawn for
   /// it (a result in between, while many blocks are regenerated, or the final one).
   double lastFirstViewMs() const { return lastFirstViewMs_; }
+  /// Where the last drawn change's time went (ms): the library until its
+  /// result arrived (0 for a change the window makes alone), the map layers
+  /// rebuilt and recoloured, the histogram, the numbers and block text, and
+  /// the views drawn into their buffers. lastLatencyMs is about their sum.
+  struct UpdateTimings {
+    double library = 0, layers = 0, histogram = 0, text = 0, views = 0;
+  };
+  UpdateTimings lastTimings() const { return lastTimings_; }
   /// True while an update is queued or under way.
   bool busy() const { return pendingSerial_ != shownSerial_ && !failedOrCancelled_; }
 
@@ -141,6 +149,7 @@ private:
   bool failedOrCancelled_ = false;
   std::map<qint64, QElapsedTimer> started_;
   double lastLatencyMs_ = 0;
+  UpdateTimings lastTimings_;
   double firstViewMs_ = -1, lastFirstViewMs_ = 0;
   int selected_ = -1;
   std::vector<std::vector<int>> histogramCounts_;

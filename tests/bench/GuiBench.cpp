@@ -46,16 +46,24 @@ struct Row {
   std::string change;
   std::vector<double> ms;
   std::vector<double> firstMs;  // to the first views drawn (a result in between, or the final one)
+  // MainWindow::lastTimings of each change, and the time from the views drawn to the screen.
+  std::vector<double> library, layers, histogram, text, views, toScreen;
 };
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
 
 void print(const Row& r) {
   std::vector<double> v = r.ms;
   std::sort(v.begin(), v.end());
   const auto at = [&](double q) { return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5)]; };
-  std::vector<double> f = r.firstMs;
-  std::sort(f.begin(), f.end());
   std::printf("%-58s n=%2zu  median %8.1f ms  p90 %8.1f ms  max %8.1f ms  first view: median %7.1f ms\n",
-              r.change.c_str(), v.size(), at(0.5), at(0.9), v.back(), f[f.size() / 2]);
+              r.change.c_str(), v.size(), at(0.5), at(0.9), v.back(), median(r.firstMs));
+  std::printf("%-58s medians: library %.1f, layers %.1f, histogram %.1f, text %.1f, views %.1f, to screen %.1f ms\n",
+              "", median(r.library), median(r.layers), median(r.histogram), median(r.text), median(r.views),
+              median(r.toScreen));
 }
 
 // When each view last rendered and last reached the screen, on one clock.
@@ -153,7 +161,7 @@ int main(int argc, char** argv) {
   };
   auto measure = [&](const std::string& name, int n, const std::function<void(int)>& change) {
     if (!wanted(name)) return;
-    Row row{name, {}, {}};
+    Row row{name, {}, {}, {}, {}, {}, {}, {}, {}};
     for (int i = 0; i < n; ++i) {
       change(i);
       if (!settle(w)) {
@@ -169,6 +177,13 @@ int main(int argc, char** argv) {
         std::exit(1);
       }
       row.ms.push_back(w.lastLatencyMs() + toScreen);
+      const MainWindow::UpdateTimings t = w.lastTimings();
+      row.library.push_back(t.library);
+      row.layers.push_back(t.layers);
+      row.histogram.push_back(t.histogram);
+      row.text.push_back(t.text);
+      row.views.push_back(t.views);
+      row.toScreen.push_back(toScreen);
       // (The time to screen of the final views stands in for that of the first.)
       row.firstMs.push_back(w.lastFirstViewMs() + toScreen);
     }

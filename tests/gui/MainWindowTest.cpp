@@ -127,6 +127,12 @@ private slots:
     QCOMPARE(static_cast<int>(after->generated.parcels.size()), libraryParcelCount());
     // The spin box follows the slider.
     QCOMPARE(window_->parameterPanel()->spinBox("w-max")->value(), window_->request().parameters.at("w-max"));
+    // The time split: the library's part and the views', within the whole.
+    const auto t = window_->lastTimings();
+    QVERIFY(t.library > 0);
+    QVERIFY(t.views > 0);
+    const double parts = t.library + t.layers + t.histogram + t.text + t.views;
+    QVERIFY2(parts <= window_->lastLatencyMs() + 0.5, qPrintable(QString::number(parts)));
   }
 
   void colourByChangesHistogramWithoutRegenerating() {
@@ -136,6 +142,8 @@ private slots:
     QCOMPARE(window_->result(), before);
     window_->setColourBy("aspect_ratio");
     QVERIFY(window_->histogramTitle().contains("aspect ratio"));
+    QCOMPARE(window_->lastTimings().library, 0.0);  // the window alone
+    QVERIFY(window_->lastTimings().views > 0);
   }
 
   void clickingABlockSelectsItAndOverridingRegeneratesIt() {
