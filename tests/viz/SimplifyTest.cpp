@@ -51,7 +51,8 @@ double ringDistance(const Point& p, const Ring& r) {
 std::vector<Polygon> randomPartition(std::mt19937& rng, int nx, int ny, int inner, double noise) {
   std::uniform_real_distribution<double> jitter(-0.2, 0.2), wobble(-noise, noise), coin(0, 1);
   const double cx = 100.0 / nx, cy = 100.0 / ny;
-  std::vector<std::vector<Point>> grid(static_cast<std::size_t>(nx + 1), std::vector<Point>(static_cast<std::size_t>(ny + 1)));
+  std::vector<std::vector<Point>> grid(static_cast<std::size_t>(nx + 1),
+                                       std::vector<Point>(static_cast<std::size_t>(ny + 1)));
   for (int i = 0; i <= nx; ++i) {
     for (int j = 0; j <= ny; ++j) {
       const bool border = i == 0 || j == 0 || i == nx || j == ny;

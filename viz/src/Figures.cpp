@@ -772,7 +772,6 @@ double drawingTolerance(double metresPerPixel) {
 
 struct MapLayer::Impl {
   std::array<LayerPart, kLayerParts> parts;
-  std::size_t shapes = 0;
   std::vector<const Polygon*> drawn;  // the last setShapes's shapes
   double tolerance = 0;               // drawingTolerance of the scale they were built for
   vtkSmartPointer<vtkLookupTable> lut = lookupTable(ColourScale{});
@@ -854,7 +853,6 @@ void MapLayer::setShapes(const std::vector<const Polygon*>& shapes, const std::v
   // The parts share nothing: they are triangulated side by side.
   parallelFor(stale.size(), [&](std::size_t i) { m.parts[stale[i]].rebuild(shapes, m.metresPerPixel, m.tolerance); });
   m.rebuilt = stale.size();
-  m.shapes = shapes.size();
   m.drawn = shapes;
 }
 
@@ -890,9 +888,9 @@ std::size_t MapLayer::outlinedShapes() const {
 }
 
 void MapLayer::setValues(const std::vector<double>& values) {
-  if (values.size() != impl_->shapes) {
-    throw usageError("map layer: " + std::to_string(impl_->shapes) + " shapes but " + std::to_string(values.size()) +
-                     " values");
+  if (values.size() != impl_->drawn.size()) {
+    throw usageError("map layer: " + std::to_string(impl_->drawn.size()) + " shapes but " +
+                     std::to_string(values.size()) + " values");
   }
   for (LayerPart& p : impl_->parts) {
     std::vector<double> partValues;
