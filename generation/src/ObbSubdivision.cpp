@@ -354,8 +354,7 @@ private:
     const std::uint64_t childBase = rng.next();
 
     auto node = std::make_shared<Node>();
-    const bool reused = previous && previous->split;
-    if (reused) {
+    if (previous && previous->split) {
       node->split = previous->split;
       node->children = previous->children;  // their nodes and widths, replaced below
     } else {

@@ -161,7 +161,8 @@ int main(int argc, char** argv) {
   };
   auto measure = [&](const std::string& name, int n, const std::function<void(int)>& change) {
     if (!wanted(name)) return;
-    Row row{name, {}, {}, {}, {}, {}, {}, {}, {}};
+    Row row;
+    row.change = name;
     for (int i = 0; i < n; ++i) {
       change(i);
       if (!settle(w)) {
