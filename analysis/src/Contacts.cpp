@@ -18,40 +18,10 @@ namespace parcelscope::analysis::detail {
 
 namespace {
 
-struct EdgeInfo {
-  int polygon;
-  const Point* p;
-  const Point* q;
-};
-
 using EdgeBox = CGAL::Box_intersection_d::Box_with_info_d<double, 2, std::size_t>;
 
-void addRingEdges(const Ring& r, int index, double grow, std::vector<EdgeInfo>& edges,
-                  std::vector<EdgeBox>& boxes) {
-  for (std::size_t i = 0, n = r.size(); i < n; ++i) {
-    const Point& p = r[i];
-    const Point& q = r[(i + 1) % n];
-    double lo[2] = {std::min(p.x, q.x) - grow, std::min(p.y, q.y) - grow};
-    double hi[2] = {std::max(p.x, q.x) + grow, std::max(p.y, q.y) + grow};
-    boxes.emplace_back(lo, hi, edges.size());
-    edges.push_back({index, &p, &q});
-  }
-}
-
-void addEdges(const Polygon& polygon, int index, double grow, std::vector<EdgeInfo>& edges,
-              std::vector<EdgeBox>& boxes) {
-  addRingEdges(polygon.outer, index, grow, edges, boxes);
-  for (const auto& h : polygon.holes) addRingEdges(h, index, grow, edges, boxes);
-}
-
-// Closed boxes meet (CGAL's default topology for box_intersection_d).
-bool closedBoxesMeet(const EdgeBox& a, const EdgeBox& b) {
-  return a.min_coord(0) <= b.max_coord(0) && b.min_coord(0) <= a.max_coord(0) && a.min_coord(1) <= b.max_coord(1) &&
-         b.min_coord(1) <= a.max_coord(1);
-}
-
 // (edge of the measured polygon, other polygon, interval) records, grouped to
-// take the union of intervals per edge and polygon pair.
+// take the union of intervals per edge.
 struct Cover {
   std::size_t edge;
   int other;
@@ -59,21 +29,6 @@ struct Cover {
   bool operator<(const Cover& o) const { return std::tie(edge, other, lo) < std::tie(o.edge, o.other, o.lo); }
 };
 
-template <typename Sink>
-void sumCovers(std::vector<Cover>& covers, const std::vector<EdgeInfo>& edges, Sink&& sink) {
-  std::sort(covers.begin(), covers.end());
-  std::vector<std::pair<double, double>> intervals;
-  for (std::size_t i = 0; i < covers.size();) {
-    std::size_t j = i;
-    intervals.clear();
-    while (j < covers.size() && covers[j].edge == covers[i].edge && covers[j].other == covers[i].other) {
-      intervals.emplace_back(covers[j].lo, covers[j].hi);
-      ++j;
-    }
-    sink(edges[covers[i].edge].polygon, covers[i].other, unionLength(intervals));
-    i = j;
-  }
-}
 }  // namespace
 
 namespace {
@@ -161,33 +116,36 @@ Box contactBox(const Polygon& polygon, double tolerance) {
 
 namespace {
 
+// Appends the edges of `r`, in order, whose boxes grown by `grow` meet `box`
+// (closed boxes).
+void appendEdgesNear(const Ring& r, double grow, const Box& box, std::vector<NearEdge>& out) {
+  for (std::size_t i = 0, n = r.size(); i < n; ++i) {
+    const Point& p = r[i];
+    const Point& q = r[(i + 1) % n];
+    NearEdge e{&p,
+               &q,
+               {std::min(p.x, q.x) - grow, std::min(p.y, q.y) - grow},
+               {std::max(p.x, q.x) + grow, std::max(p.y, q.y) + grow},
+               0,
+               0,
+               0};
+    if (e.lo[0] <= box.maxX && box.minX <= e.hi[0] && e.lo[1] <= box.maxY && box.minY <= e.hi[1]) {
+      e.len = norm(q.x - p.x, q.y - p.y);
+      if (e.len != 0) {
+        e.ux = (q.x - p.x) / e.len;
+        e.uy = (q.y - p.y) / e.len;
+      }
+      out.push_back(e);
+    }
+  }
+}
+
 // The edges of `polygon`, in ring order (outer ring, then holes), whose boxes
 // grown by `grow` meet `box` (closed boxes).
 void edgesNear(const Polygon& polygon, double grow, const Box& box, std::vector<NearEdge>& out) {
   out.clear();
-  auto ring = [&](const Ring& r) {
-    for (std::size_t i = 0, n = r.size(); i < n; ++i) {
-      const Point& p = r[i];
-      const Point& q = r[(i + 1) % n];
-      NearEdge e{&p,
-                 &q,
-                 {std::min(p.x, q.x) - grow, std::min(p.y, q.y) - grow},
-                 {std::max(p.x, q.x) + grow, std::max(p.y, q.y) + grow},
-                 0,
-                 0,
-                 0};
-      if (e.lo[0] <= box.maxX && box.minX <= e.hi[0] && e.lo[1] <= box.maxY && box.minY <= e.hi[1]) {
-        e.len = norm(q.x - p.x, q.y - p.y);
-        if (e.len != 0) {
-          e.ux = (q.x - p.x) / e.len;
-          e.uy = (q.y - p.y) / e.len;
-        }
-        out.push_back(e);
-      }
-    }
-  };
-  ring(polygon.outer);
-  for (const Ring& h : polygon.holes) ring(h);
+  appendEdgesNear(polygon.outer, grow, box, out);
+  for (const Ring& h : polygon.holes) appendEdgesNear(h, grow, box, out);
 }
 
 struct PairMeasure {
@@ -309,36 +267,73 @@ double sharedLength(const Polygon& a, const Polygon& b, double tolerance) {
 
 std::vector<double> lengthAlong(const std::vector<const Polygon*>& polygons, const std::vector<Ring>& rings,
                                 double tolerance) {
-  constexpr std::ptrdiff_t kScanCutoff = 1000;
+  // Polygon by polygon: the ring edges near its contact box, then each of its
+  // edges against those. Pairs of a polygon edge and a ring edge are tested
+  // when their boxes grown by half the tolerance meet, as an edge-by-edge
+  // search would pair them; each edge's covered intervals are united and the
+  // edges summed in ring order.
   constexpr std::size_t kEveryPairUpTo = 16384;
-  std::vector<EdgeInfo> edges, ringEdges;
-  std::vector<EdgeBox> boxes, ringBoxes;
-  for (std::size_t i = 0; i < polygons.size(); ++i) {
-    addEdges(*polygons[i], static_cast<int>(i), 0.5 * tolerance, edges, boxes);
-  }
-  for (const Ring& r : rings) addRingEdges(r, -1, 0.5 * tolerance, ringEdges, ringBoxes);
-  std::vector<Cover> covers;
-  auto cover = [&](const EdgeBox& x, const EdgeBox& y) {
-    const EdgeInfo& e = edges[x.info()];
-    const EdgeInfo& f = ringEdges[y.info()];
-    double lo = 0, hi = 0;
-    if (coveredInterval(*e.p, *e.q, *f.p, *f.q, tolerance, lo, hi)) covers.push_back({x.info(), -1, lo, hi});
+  constexpr std::ptrdiff_t kScanCutoff = 1000;
+  const double grow = 0.5 * tolerance;
+  const Box everything{-HUGE_VAL, -HUGE_VAL, HUGE_VAL, HUGE_VAL};
+  std::vector<NearEdge> ringEdges;
+  for (const Ring& r : rings) appendEdgesNear(r, grow, everything, ringEdges);
+  std::vector<Box> boxes(polygons.size());
+  for (std::size_t i = 0; i < polygons.size(); ++i) boxes[i] = contactBox(*polygons[i], tolerance);
+  auto meets = [](const NearEdge& e, const Box& b) {
+    return e.lo[0] <= b.maxX && b.minX <= e.hi[0] && e.lo[1] <= b.maxY && b.minY <= e.hi[1];
   };
-  if (boxes.size() * ringBoxes.size() <= kEveryPairUpTo) {
-    // A generated block's parcels against its outline: testing every pair of
-    // boxes costs less than sorting them. The pairs are those CGAL reports.
-    for (const EdgeBox& x : boxes) {
-      for (const EdgeBox& y : ringBoxes) {
-        if (closedBoxesMeet(x, y)) cover(x, y);
+  // (polygon, ring edge) pairs whose boxes meet, by polygon.
+  std::vector<std::pair<std::size_t, std::size_t>> near;
+  if (polygons.size() * ringEdges.size() <= kEveryPairUpTo) {
+    for (std::size_t i = 0; i < polygons.size(); ++i) {
+      for (std::size_t j = 0; j < ringEdges.size(); ++j) {
+        if (meets(ringEdges[j], boxes[i])) near.emplace_back(i, j);
       }
     }
   } else {
-    // One block's edges at a time: below kScanCutoff boxes a side, CGAL scans
-    // them sorted along x (its segment tree costs more than it saves there).
-    CGAL::box_intersection_d(boxes.begin(), boxes.end(), ringBoxes.begin(), ringBoxes.end(), cover, kScanCutoff);
+    std::vector<EdgeBox> polygonBoxes, edgeBoxes;
+    polygonBoxes.reserve(polygons.size());
+    edgeBoxes.reserve(ringEdges.size());
+    for (std::size_t i = 0; i < polygons.size(); ++i) {
+      double lo[2] = {boxes[i].minX, boxes[i].minY}, hi[2] = {boxes[i].maxX, boxes[i].maxY};
+      polygonBoxes.emplace_back(lo, hi, i);
+    }
+    for (std::size_t j = 0; j < ringEdges.size(); ++j) {
+      double lo[2] = {ringEdges[j].lo[0], ringEdges[j].lo[1]}, hi[2] = {ringEdges[j].hi[0], ringEdges[j].hi[1]};
+      edgeBoxes.emplace_back(lo, hi, j);
+    }
+    CGAL::box_intersection_d(
+        polygonBoxes.begin(), polygonBoxes.end(), edgeBoxes.begin(), edgeBoxes.end(),
+        [&](const EdgeBox& a, const EdgeBox& b) { near.emplace_back(a.info(), b.info()); }, kScanCutoff);
+    std::sort(near.begin(), near.end());
   }
   std::vector<double> out(polygons.size(), 0.0);
-  sumCovers(covers, edges, [&](int measured, int, double length) { out[measured] += length; });
+  std::vector<NearEdge> edges, candidates;
+  std::vector<std::pair<double, double>> intervals;
+  for (std::size_t k = 0; k < near.size();) {
+    const std::size_t i = near[k].first;
+    candidates.clear();
+    Box reach{HUGE_VAL, HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (; k < near.size() && near[k].first == i; ++k) {
+      const NearEdge& f = ringEdges[near[k].second];
+      candidates.push_back(f);
+      reach = {std::min(reach.minX, f.lo[0]), std::min(reach.minY, f.lo[1]), std::max(reach.maxX, f.hi[0]),
+               std::max(reach.maxY, f.hi[1])};
+    }
+    edgesNear(*polygons[i], grow, reach, edges);
+    double total = 0;
+    for (const NearEdge& e : edges) {
+      intervals.clear();
+      for (const NearEdge& f : candidates) {
+        if (!(e.lo[0] <= f.hi[0] && f.lo[0] <= e.hi[0] && e.lo[1] <= f.hi[1] && f.lo[1] <= e.hi[1])) continue;
+        double lo = 0, hi = 0;
+        if (coveredInterval(e, f, tolerance, lo, hi)) intervals.emplace_back(lo, hi);
+      }
+      if (!intervals.empty()) total += unionLength(intervals);
+    }
+    out[i] = total;
+  }
   return out;
 }
 

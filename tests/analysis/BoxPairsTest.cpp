@@ -90,6 +90,100 @@ TEST(LengthAlong, SameLengthsWhetherEveryEdgePairIsTestedOrCgalScans) {
   }
 }
 
+namespace {
+// lengthAlong as its definition reads: every polygon edge against every ring
+// edge whose box meets its own (both grown by half the tolerance), covered
+// intervals united per polygon edge, edges summed in ring order.
+std::vector<double> lengthAlongEveryPair(const std::vector<const Polygon*>& polygons, const std::vector<Ring>& rings,
+                                         double tolerance) {
+  const double g = 0.5 * tolerance;
+  auto edges = [](const Polygon& p) {
+    std::vector<std::pair<Point, Point>> out;
+    auto ring = [&](const Ring& r) {
+      for (std::size_t i = 0; i < r.size(); ++i) out.emplace_back(r[i], r[(i + 1) % r.size()]);
+    };
+    ring(p.outer);
+    for (const Ring& h : p.holes) ring(h);
+    return out;
+  };
+  std::vector<std::pair<Point, Point>> along;
+  for (const Ring& r : rings) {
+    const auto e = edges(Polygon{r, {}});
+    along.insert(along.end(), e.begin(), e.end());
+  }
+  std::vector<double> out;
+  for (const Polygon* p : polygons) {
+    double total = 0;
+    for (const auto& [a, b] : edges(*p)) {
+      std::vector<std::pair<double, double>> intervals;
+      for (const auto& [c, d] : along) {
+        if (std::min(a.x, b.x) - g > std::max(c.x, d.x) + g || std::min(c.x, d.x) - g > std::max(a.x, b.x) + g ||
+            std::min(a.y, b.y) - g > std::max(c.y, d.y) + g || std::min(c.y, d.y) - g > std::max(a.y, b.y) + g) {
+          continue;
+        }
+        double lo = 0, hi = 0;
+        if (analysis::detail::coveredInterval(a, b, c, d, tolerance, lo, hi)) intervals.emplace_back(lo, hi);
+      }
+      if (!intervals.empty()) total += analysis::detail::unionLength(intervals);
+    }
+    out.push_back(total);
+  }
+  return out;
+}
+}  // namespace
+
+// Jittered lots along noisy outlines (their vertices off the lots' edges by
+// up to the tolerance and beyond, some edges reversed), small enough for the
+// short path and large enough for CGAL's: the lengths are those of the
+// definition, to the last bit.
+TEST(LengthAlong, EqualsTheEdgeByEdgeDefinitionOnRandomLotsAndOutlines) {
+  auto rng64 = test::seededRandom(20261122, "LengthAlong");
+  std::mt19937 rng(static_cast<std::uint32_t>(rng64()));
+  std::uniform_int_distribution<int> cells(1, 30);
+  std::uniform_real_distribution<double> off(-0.08, 0.08), unit(0.0, 1.0);
+  int fronting = 0, inside = 0;
+  for (int round = 0; round < 40; ++round) {
+    const int nx = cells(rng), ny = round % 4 == 0 ? 1 : cells(rng);
+    std::vector<Polygon> lots = test::jitteredGrid(rng, nx, ny, 0.9);
+    if (!lots.empty() && round % 3 == 0) {
+      // A lot with a hole, whose ring the outline does not follow.
+      Polygon& p = lots.front();
+      const Point c = centroid(p);
+      p.holes.push_back({{c.x - 1, c.y - 1}, {c.x - 1, c.y + 1}, {c.x + 1, c.y + 1}, {c.x + 1, c.y - 1}});
+    }
+    // The grid's outer square, walked with several vertices per cell side.
+    Ring outline;
+    auto walk = [&](Point from, Point to, int steps) {
+      for (int k = 0; k < steps; ++k) {
+        const double t = static_cast<double>(k) / steps;
+        outline.push_back({from.x + t * (to.x - from.x) + off(rng), from.y + t * (to.y - from.y) + off(rng)});
+      }
+    };
+    const double w = 10.0 * nx, h = 10.0 * ny;
+    walk({0, 0}, {w, 0}, 3 * nx);
+    walk({w, 0}, {w, h}, 3 * ny);
+    walk({w, h}, {0, h}, 3 * nx);
+    walk({0, h}, {0, 0}, 3 * ny);
+    std::vector<Ring> rings{outline};
+    if (unit(rng) < 0.5) rings.push_back({{w / 2, h / 2}, {w / 2 + 5, h / 2 + 0.01}, {w / 2 + 5, h / 2 + 4}});
+    std::vector<const Polygon*> all;
+    for (const Polygon& p : lots) all.push_back(&p);
+    for (const double tolerance : {0.05, 0.3, 1.0}) {
+      const std::vector<double> got = analysis::detail::lengthAlong(all, rings, tolerance);
+      const std::vector<double> expected = lengthAlongEveryPair(all, rings, tolerance);
+      ASSERT_EQ(got.size(), expected.size());
+      for (std::size_t i = 0; i < got.size(); ++i) {
+        ASSERT_EQ(got[i], expected[i]) << "round " << round << ", lot " << i << " of " << got.size()
+                                       << ", tolerance " << tolerance;
+        fronting += got[i] > 5.0;
+        inside += got[i] == 0.0;
+      }
+    }
+  }
+  EXPECT_GT(fronting, 500) << "lots along the outline should front it";
+  EXPECT_GT(inside, 500) << "lots inside should not";
+}
+
 // Neighbours are counted from contacts measured only until one edge pair
 // covers the threshold: the decision must be the one the whole length gives.
 TEST(Contacts, StoppingAtEnoughDecidesAsTheWholeLength) {
