@@ -32,12 +32,14 @@
 #include <QVBoxLayout>
 #include <QVTKOpenGLStereoWidget.h>
 
+#include <vtkAxis.h>
 #include <vtkChartXY.h>
 #include <vtkContextInteractorStyle.h>
 #include <vtkContextScene.h>
 #include <vtkContextView.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkObjectFactory.h>
+#include <vtkPlot.h>
 #include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
 
@@ -89,6 +91,21 @@ private:
 const char* kFirst[] = {"k", "a-min", "a-max", "w-min", "w-max", "omega", "xi", "offset", "seed"};
 const char* kBounds[] = {"a-min", "a-max", "w-min", "w-max"};
 const char* kBlockParameters[] = {"a-min", "a-max", "w-min", "w-max", "omega", "offset", "seed"};
+
+// The chart's texts without the numbers that change with every result (the
+// counts in the legend, the value the last bin starts at): VTK keeps the
+// textures of the last 50 texts drawn, oldest first out, so a new text on
+// every redraw soon pushed out, and made it draw again, every other label of
+// the chart on each redraw. The counts are in the numbers table; exported
+// figures keep them.
+void stableLabels(viz::QuantityHistogram& h) {
+  for (viz::HistogramSeries& s : h.series) {
+    if (const auto at = s.label.find(" (n = "); at != std::string::npos) s.label.erase(at);
+  }
+  if (const auto at = h.xTitle.find("; the last bin holds"); at != std::string::npos) {
+    h.xTitle.replace(at, std::string::npos, "; the last bin holds every higher value");
+  }
+}
 
 std::vector<ParameterDescription> panelParameters() {
   const auto all = viz::compareParameters();
@@ -190,6 +207,9 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
 
   // Histogram and numbers.
   histogramWidget_ = new QVTKOpenGLStereoWidget;
+  // No multisampled buffer: with software OpenGL it made each redraw of the
+  // chart several milliseconds longer (its text is drawn from textures anyway).
+  histogramWindow_->SetMultiSamples(0);
   histogramWidget_->setRenderWindow(histogramWindow_);
   histogramWidget_->setMinimumSize(300, 220);
   histogramView_->SetRenderWindow(histogramWindow_);
@@ -776,7 +796,8 @@ bool MainWindow::recolour(bool observedChanged) {
 }
 
 void MainWindow::drawHistogram() {
-  const viz::QuantityHistogram h = viz::quantityHistogram(*result_, shown(), request_.metric);
+  viz::QuantityHistogram h = viz::quantityHistogram(*result_, shown(), request_.metric);
+  stableLabels(h);
   histogramCounts_.clear();
   if (h.edges.empty()) {
     chart_->ClearPlots();
@@ -801,6 +822,16 @@ QImage MainWindow::screenshot() {
 }
 
 QString MainWindow::histogramTitle() const { return QString::fromStdString(chart_->GetTitle()); }
+
+QStringList MainWindow::histogramTexts() const {
+  QStringList texts{QString::fromStdString(chart_->GetTitle()),
+                    QString::fromStdString(chart_->GetAxis(vtkAxis::BOTTOM)->GetTitle()),
+                    QString::fromStdString(chart_->GetAxis(vtkAxis::LEFT)->GetTitle())};
+  for (vtkIdType i = 0; i < chart_->GetNumberOfPlots(); ++i) {
+    texts << QString::fromStdString(chart_->GetPlot(i)->GetLabel());
+  }
+  return texts;
+}
 
 void MainWindow::fillNumbers() {
   const Table summary = analysis::summaryTable(result_->city);

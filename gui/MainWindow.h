@@ -8,6 +8,7 @@
 #include <QImage>
 #include <QMainWindow>
 #include <QString>
+#include <QStringList>
 #include <QThread>
 
 #include <functional>
@@ -83,6 +84,8 @@ public:
   QTableWidget* numbers() const { return numbers_; }
   /// The histogram chart's title and series counts, as shown.
   QString histogramTitle() const;
+  /// Every text of the histogram chart: title, axis titles, series labels.
+  QStringList histogramTexts() const;
   std::vector<std::vector<int>> histogramCounts() const { return histogramCounts_; }
   int selectedBlock() const { return selected_; }
   /// The message shown in the window's error bar (empty when none).

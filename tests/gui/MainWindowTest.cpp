@@ -110,6 +110,7 @@ private slots:
   void movingASliderRegeneratesLikeTheLibrary() {
     const auto before = window_->result();
     const auto histogramBefore = window_->histogramCounts();
+    const QStringList textsBefore = window_->histogramTexts();
     // Drag the W_max slider down, step by step as a drag does, to about 18 m:
     // narrower parcels, so more of them.
     QSlider* slider = window_->parameterPanel()->slider("w-max");
@@ -122,6 +123,10 @@ private slots:
     QVERIFY(after != before);
     QVERIFY(after->generated.parcels.size() > before->generated.parcels.size());
     QVERIFY(window_->histogramCounts() != histogramBefore);
+    // The chart's texts stay the same while its counts change: a text new with
+    // every result would make VTK draw all of them again on each redraw.
+    QCOMPARE(window_->histogramTexts(), textsBefore);
+    QVERIFY(textsBefore.size() >= 5);
     QVERIFY(window_->proceduralView()->title().contains(QString::number(after->generated.parcels.size())));
     QVERIFY(window_->request().explicitParameters.count("w-max"));
     QCOMPARE(static_cast<int>(after->generated.parcels.size()), libraryParcelCount());
