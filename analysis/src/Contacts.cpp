@@ -96,6 +96,57 @@ struct NearEdge {
   double len, ux, uy;  // length and unit direction, computed once per edge
 };
 
+// Edges sorted by the left side of their boxes: those whose boxes meet a
+// query box are found among the edges starting at most the widest box's
+// width to its left, not by testing every edge.
+class EdgeIndex {
+public:
+  // Below this many edges, testing every one costs less.
+  static constexpr std::size_t kScanUpTo = 24;
+
+  void build(const std::vector<NearEdge>& edges) {
+    order_.clear();
+    left_.clear();
+    widest_ = 0;
+    if (edges.size() <= kScanUpTo) return;
+    order_.resize(edges.size());
+    for (std::size_t j = 0; j < edges.size(); ++j) order_[j] = j;
+    std::sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) { return edges[a].lo[0] < edges[b].lo[0]; });
+    left_.reserve(edges.size());
+    for (std::size_t j : order_) {
+      left_.push_back(edges[j].lo[0]);
+      widest_ = std::max(widest_, edges[j].hi[0] - edges[j].lo[0]);
+    }
+  }
+
+  // The indices of `edges` (those given to build) whose boxes meet `box`
+  // (closed boxes), in increasing order.
+  void meeting(const std::vector<NearEdge>& edges, const Box& box, std::vector<std::size_t>& out) const {
+    out.clear();
+    auto meets = [&](const NearEdge& e) {
+      return e.lo[0] <= box.maxX && box.minX <= e.hi[0] && e.lo[1] <= box.maxY && box.minY <= e.hi[1];
+    };
+    if (order_.empty()) {
+      for (std::size_t j = 0; j < edges.size(); ++j) {
+        if (meets(edges[j])) out.push_back(j);
+      }
+      return;
+    }
+    const auto from = std::lower_bound(left_.begin(), left_.end(), box.minX - widest_);
+    const auto to = std::upper_bound(from, left_.end(), box.maxX);
+    for (auto k = from; k != to; ++k) {
+      const std::size_t j = order_[static_cast<std::size_t>(k - left_.begin())];
+      if (meets(edges[j])) out.push_back(j);
+    }
+    std::sort(out.begin(), out.end());
+  }
+
+private:
+  std::vector<std::size_t> order_;
+  std::vector<double> left_;  // edges' lo[0], in order_
+  double widest_ = 0;
+};
+
 // coveredInterval(*e.p, *e.q, *f.p, *f.q, ...) with the lengths and directions
 // computed when the edges were gathered: the same values, without the square roots.
 bool coveredInterval(const NearEdge& e, const NearEdge& f, double tolerance, double& lo, double& hi) {
@@ -280,16 +331,15 @@ std::vector<double> lengthAlong(const std::vector<const Polygon*>& polygons, con
   for (const Ring& r : rings) appendEdgesNear(r, grow, everything, ringEdges);
   std::vector<Box> boxes(polygons.size());
   for (std::size_t i = 0; i < polygons.size(); ++i) boxes[i] = contactBox(*polygons[i], tolerance);
-  auto meets = [](const NearEdge& e, const Box& b) {
-    return e.lo[0] <= b.maxX && b.minX <= e.hi[0] && e.lo[1] <= b.maxY && b.minY <= e.hi[1];
-  };
   // (polygon, ring edge) pairs whose boxes meet, by polygon.
   std::vector<std::pair<std::size_t, std::size_t>> near;
   if (polygons.size() * ringEdges.size() <= kEveryPairUpTo) {
+    EdgeIndex index;
+    index.build(ringEdges);
+    std::vector<std::size_t> found;
     for (std::size_t i = 0; i < polygons.size(); ++i) {
-      for (std::size_t j = 0; j < ringEdges.size(); ++j) {
-        if (meets(ringEdges[j], boxes[i])) near.emplace_back(i, j);
-      }
+      index.meeting(ringEdges, boxes[i], found);
+      for (std::size_t j : found) near.emplace_back(i, j);
     }
   } else {
     std::vector<EdgeBox> polygonBoxes, edgeBoxes;
@@ -343,6 +393,7 @@ namespace parcelscope::analysis {
 
 struct PreparedBoundary::Impl {
   std::vector<detail::NearEdge> edges;  // every edge of the reference, boxes grown by half the tolerance, ring order
+  detail::EdgeIndex index;               // of edges
   Box box;                      // the reference's contact box
   Box bounds;                   // the reference's bounds
   double tolerance = 0;
@@ -354,6 +405,7 @@ PreparedBoundary::PreparedBoundary(const Polygon& reference, double tolerance) :
   impl_->bounds = parcelscope::bounds(reference);
   const Box everything{-HUGE_VAL, -HUGE_VAL, HUGE_VAL, HUGE_VAL};
   detail::edgesNear(reference, 0.5 * tolerance, everything, impl_->edges);
+  impl_->index.build(impl_->edges);
 }
 
 PreparedBoundary::~PreparedBoundary() = default;
@@ -366,15 +418,15 @@ bool PreparedBoundary::sharesAtLeast(const Polygon& piece, double length) const 
 
 double PreparedBoundary::measure(const Polygon& piece, double enough) const {
   thread_local std::vector<detail::NearEdge> ea, eb;
+  thread_local std::vector<std::size_t> found;
   const Impl& r = *impl_;
   if (!parcelscope::bounds(piece).expanded(r.tolerance).intersects(r.bounds)) return 0.0;  // as sharedBoundaryLength
   const double grow = 0.5 * r.tolerance;
   detail::edgesNear(piece, grow, r.box, ea);
   const Box box = detail::contactBox(piece, r.tolerance);
+  r.index.meeting(r.edges, box, found);
   eb.clear();
-  for (const detail::NearEdge& e : r.edges) {
-    if (e.lo[0] <= box.maxX && box.minX <= e.hi[0] && e.lo[1] <= box.maxY && box.minY <= e.hi[1]) eb.push_back(e);
-  }
+  for (std::size_t j : found) eb.push_back(r.edges[j]);
   const detail::PairMeasure m = detail::measureEdges(ea, eb, r.tolerance, r.tolerance, false, enough);
   return m.enough ? enough : std::min(m.sharedA, m.sharedB);
 }
