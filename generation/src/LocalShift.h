@@ -20,11 +20,15 @@ inline Point exactShiftOrigin(const Polygon& block) {
   return o;
 }
 
-inline Polygon translated(const Polygon& in, double dx, double dy) {
-  Polygon r = in;
+inline void translate(Polygon& r, double dx, double dy) {
   for (Point& q : r.outer) q = {q.x + dx, q.y + dy};
   for (Ring& h : r.holes)
     for (Point& q : h) q = {q.x + dx, q.y + dy};
+}
+
+inline Polygon translated(const Polygon& in, double dx, double dy) {
+  Polygon r = in;
+  translate(r, dx, dy);
   return r;
 }
 

@@ -423,7 +423,7 @@ Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, 
     return out;
   }
   if (o.x != 0 || o.y != 0) {
-    for (Polygon& parcel : out.parcels) parcel = detail::translated(parcel, o.x, o.y);
+    for (Polygon& parcel : out.parcels) detail::translate(parcel, o.x, o.y);
   }
   return out;
 }
