@@ -20,13 +20,12 @@ namespace {
 
 using EdgeBox = CGAL::Box_intersection_d::Box_with_info_d<double, 2, std::size_t>;
 
-// (edge of the measured polygon, other polygon, interval) records, grouped to
-// take the union of intervals per edge.
+// (edge of the measured polygon, interval) records, grouped to take the union
+// of intervals per edge.
 struct Cover {
   std::size_t edge;
-  int other;
   double lo, hi;
-  bool operator<(const Cover& o) const { return std::tie(edge, other, lo) < std::tie(o.edge, o.other, o.lo); }
+  bool operator<(const Cover& o) const { return std::tie(edge, lo) < std::tie(o.edge, o.lo); }
 };
 
 }  // namespace
@@ -111,7 +110,8 @@ public:
     if (edges.size() <= kScanUpTo) return;
     order_.resize(edges.size());
     for (std::size_t j = 0; j < edges.size(); ++j) order_[j] = j;
-    std::sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) { return edges[a].lo[0] < edges[b].lo[0]; });
+    std::sort(order_.begin(), order_.end(),
+              [&](std::size_t a, std::size_t b) { return edges[a].lo[0] < edges[b].lo[0]; });
     left_.reserve(edges.size());
     for (std::size_t j : order_) {
       left_.push_back(edges[j].lo[0]);
@@ -231,7 +231,7 @@ PairMeasure measureEdges(const std::vector<NearEdge>& ea, const std::vector<Near
       const bool alongA = coveredInterval(e, f, sharedTolerance, lo, hi);
       if (alongA) intervals.emplace_back(lo, hi);
       const bool alongB = coveredInterval(f, e, sharedTolerance, loB, hiB);
-      if (alongB) coversB.push_back({j, 0, loB, hiB});
+      if (alongB) coversB.push_back({j, loB, hiB});
       // One edge pair covering `enough` both ways: each shared length (a sum
       // of unions holding these intervals) is at least that much.
       if (alongA && alongB && hi - lo >= enough && hiB - loB >= enough) {
@@ -353,6 +353,8 @@ std::vector<double> lengthAlong(const std::vector<const Polygon*>& polygons, con
       double lo[2] = {ringEdges[j].lo[0], ringEdges[j].lo[1]}, hi[2] = {ringEdges[j].hi[0], ringEdges[j].hi[1]};
       edgeBoxes.emplace_back(lo, hi, j);
     }
+    // Below kScanCutoff boxes a side, CGAL scans them sorted along x (its
+    // segment tree costs more than it saves there).
     CGAL::box_intersection_d(
         polygonBoxes.begin(), polygonBoxes.end(), edgeBoxes.begin(), edgeBoxes.end(),
         [&](const EdgeBox& a, const EdgeBox& b) { near.emplace_back(a.info(), b.info()); }, kScanCutoff);
