@@ -92,21 +92,6 @@ const char* kFirst[] = {"k", "a-min", "a-max", "w-min", "w-max", "omega", "xi", 
 const char* kBounds[] = {"a-min", "a-max", "w-min", "w-max"};
 const char* kBlockParameters[] = {"a-min", "a-max", "w-min", "w-max", "omega", "offset", "seed"};
 
-// The chart's texts without the numbers that change with every result (the
-// counts in the legend, the value the last bin starts at): VTK keeps the
-// textures of the last 50 texts drawn, oldest first out, so a new text on
-// every redraw soon pushed out, and made it draw again, every other label of
-// the chart on each redraw. The counts are in the numbers table; exported
-// figures keep them.
-void stableLabels(viz::QuantityHistogram& h) {
-  for (viz::HistogramSeries& s : h.series) {
-    if (const auto at = s.label.find(" (n = "); at != std::string::npos) s.label.erase(at);
-  }
-  if (const auto at = h.xTitle.find("; the last bin holds"); at != std::string::npos) {
-    h.xTitle.replace(at, std::string::npos, "; the last bin holds every higher value");
-  }
-}
-
 std::vector<ParameterDescription> panelParameters() {
   const auto all = viz::compareParameters();
   std::vector<ParameterDescription> out;
@@ -796,8 +781,9 @@ bool MainWindow::recolour(bool observedChanged) {
 }
 
 void MainWindow::drawHistogram() {
-  viz::QuantityHistogram h = viz::quantityHistogram(*result_, shown(), request_.metric);
-  stableLabels(h);
+  // Texts without this result's numbers (the numbers table has the counts).
+  const viz::QuantityHistogram h =
+      viz::quantityHistogram(*result_, shown(), request_.metric, viz::HistogramTexts::Steady);
   histogramCounts_.clear();
   if (h.edges.empty()) {
     chart_->ClearPlots();

@@ -316,7 +316,8 @@ void renderQuantityMap(const CompareResult& r, const CompareRequest& request, co
 }
 
 QuantityHistogram quantityHistogram(const CompareResult& r, const CompareRequest& request,
-                                    const std::string& quantity) {
+                                    const std::string& quantity, HistogramTexts texts) {
+  const bool numbers = texts == HistogramTexts::WithNumbers;
   const analysis::ParcelQuantity& q = analysis::parcelQuantity(quantity);
   const int bins = static_cast<int>(value(request, "bins"));
   const double quantile = value(request, "histogram-quantile");
@@ -339,13 +340,14 @@ QuantityHistogram quantityHistogram(const CompareResult& r, const CompareRequest
   if (h.aOverflow + h.bOverflow > 0) {
     char note[96];
     std::snprintf(note, sizeof note, "; the last bin holds every value above %.4g", h.edges.back());
-    out.xTitle += note;
+    out.xTitle += numbers ? note : "; the last bin holds every higher value";
   }
   out.yTitle = "parcels (count)";
-  auto counts = [](const std::vector<int>& c) { return std::accumulate(c.begin(), c.end(), 0); };
-  out.series = {{"observed (n = " + std::to_string(counts(h.a)) + ")", h.a, {0.84, 0.15, 0.16}},
-                {"procedural, " + request.style + " (n = " + std::to_string(counts(h.b)) + ")", h.b,
-                 {0.12, 0.38, 0.75}}};
+  auto counts = [&](const std::vector<int>& c) {
+    return numbers ? " (n = " + std::to_string(std::accumulate(c.begin(), c.end(), 0)) + ")" : std::string();
+  };
+  out.series = {{"observed" + counts(h.a), h.a, {0.84, 0.15, 0.16}},
+                {"procedural, " + request.style + counts(h.b), h.b, {0.12, 0.38, 0.75}}};
   const std::string what = q.name == "aspect_ratio" ? std::string("Parcel aspect ratio") : "Parcel " + q.name;
   out.title = what + ": observed and " + generatedName(request, r) + ", " + inputName(request);
   return out;

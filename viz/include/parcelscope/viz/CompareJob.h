@@ -91,8 +91,15 @@ struct QuantityHistogram {
   std::vector<double> edges;
   std::vector<HistogramSeries> series;  ///< observed (red), procedural (blue)
 };
+/// Which texts a histogram carries: the figure's, with the numbers of this
+/// result (legend counts, the value the last bin starts at), or texts that
+/// stay the same from one result to the next (a chart redrawn after every
+/// change: VTK keeps the textures of the last 50 texts drawn, first in first
+/// out, so one new text per redraw soon made it draw every label again).
+enum class HistogramTexts { WithNumbers, Steady };
 QuantityHistogram quantityHistogram(const CompareResult& result, const CompareRequest& request,
-                                    const std::string& quantity);
+                                    const std::string& quantity,
+                                    HistogramTexts texts = HistogramTexts::WithNumbers);
 
 /// Index of the observed block that contains `p` (local metres), or -1.
 int blockAt(const CompareResult& result, const Point& p);
