@@ -285,8 +285,9 @@ int sideOf(const Point& q, const Point& pivot, const Point& dir) {
 }
 }  // namespace
 
-bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& dir, SplitPieces& out) {
-  if (!polygon.holes.empty()) return false;
+namespace {
+// splitByLineFast for a polygon without holes.
+bool splitRingFast(const Polygon& polygon, const Point& pivot, const Point& dir, SplitPieces& out) {
   const Ring& r = polygon.outer;
   const std::size_t n = r.size();
   if (n < 3) return false;
@@ -467,6 +468,72 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
   }
   out = std::move(result);
   return true;
+}
+
+// Holes the line misses (every vertex certainly on one side, the same for the
+// whole hole; a hole's edges then stay on that side too): the line cuts the
+// outer ring alone, and each hole goes into the piece of its side that holds
+// it. That piece is the side's only one, or the one whose outer ring holds a
+// vertex of the hole clear of every piece's boundary.
+bool splitHoledFast(const Polygon& polygon, const Point& pivot, const Point& dir, SplitPieces& out) {
+  std::vector<int> sides;
+  sides.reserve(polygon.holes.size());
+  for (const Ring& h : polygon.holes) {
+    int s = 0;
+    for (const Point& q : h) {
+      const int t = sideOf(q, pivot, dir);
+      if (t == 0 || (s != 0 && t != s)) return false;
+      s = t;
+    }
+    if (s == 0) return false;
+    sides.push_back(s);
+  }
+  SplitPieces pieces;
+  if (!splitRingFast(Polygon{polygon.outer, {}}, pivot, dir, pieces)) return false;
+  const Box b = bounds(polygon.outer);
+  const double clearance = 1e-9 * (b.width() + b.height());
+  const auto nearBoundary = [&](const Point& q, const Ring& ring) {
+    for (std::size_t i = 0, n = ring.size(); i < n; ++i) {
+      if (pointSegmentDistance(q, ring[i], ring[(i + 1) % n]) <= clearance) return true;
+    }
+    return false;
+  };
+  std::vector<char> holed(pieces.left.size() + pieces.right.size(), 0);
+  for (std::size_t k = 0; k < polygon.holes.size(); ++k) {
+    std::vector<Polygon>& side = sides[k] > 0 ? pieces.left : pieces.right;
+    std::size_t holder = side.size();
+    if (side.size() == 1) {
+      holder = 0;
+    } else {
+      for (const Point& q : polygon.holes[k]) {
+        if (std::any_of(side.begin(), side.end(), [&](const Polygon& p) { return nearBoundary(q, p.outer); })) continue;
+        std::size_t found = 0;
+        for (std::size_t j = 0; j < side.size(); ++j) {
+          if (pointInRing(q, side[j].outer)) {
+            holder = j;
+            ++found;
+          }
+        }
+        if (found != 1) return false;
+        break;
+      }
+    }
+    if (holder >= side.size()) return false;
+    side[holder].holes.push_back(polygon.holes[k]);
+    holed[(sides[k] > 0 ? 0 : pieces.left.size()) + holder] = 1;
+  }
+  for (std::size_t j = 0; j < holed.size(); ++j) {
+    if (!holed[j]) continue;
+    Polygon& p = j < pieces.left.size() ? pieces.left[j] : pieces.right[j - pieces.left.size()];
+    if (!normalise(p)) return false;
+  }
+  out = std::move(pieces);
+  return true;
+}
+}  // namespace
+
+bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& dir, SplitPieces& out) {
+  return polygon.holes.empty() ? splitRingFast(polygon, pivot, dir, out) : splitHoledFast(polygon, pivot, dir, out);
 }
 
 }  // namespace parcelscope::generation::detail

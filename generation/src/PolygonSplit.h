@@ -29,16 +29,19 @@ struct SplitPieces {
 };
 SplitPieces splitByLine(const Polygon& polygon, const Point& pivot, const Point& dir);
 
-/// The same split in floating point, for a polygon without holes whose
-/// vertices on the line (exactly: the side of every vertex is certain) are
-/// crossings between opposite sides or touches from one side: the crossing
-/// points are computed once and shared by the pieces on both sides, and paired
-/// into cuts in their order along the line. A touch away from the cuts stays a
-/// vertex of its side's piece; a touch on a cut ends one of its side's pieces
-/// and begins the next (see SplitPieces::pinched) and is a vertex of the
-/// other side's piece. False, with `out` untouched, for anything else (holes,
-/// an edge along the line, points on the line too close along it to order, a
-/// piece pinched onto itself): then the exact `splitByLine` must be used.
+/// The same split in floating point, for a polygon whose vertices on the
+/// line (exactly: the side of every vertex is certain) are crossings between
+/// opposite sides or touches from one side, and whose holes the line misses:
+/// the crossing points are computed once and shared by the pieces on both
+/// sides, and paired into cuts in their order along the line. A touch away
+/// from the cuts stays a vertex of its side's piece; a touch on a cut ends one
+/// of its side's pieces and begins the next (see SplitPieces::pinched) and is
+/// a vertex of the other side's piece. Each hole, wholly on one side, goes to
+/// the piece there that holds it. False, with `out` untouched, for anything
+/// else (a hole the line meets, a hole vertex too close to a piece's boundary
+/// to place it, an edge along the line, points on the line too close along it
+/// to order, a piece pinched onto itself): then the exact `splitByLine` must
+/// be used.
 bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& dir, SplitPieces& out);
 
 }  // namespace parcelscope::generation::detail

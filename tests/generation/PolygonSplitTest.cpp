@@ -33,19 +33,28 @@ bool sameRing(const Ring& a, const Ring& b, double tolerance) {
   return false;
 }
 
-// The same pieces in any order.
-bool samePieces(const std::vector<Polygon>& a, const std::vector<Polygon>& b, double tolerance) {
+// The same elements in any order, matched one to one by `same`.
+template <class T, class Same>
+bool sameInAnyOrder(const std::vector<T>& a, const std::vector<T>& b, Same same) {
   if (a.size() != b.size()) return false;
   std::vector<char> used(b.size(), 0);
-  for (const Polygon& p : a) {
+  for (const T& x : a) {
     bool found = false;
     for (std::size_t j = 0; !found && j < b.size(); ++j) {
-      found = !used[j] && p.holes.empty() && b[j].holes.empty() && sameRing(p.outer, b[j].outer, tolerance);
+      found = !used[j] && same(x, b[j]);
       if (found) used[j] = 1;
     }
     if (!found) return false;
   }
   return true;
+}
+
+// The same pieces (outer rings and holes) in any order.
+bool samePieces(const std::vector<Polygon>& a, const std::vector<Polygon>& b, double tolerance) {
+  const auto ring = [&](const Ring& x, const Ring& y) { return sameRing(x, y, tolerance); };
+  return sameInAnyOrder(a, b, [&](const Polygon& p, const Polygon& q) {
+    return ring(p.outer, q.outer) && sameInAnyOrder(p.holes, q.holes, ring);
+  });
 }
 
 double sideArea(const std::vector<Polygon>& pieces) {
@@ -89,7 +98,7 @@ double totalArea(const SplitPieces& s) {
 TEST(PolygonSplit, FastSplitMatchesExactSplitOnRandomShapes) {
   std::mt19937_64 rng = test::seededRandom(5, "random shapes");
   std::uniform_real_distribution<double> u(0, 1);
-  int fast = 0, declined = 0, multiple = 0, pinched = 0;
+  int fast = 0, declined = 0, multiple = 0, pinched = 0, holed = 0;
   for (int i = 0; i < 2000 / test::kSanitizerDivisor; ++i) {
     Polygon block = test::randomShape(rng, i % test::kShapeKinds);
     if (!normalise(block)) continue;
@@ -136,11 +145,14 @@ TEST(PolygonSplit, FastSplitMatchesExactSplitOnRandomShapes) {
       EXPECT_GE(shared, 2) << what;
     }
     if (f.left.size() + f.right.size() > 2) ++multiple;
+    holed += !block.holes.empty();
   }
-  std::printf("%d split in floating point (%d into more than two pieces, %d pinched), %d left to the exact split\n",
-              fast, multiple, pinched, declined);
+  std::printf("%d split in floating point (%d into more than two pieces, %d pinched, %d with holes), %d left to the "
+              "exact split\n",
+              fast, multiple, pinched, holed, declined);
   EXPECT_GT(multiple, 0);
   EXPECT_GT(pinched, 0);
+  EXPECT_GT(holed, 0);
   EXPECT_GT(fast, 1000 / test::kSanitizerDivisor);
   EXPECT_GT(declined, 0);
 }
@@ -220,6 +232,88 @@ TEST(PolygonSplit, TouchOnACutPinchesItsPieceInTwo) {
     for (const Polygon& p : *side) EXPECT_FALSE(touchesItself(p.outer));
 }
 
+// Concave shapes (L, U, comb, star) with a few small holes, cut by random
+// lines: where the fast split applies, the exact split gives the same pieces,
+// holes included, also when a hole's side has several pieces.
+TEST(PolygonSplit, FastSplitMatchesExactSplitWithHolesInConcaveShapes) {
+  std::mt19937_64 rng = test::seededRandom(11, "holes in concave shapes");
+  std::uniform_real_distribution<double> u(0, 1);
+  int fast = 0, severalOnAHoleSide = 0;
+  for (int i = 0; i < 600 / test::kSanitizerDivisor; ++i) {
+    Polygon block = test::randomShape(rng, 1 + i % 4);
+    if (!normalise(block)) continue;
+    const Box b = bounds(block);
+    const double r = 0.03 * std::min(b.width(), b.height());
+    for (int tries = 0; tries < 40 && block.holes.size() < 3; ++tries) {
+      const Point c{b.minX + u(rng) * b.width(), b.minY + u(rng) * b.height()};
+      if (!pointInRing(c, block.outer)) continue;
+      bool clear = true;
+      for (std::size_t k = 0, n = block.outer.size(); clear && k < n; ++k) {
+        clear = pointSegmentDistance(c, block.outer[k], block.outer[(k + 1) % n]) > 3 * r;
+      }
+      for (const Ring& h : block.holes) clear = clear && std::hypot(h[0].x - c.x, h[0].y - c.y) > 6 * r;
+      if (clear) block.holes.push_back({{c.x - r, c.y - r}, {c.x - r, c.y + r}, {c.x + r, c.y + r}, {c.x + r, c.y - r}});
+    }
+    if (block.holes.empty() || !normalise(block)) continue;
+    const double angle = u(rng) * kPi;
+    const Point dir{std::cos(angle), std::sin(angle)};
+    const Point pivot{b.minX + u(rng) * b.width(), b.minY + u(rng) * b.height()};
+    SplitPieces f;
+    if (!splitByLineFast(block, pivot, dir, f)) continue;
+    ++fast;
+    const SplitPieces e = splitByLine(block, pivot, dir);
+    const std::string what = "shape " + std::to_string(i);
+    const double tolerance = 1e-9 * (b.width() + b.height()) + 1e-12 * (std::fabs(b.minX) + std::fabs(b.minY));
+    if (f.pinched) continue;  // compared above; holes change nothing there
+    EXPECT_TRUE(samePieces(f.left, e.left, tolerance)) << what;
+    EXPECT_TRUE(samePieces(f.right, e.right, tolerance)) << what;
+    EXPECT_NEAR(totalArea(f), area(block), 1e-9 * area(block)) << what;
+    for (const auto* side : {&f.left, &f.right}) {
+      bool holes = false;
+      for (const Polygon& p : *side) holes = holes || !p.holes.empty();
+      severalOnAHoleSide += holes && side->size() > 1;
+    }
+  }
+  std::printf("%d split in floating point, %d with several pieces on a side holding a hole\n", fast,
+              severalOnAHoleSide);
+  EXPECT_GT(fast, 200 / test::kSanitizerDivisor);
+  EXPECT_GT(severalOnAHoleSide, 10 / test::kSanitizerDivisor);
+}
+
+// Holes the line misses go to the piece on their side that holds them, also
+// when that side has more than one piece.
+TEST(PolygonSplit, HolesOffTheLineGoToThePieceHoldingThem) {
+  SplitPieces s;
+  Polygon courtyard = rect(0, 0, 30, 30);
+  courtyard.holes.push_back({{10, 10}, {10, 20}, {20, 20}, {20, 10}});
+  normalise(courtyard);
+  ASSERT_TRUE(splitByLineFast(courtyard, {0, 25}, {1, 0}, s));  // the line above the hole
+  ASSERT_EQ(s.left.size(), 1u);
+  ASSERT_EQ(s.right.size(), 1u);
+  EXPECT_TRUE(s.left[0].holes.empty());
+  ASSERT_EQ(s.right[0].holes.size(), 1u);
+  EXPECT_LT(signedArea(s.right[0].holes[0]), 0);  // clockwise, as normalise leaves holes
+  EXPECT_DOUBLE_EQ(area(s.left[0]) + area(s.right[0]), area(courtyard));
+  // A U with a hole in its right arm, cut across both arms: two pieces above
+  // the line (right of it, heading -x), the hole in the right arm's.
+  Polygon u = poly({{0, 0}, {30, 0}, {30, 30}, {20, 30}, {20, 10}, {10, 10}, {10, 30}, {0, 30}});
+  u.holes.push_back({{23, 22}, {23, 26}, {27, 26}, {27, 22}});
+  normalise(u);
+  ASSERT_TRUE(splitByLineFast(u, {15, 15}, {-1, 0}, s));
+  ASSERT_EQ(s.left.size(), 1u);
+  ASSERT_EQ(s.right.size(), 2u);
+  std::size_t withHole = 0;
+  for (const Polygon& p : s.right) {
+    if (p.holes.empty()) continue;
+    ++withHole;
+    EXPECT_GT(bounds(p).minX, 15);
+  }
+  EXPECT_EQ(withHole, 1u);
+  const SplitPieces e = splitByLine(u, {15, 15}, {-1, 0});
+  EXPECT_TRUE(samePieces(s.left, e.left, 1e-9));
+  EXPECT_TRUE(samePieces(s.right, e.right, 1e-9));
+}
+
 TEST(PolygonSplit, FastSplitDeclinesWhatOnlyTheExactSplitHandles) {
   SplitPieces s;
   // A hole.
@@ -227,6 +321,8 @@ TEST(PolygonSplit, FastSplitDeclinesWhatOnlyTheExactSplitHandles) {
   courtyard.holes.push_back({{10, 10}, {10, 20}, {20, 20}, {20, 10}});
   normalise(courtyard);
   EXPECT_FALSE(splitByLineFast(courtyard, {15, 15}, {1, 0}, s));
+  // A hole touching the line.
+  EXPECT_FALSE(splitByLineFast(courtyard, {15, 10}, {1, 0}, s));
   // A U cut across both arms through its inner corners: vertices on the line
   // that are not crossings.
   const Polygon u = poly({{0, 0}, {30, 0}, {30, 30}, {20, 30}, {20, 10}, {10, 10}, {10, 30}, {0, 30}});
