@@ -82,16 +82,11 @@ Point centroid(const Polygon& polygon) {
 }
 
 namespace {
+// Drops repeated consecutive vertices (and closing repeats of the first), in place.
 void dedupe(Ring& r) {
-  Ring out;
-  out.reserve(r.size());
-  for (const auto& p : r) {
-    if (out.empty() || out.back().x != p.x || out.back().y != p.y) out.push_back(p);
-  }
-  while (out.size() > 1 && out.front().x == out.back().x && out.front().y == out.back().y) {
-    out.pop_back();
-  }
-  r.swap(out);
+  r.erase(std::unique(r.begin(), r.end(), [](const Point& a, const Point& b) { return a.x == b.x && a.y == b.y; }),
+          r.end());
+  while (r.size() > 1 && r.front().x == r.back().x && r.front().y == r.back().y) r.pop_back();
 }
 }  // namespace
 

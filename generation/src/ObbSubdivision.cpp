@@ -263,8 +263,12 @@ private:
                          double shiftAcross, double shiftAlong) const {
     const OrientedBox box = edgeAlignedBox(piece.outer, hull);
     const Point u = box.u, v{-box.u.y, box.u.x};
-    std::vector<Candidate> candidates;
-    candidates.reserve(13);  // the first, the access rotation, the 11 fallbacks
+    // Scratch kept across calls on this thread (split does not recurse).
+    thread_local std::vector<Candidate> candidates;
+    thread_local std::vector<char> partAccess;
+    thread_local std::vector<std::size_t> order;
+    thread_local std::vector<Point> centres;
+    candidates.clear();
     candidates.push_back({false, 0.25 * box.length * shiftAcross});
     bool accessTried = false;
     auto addFallbacks = [&] {
@@ -288,7 +292,7 @@ private:
         admissible = !parts.empty();
         if (admissible || (through.x == pivot.x && through.y == pivot.y)) break;
       }
-      std::vector<char> partAccess(parts.size(), 0);
+      partAccess.assign(parts.size(), 0);
       bool allAccess = true;
       if (admissible) {
         // A part's boundary is the piece's and the cut line, which runs inside
@@ -308,9 +312,9 @@ private:
       }
       if (c == 0) addFallbacks();
       if (!admissible) continue;
-      std::vector<std::size_t> order(parts.size());
+      order.resize(parts.size());
       for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-      std::vector<Point> centres;
+      centres.clear();
       for (const Polygon& part : parts) centres.push_back(centroid(part));
       std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
         const double px = centres[x].x * u.x + centres[x].y * u.y, py = centres[y].x * u.x + centres[y].y * u.y;

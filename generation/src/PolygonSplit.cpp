@@ -390,7 +390,8 @@ bool splitRingFast(const Polygon& polygon, const Point& pivot, const Point& dir,
     // The stops along the cut: its ends and the touches on it, which pinch
     // their side's piece (one piece ends there, the next begins). A touch
     // too near an end or another stop to order is left to the exact split.
-    std::vector<std::size_t> stops{x};
+    thread_local std::vector<std::size_t> stops;
+    stops.assign(1, x);
     for (const std::size_t t : touches) {
       const double at = nodes[t].along;
       if (!(at > nodes[x].along - separation && at < nodes[y].along + separation)) continue;
