@@ -499,7 +499,6 @@ bool splitHoledFast(const Polygon& polygon, const Point& pivot, const Point& dir
     }
     return false;
   };
-  std::vector<char> holed(pieces.left.size() + pieces.right.size(), 0);
   for (std::size_t k = 0; k < polygon.holes.size(); ++k) {
     std::vector<Polygon>& side = sides[k] > 0 ? pieces.left : pieces.right;
     std::size_t holder = side.size();
@@ -521,12 +520,11 @@ bool splitHoledFast(const Polygon& polygon, const Point& pivot, const Point& dir
     }
     if (holder >= side.size()) return false;
     side[holder].holes.push_back(polygon.holes[k]);
-    holed[(sides[k] > 0 ? 0 : pieces.left.size()) + holder] = 1;
   }
-  for (std::size_t j = 0; j < holed.size(); ++j) {
-    if (!holed[j]) continue;
-    Polygon& p = j < pieces.left.size() ? pieces.left[j] : pieces.right[j - pieces.left.size()];
-    if (!normalise(p)) return false;
+  for (auto* side : {&pieces.left, &pieces.right}) {
+    for (Polygon& p : *side) {
+      if (!p.holes.empty() && !normalise(p)) return false;
+    }
   }
   out = std::move(pieces);
   return true;
