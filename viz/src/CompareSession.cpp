@@ -141,7 +141,9 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
       changed[todo[t]] = 1;
       ++n;
     }
-    if (n == partialDone) return;
+    // Blocks may finish between the tick and this count; once all have, the
+    // final result follows and a result in between would only repeat it.
+    if (n == partialDone || n == todo.size()) return;
     partialDone = n;
     CompareResult r;
     r.observed = observed;
