@@ -170,6 +170,7 @@ namespace {
 // Appends the edges of `r`, in order, whose boxes grown by `grow` meet `box`
 // (closed boxes).
 void appendEdgesNear(const Ring& r, double grow, const Box& box, std::vector<NearEdge>& out) {
+  if (out.capacity() < out.size() + r.size()) out.reserve(std::max(out.size() + r.size(), 2 * out.capacity()));
   for (std::size_t i = 0, n = r.size(); i < n; ++i) {
     const Point& p = r[i];
     const Point& q = r[(i + 1) % n];

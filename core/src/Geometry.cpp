@@ -250,14 +250,19 @@ bool isClearlySimple(const Ring& r) {
   return true;
 }
 
-Ring convexHull(std::vector<Point> pts) {
+void convexHullInto(const std::vector<Point>& points, Ring& hull) {
+  thread_local std::vector<Point> pts;  // sorted copy, kept across calls on this thread
+  pts.assign(points.begin(), points.end());
   std::sort(pts.begin(), pts.end(),
             [](const Point& a, const Point& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
   pts.erase(std::unique(pts.begin(), pts.end(),
                         [](const Point& a, const Point& b) { return a.x == b.x && a.y == b.y; }),
             pts.end());
-  if (pts.size() < 3) return pts;
-  Ring hull(2 * pts.size());
+  if (pts.size() < 3) {
+    hull.assign(pts.begin(), pts.end());
+    return;
+  }
+  hull.resize(2 * pts.size());
   std::size_t k = 0;
   for (std::size_t i = 0; i < pts.size(); ++i) {  // lower hull
     while (k >= 2 && cross(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
@@ -268,6 +273,12 @@ Ring convexHull(std::vector<Point> pts) {
     hull[k++] = pts[i - 1];
   }
   hull.resize(k - 1);
+}
+
+Ring convexHull(const std::vector<Point>& points) {
+  Ring hull;
+  hull.reserve(2 * points.size());
+  convexHullInto(points, hull);
   return hull;
 }
 
@@ -347,7 +358,11 @@ OrientedBox smallestBoxAlongEdges(const Ring& hull, const Ring& edges) {
   return best;
 }
 
-OrientedBox minimumAreaBox(const Ring& ring) { return minimumAreaBoxOfHull(convexHull(ring)); }
+OrientedBox minimumAreaBox(const Ring& ring) {
+  thread_local Ring hull;  // kept across calls on this thread
+  convexHullInto(ring, hull);
+  return minimumAreaBoxOfHull(hull);
+}
 
 OrientedBox minimumAreaBoxOfHull(const Ring& hull) {
   if (hull.size() >= 3) return smallestBoxAlongEdges(hull, hull);

@@ -180,6 +180,7 @@ private:
 
   static std::vector<Polygon> joined(detail::SplitPieces&& split) {
     std::vector<Polygon> parts = std::move(split.left);
+    parts.reserve(parts.size() + split.right.size());
     parts.insert(parts.end(), std::make_move_iterator(split.right.begin()), std::make_move_iterator(split.right.end()));
     return parts;
   }
@@ -220,10 +221,10 @@ private:
     const double size = b.width() + b.height();
     const double onLine = 1e-9 * size + 1e-12, clearance = 1e-6 * size;
     auto offLine = [&](const Point& q) { return std::fabs((q.x - through.x) * dir.y - (q.y - through.y) * dir.x); };
-    std::vector<const Ring*> rings{&part.outer};
-    for (const Ring& h : part.holes) rings.push_back(&h);
-    for (std::size_t ri = 0; ri < rings.size(); ++ri) {
-      const Ring& r = *rings[ri];
+    const std::size_t rings = 1 + part.holes.size();
+    const auto ring = [&](std::size_t k) -> const Ring& { return k == 0 ? part.outer : part.holes[k - 1]; };
+    for (std::size_t ri = 0; ri < rings; ++ri) {
+      const Ring& r = ring(ri);
       for (std::size_t i = 0, n = r.size(); i < n; ++i) {
         const Point& p = r[i];
         const Point& q = r[(i + 1) % n];
@@ -232,8 +233,8 @@ private:
         // edge's box are farther from the edge itself.
         const Box near = Box{std::min(p.x, q.x), std::min(p.y, q.y), std::max(p.x, q.x), std::max(p.y, q.y)}
                              .expanded(clearance);
-        for (std::size_t rj = 0; rj < rings.size(); ++rj) {
-          const Ring& t = *rings[rj];
+        for (std::size_t rj = 0; rj < rings; ++rj) {
+          const Ring& t = ring(rj);
           for (std::size_t j = 0, m = t.size(); j < m; ++j) {
             if (rj == ri && (j == i || j == (i + 1) % n || (j + 1) % m == i)) continue;  // itself, neighbours
             const Point& c = t[j];
@@ -268,6 +269,7 @@ private:
     thread_local std::vector<char> partAccess;
     thread_local std::vector<std::size_t> order;
     thread_local std::vector<Point> centres;
+    thread_local std::vector<double> areas;
     candidates.clear();
     candidates.push_back({false, 0.25 * box.length * shiftAcross});
     bool accessTried = false;
@@ -284,7 +286,6 @@ private:
       // The snapped line first; if it makes an inadmissible split (for example a
       // sliver along a contour edge parallel to it), the line as drawn.
       std::vector<Polygon> parts;
-      std::vector<double> areas;
       bool admissible = false;
       const Point snapped = snap(pivot, dir, near);
       for (const Point& through : {snapped, pivot}) {
@@ -322,6 +323,9 @@ private:
         return centres[x].x * v.x + centres[x].y * v.y < centres[y].x * v.x + centres[y].y * v.y;
       });
       ObbSplits::Split out;
+      out.parts.reserve(parts.size());
+      out.access.reserve(parts.size());
+      out.areas.reserve(parts.size());
       for (std::size_t k : order) {
         out.parts.push_back(std::move(parts[k]));
         out.access.push_back(partAccess[k]);
@@ -336,10 +340,13 @@ private:
   // known (NaN otherwise), set here when measured.
   NodePtr recurse(const Polygon& piece, double a, double& width, std::uint64_t seed, bool access, int depth,
                   const NodePtr& previous) {
-    Ring hull;  // for the fit test and the split's box, made when first needed
+    // The hull, for the fit test and the split's box, made when first needed
+    // (in storage shared by all pieces: it is not needed once the parts recurse).
+    bool hullMade = false;
     const auto hullOf = [&]() -> const Ring& {
-      if (hull.empty()) hull = convexHull(piece.outer);
-      return hull;
+      if (!hullMade) convexHullInto(piece.outer, hull_);
+      hullMade = true;
+      return hull_;
     };
     // The width is measured only when the area fits.
     bool fits = a <= p_.aMax;
@@ -391,6 +398,7 @@ private:
   double accessTolerance_ = 1e-6;
   std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;  // outline_, for the access test
   bool record_ = false;
+  Ring hull_;  // the hull of the piece recurse() is deciding on
 };
 
 }  // namespace

@@ -77,7 +77,10 @@ double segmentDistance(const Point& a, const Point& b, const Point& c, const Poi
 bool isClearlySimple(const Ring& ring);
 
 /// Convex hull of a point set, counter-clockwise, without collinear points.
-Ring convexHull(std::vector<Point> points);
+Ring convexHull(const std::vector<Point>& points);
+/// The same into `hull` (its storage reused): no allocation once the
+/// calling thread's scratch and `hull` have grown.
+void convexHullInto(const std::vector<Point>& points, Ring& hull);
 
 /// An oriented rectangle: centre, unit axis `u` along the long side, and side lengths.
 struct OrientedBox {
