@@ -100,6 +100,9 @@ public:
     const Box b = bounds(block);
     accessTolerance_ = std::max(1e-6, 1e-9 * (b.width() + b.height()));
     outlineEdges_ = std::make_unique<analysis::PreparedBoundary>(outline_, accessTolerance_);
+    outlineVertices_.reserve(block.outer.size());
+    for (std::size_t i = 0; i < block.outer.size(); ++i) outlineVertices_.push_back({block.outer[i], i});
+    std::sort(outlineVertices_.begin(), outlineVertices_.end(), byPosition);
   }
 
   /// Subdivides the block, reusing the splits of `previous` (may be null);
@@ -116,7 +119,36 @@ private:
   };
 
   bool hasAccess(const Polygon& piece) const {
-    return outlineEdges_->sharesAtLeast(piece, p_.minFrontage);
+    return holdsOutlineEdge(piece.outer) || outlineEdges_->sharesAtLeast(piece, p_.minFrontage);
+  }
+
+  struct Vertex {
+    Point p;
+    std::size_t index;  // in the block's outer ring
+  };
+  static bool byPosition(const Vertex& a, const Vertex& b) {
+    return a.p.x < b.p.x || (a.p.x == b.p.x && a.p.y < b.p.y);
+  }
+
+  // A shortcut of the access test: the ring has a whole edge of the block's
+  // outer ring (the same two vertices, in the same order, as counter-clockwise
+  // rings keep them) clearly longer than the frontage needed. That edge alone
+  // gives the measured shared length, so the test would pass too.
+  bool holdsOutlineEdge(const Ring& ring) const {
+    const Ring& outline = block_.outer;
+    const std::size_t n = ring.size(), m = outline.size();
+    const double needed = p_.minFrontage * (1 + 1e-9);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Point& a = ring[i];
+      const Point& b = ring[(i + 1) % n];
+      if (!(norm(b.x - a.x, b.y - a.y) > needed)) continue;
+      const auto at = std::lower_bound(outlineVertices_.begin(), outlineVertices_.end(), Vertex{a, 0}, byPosition);
+      for (auto v = at; v != outlineVertices_.end() && v->p.x == a.x && v->p.y == a.y; ++v) {
+        const Point& next = outline[(v->index + 1) % m];
+        if (next.x == b.x && next.y == b.y) return true;
+      }
+    }
+    return false;
   }
 
   void emit(const Polygon& piece, bool access, bool oversize) {
@@ -399,6 +431,7 @@ private:
   std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;  // outline_, for the access test
   bool record_ = false;
   Ring hull_;  // the hull of the piece recurse() is deciding on
+  std::vector<Vertex> outlineVertices_;  // of block_.outer, by position
 };
 
 }  // namespace

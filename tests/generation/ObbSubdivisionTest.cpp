@@ -144,7 +144,7 @@ constexpr int kRandomShapes = 1400 / test::kSanitizerDivisor;
 TEST(ObbSubdivision, RandomShapesAreTiledValidlyAndReproducibly) {
   std::mt19937_64 rng = test::seededRandom(20261121, "random shapes");
   std::uniform_real_distribution<double> u(0, 1);
-  int shapes = 0, parcels = 0, accessExceptions = 0;
+  int shapes = 0, parcels = 0, accessExceptions = 0, withoutAccess = 0;
   for (int i = 0; i < kRandomShapes; ++i) {
     const int kind = i % 7;
     const Polygon block = test::randomShape(rng, kind);
@@ -162,6 +162,17 @@ TEST(ObbSubdivision, RandomShapesAreTiledValidlyAndReproducibly) {
       }
     }
     if (p.xi == 1.0) accessExceptions += sub.withoutAccess;
+    {
+      // The access the subdivision decided on is the measured one: parcels
+      // sharing less than min-frontage of the block's outer ring.
+      const Box b = bounds(block);
+      const Polygon outer{block.outer, {}};  // PreparedBoundary refers to it
+      const analysis::PreparedBoundary outline(outer, std::max(1e-6, 1e-9 * (b.width() + b.height())));
+      int measuredWithout = 0;
+      for (const Polygon& q : sub.parcels) measuredWithout += !outline.sharesAtLeast(q, p.minFrontage);
+      EXPECT_EQ(measuredWithout, sub.withoutAccess) << what;
+      withoutAccess += measuredWithout;
+    }
     if (i % 50 == 0) {  // reproducible from the seed
       const Subdivision again = subdivideObb(block, p, s);
       ASSERT_EQ(again.parcels.size(), sub.parcels.size()) << what;
@@ -172,8 +183,10 @@ TEST(ObbSubdivision, RandomShapesAreTiledValidlyAndReproducibly) {
     ++shapes;
     parcels += static_cast<int>(sub.parcels.size());
   }
-  std::printf("%d shapes, %d parcels, %d without street access at xi = 1\n", shapes, parcels, accessExceptions);
+  std::printf("%d shapes, %d parcels, %d without street access (%d at xi = 1)\n", shapes, parcels, withoutAccess,
+              accessExceptions);
   EXPECT_EQ(accessExceptions, 0);
+  EXPECT_GT(withoutAccess, 0);
 }
 
 // Moving A_max and W_max up and down while reusing the recorded splits gives,

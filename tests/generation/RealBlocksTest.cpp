@@ -3,11 +3,13 @@
 // 2012, section 6).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
 #include "TestUtil.h"
 #include "generation/TilingCheck.h"
+#include "parcelscope/analysis/Metrics.h"
 #include "parcelscope/analysis/StatsJob.h"
 #include "parcelscope/core/Parallel.h"
 #include "parcelscope/generation/GenerateJob.h"
@@ -60,9 +62,18 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
   const std::size_t n = inputs.entries.size();
   std::vector<Subdivision> results(n);
   std::vector<test::TilingReport> reports(n);
+  std::vector<int> measuredWithout(n, 0);
+  const double minFrontage = request.parameters.at("min-frontage");
   parallelFor(n, [&](std::size_t k) {
-    results[k] = runBlock(inputs, k, plans[k], request.parameters.at("min-frontage")).subdivision;
+    results[k] = runBlock(inputs, k, plans[k], minFrontage).subdivision;
     reports[k] = test::checkTiling(inputs.entries[k].shape, results[k].parcels);
+    if (style == "obb" && !results[k].failed) {
+      // The access the subdivision decided on is the measured one.
+      const Polygon outer{inputs.entries[k].shape.outer, {}};  // PreparedBoundary refers to it
+      const Box b = bounds(outer);
+      const analysis::PreparedBoundary outline(outer, std::max(1e-6, 1e-9 * (b.width() + b.height())));
+      for (const Polygon& q : results[k].parcels) measuredWithout[k] += !outline.sharesAtLeast(q, minFrontage);
+    }
   });
   int parcels = 0, withoutAccess = 0, failed = 0, oversize = 0, fallbacks = 0, patios = 0;
   for (std::size_t k = 0; k < n; ++k) {
@@ -73,6 +84,9 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
     EXPECT_LE(reports[k].maxOverlap, 1e-6) << what;
     EXPECT_EQ(reports[k].invalid, 0) << what;
     EXPECT_EQ(reports[k].outside, 0) << what;
+    if (style == "obb") {
+      EXPECT_EQ(measuredWithout[k], results[k].withoutAccess) << what;
+    }
     parcels += static_cast<int>(results[k].parcels.size());
     withoutAccess += results[k].withoutAccess;
     failed += results[k].failed;
