@@ -188,11 +188,15 @@ double segmentDistance(const Point& a, const Point& b, const Point& c, const Poi
 }
 
 bool isClearlySimple(const Ring& r) {
+  if (r.size() < 3) return false;
+  return isClearlySimple(r, bounds(r), signedArea(r));
+}
+
+bool isClearlySimple(const Ring& r, const Box& b, double ringArea) {
   const std::size_t n = r.size();
   if (n < 3) return false;
-  const Box b = bounds(r);
   const double eps = 1e-9 * std::max(b.width(), b.height());
-  if (!(eps > 0) || std::fabs(signedArea(r)) <= eps * eps) return false;
+  if (!(eps > 0) || std::fabs(ringArea) <= eps * eps) return false;
   for (std::size_t i = 0; i < n; ++i) {
     const Point& p = r[i];
     const Point& q = r[(i + 1) % n];

@@ -221,6 +221,8 @@ private:
   // `areas[k]` is the area of parts[k].
   Verdict judge(const std::vector<Polygon>& parts, const std::vector<double>& areas, const Point& through,
                 const Point& dir) const {
+    thread_local std::vector<Box> boxes;  // of the parts
+    boxes.clear();
     for (std::size_t k = 0; k < parts.size(); ++k) {
       const Polygon& part = parts[k];
       const double a = areas[k];
@@ -228,17 +230,20 @@ private:
       // A shape of area A and diameter D is at least A / D wide (its hull lies
       // in a strip of its least width, at most D long), and so is every box
       // around it: when that bound clears W_min, no box is needed.
-      const Box b = bounds(part);
+      const Box& b = boxes.emplace_back(bounds(part));
       if (a >= p_.wMin * norm(b.width(), b.height()) * (1 + 1e-9)) continue;
       if (minimumAreaBox(part.outer).width < p_.wMin) return Verdict::TooSmall;
     }
-    for (const Polygon& part : parts) {
-      if (!cutIsClean(part, through, dir)) return Verdict::CutNotClear;
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      const Polygon& part = parts[k];
+      if (!cutIsClean(part, boxes[k], through, dir)) return Verdict::CutNotClear;
       // GEOS validity, skipped for rings proven simple (a ring with no holes
       // and non-zero area is valid when simple): the conservative test for
-      // short rings, the exact sweep (after the conservative test) for long ones.
-      const bool simple = part.holes.empty() && (part.outer.size() <= 16 ? isClearlySimple(part.outer)
-                                                                          : detail::isStrictlySimple(part.outer));
+      // short rings (its area, of a ring without holes, is the part's), the
+      // exact sweep (after the conservative test) for long ones.
+      const bool simple =
+          part.holes.empty() && (part.outer.size() <= 16 ? isClearlySimple(part.outer, boxes[k], areas[k])
+                                                         : detail::isStrictlySimple(part.outer));
       if (!simple && !io::isValid(part)) return Verdict::Invalid;
     }
     return Verdict::Admissible;
@@ -248,8 +253,8 @@ private:
   // distance from every other edge of the piece and do not fold back. A cut
   // that grazes a vertex or runs along an edge is exact, but its pieces would
   // carry slivers that rounding to doubles can turn invalid.
-  static bool cutIsClean(const Polygon& part, const Point& through, const Point& dir) {
-    const Box b = bounds(part);
+  // `b` is the part's bounds.
+  static bool cutIsClean(const Polygon& part, const Box& b, const Point& through, const Point& dir) {
     const double size = b.width() + b.height();
     const double onLine = 1e-9 * size + 1e-12, clearance = 1e-6 * size;
     auto offLine = [&](const Point& q) { return std::fabs((q.x - through.x) * dir.y - (q.y - through.y) * dir.x); };

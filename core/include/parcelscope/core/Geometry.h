@@ -75,6 +75,8 @@ double segmentDistance(const Point& a, const Point& b, const Point& c, const Poi
 /// False means "not proven": ask GEOS or an exact test. Rings of more than 64
 /// vertices are checked by a sweep over their edges' boxes.
 bool isClearlySimple(const Ring& ring);
+/// The same, given the ring's bounds and signedArea (computed already).
+bool isClearlySimple(const Ring& ring, const Box& bounds, double signedArea);
 
 /// Convex hull of a point set, counter-clockwise, without collinear points.
 Ring convexHull(const std::vector<Point>& points);
