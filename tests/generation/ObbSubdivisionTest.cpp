@@ -162,17 +162,10 @@ TEST(ObbSubdivision, RandomShapesAreTiledValidlyAndReproducibly) {
       }
     }
     if (p.xi == 1.0) accessExceptions += sub.withoutAccess;
-    {
-      // The access the subdivision decided on is the measured one: parcels
-      // sharing less than min-frontage of the block's outer ring.
-      const Box b = bounds(block);
-      const Polygon outer{block.outer, {}};  // PreparedBoundary refers to it
-      const analysis::PreparedBoundary outline(outer, std::max(1e-6, 1e-9 * (b.width() + b.height())));
-      int measuredWithout = 0;
-      for (const Polygon& q : sub.parcels) measuredWithout += !outline.sharesAtLeast(q, p.minFrontage);
-      EXPECT_EQ(measuredWithout, sub.withoutAccess) << what;
-      withoutAccess += measuredWithout;
-    }
+    // The access the subdivision decided on is the measured one.
+    const int measuredWithout = test::measuredWithoutAccess(block, sub.parcels, p.minFrontage);
+    EXPECT_EQ(measuredWithout, sub.withoutAccess) << what;
+    withoutAccess += measuredWithout;
     if (i % 50 == 0) {  // reproducible from the seed
       const Subdivision again = subdivideObb(block, p, s);
       ASSERT_EQ(again.parcels.size(), sub.parcels.size()) << what;

@@ -3,13 +3,11 @@
 // 2012, section 6).
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <memory>
 
 #include "TestUtil.h"
 #include "generation/TilingCheck.h"
-#include "parcelscope/analysis/Metrics.h"
 #include "parcelscope/analysis/StatsJob.h"
 #include "parcelscope/core/Parallel.h"
 #include "parcelscope/generation/GenerateJob.h"
@@ -69,10 +67,7 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
     reports[k] = test::checkTiling(inputs.entries[k].shape, results[k].parcels);
     if (style == "obb" && !results[k].failed) {
       // The access the subdivision decided on is the measured one.
-      const Polygon outer{inputs.entries[k].shape.outer, {}};  // PreparedBoundary refers to it
-      const Box b = bounds(outer);
-      const analysis::PreparedBoundary outline(outer, std::max(1e-6, 1e-9 * (b.width() + b.height())));
-      for (const Polygon& q : results[k].parcels) measuredWithout[k] += !outline.sharesAtLeast(q, minFrontage);
+      measuredWithout[k] = test::measuredWithoutAccess(inputs.entries[k].shape, results[k].parcels, minFrontage);
     }
   });
   int parcels = 0, withoutAccess = 0, failed = 0, oversize = 0, fallbacks = 0, patios = 0;

@@ -3,9 +3,11 @@
 // they tile the block (areas sum to its area), do not overlap, and are valid.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
+#include "parcelscope/analysis/Metrics.h"
 #include "parcelscope/core/Geometry.h"
 #include "parcelscope/io/GeometryOps.h"
 
@@ -41,6 +43,17 @@ inline TilingReport checkTiling(const Polygon& block, const std::vector<Polygon>
     }
   }
   return r;
+}
+
+/// Parcels that share less than `minFrontage` of the block's outer ring, as
+/// measured (the OBB subdivision's access test, with its tolerance).
+inline int measuredWithoutAccess(const Polygon& block, const std::vector<Polygon>& parcels, double minFrontage) {
+  const Polygon outer{block.outer, {}};  // PreparedBoundary refers to it
+  const Box b = bounds(outer);
+  const analysis::PreparedBoundary outline(outer, std::max(1e-6, 1e-9 * (b.width() + b.height())));
+  int without = 0;
+  for (const Polygon& q : parcels) without += !outline.sharesAtLeast(q, minFrontage);
+  return without;
 }
 
 #define EXPECT_TILES(block, parcels, what)                                   \
