@@ -108,13 +108,21 @@ public:
     left_.clear();
     widest_ = 0;
     if (edges.size() <= kScanUpTo) return;
+    // Sorted as (left side, edge) pairs; `meeting` sorts what it finds, so
+    // the order of ties does not matter.
+    thread_local std::vector<std::pair<double, std::size_t>> sorted;
+    sorted.resize(edges.size());
+    for (std::size_t j = 0; j < edges.size(); ++j) sorted[j] = {edges[j].lo[0], j};
+    std::sort(sorted.begin(), sorted.end(),
+              [](const std::pair<double, std::size_t>& a, const std::pair<double, std::size_t>& b) {
+                return a.first < b.first;
+              });
     order_.resize(edges.size());
-    for (std::size_t j = 0; j < edges.size(); ++j) order_[j] = j;
-    std::sort(order_.begin(), order_.end(),
-              [&](std::size_t a, std::size_t b) { return edges[a].lo[0] < edges[b].lo[0]; });
-    left_.reserve(edges.size());
-    for (std::size_t j : order_) {
-      left_.push_back(edges[j].lo[0]);
+    left_.resize(edges.size());
+    for (std::size_t k = 0; k < sorted.size(); ++k) {
+      const std::size_t j = sorted[k].second;
+      order_[k] = j;
+      left_[k] = sorted[k].first;
       widest_ = std::max(widest_, edges[j].hi[0] - edges[j].lo[0]);
     }
   }

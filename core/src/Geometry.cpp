@@ -159,12 +159,20 @@ Point interiorPoint(const Polygon& polygon) {
   return best;
 }
 
-double pointSegmentDistance(const Point& p, const Point& a, const Point& b) {
+namespace {
+// The square of pointSegmentDistance: the same sum, before its square root.
+double pointSegmentDistance2(const Point& p, const Point& a, const Point& b) {
   const double dx = b.x - a.x, dy = b.y - a.y;
   const double len2 = dx * dx + dy * dy;
   double t = len2 > 0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / len2 : 0.0;
   t = std::clamp(t, 0.0, 1.0);
-  return norm(p.x - (a.x + t * dx), p.y - (a.y + t * dy));
+  const double ex = p.x - (a.x + t * dx), ey = p.y - (a.y + t * dy);
+  return ex * ex + ey * ey;
+}
+}  // namespace
+
+double pointSegmentDistance(const Point& p, const Point& a, const Point& b) {
+  return __builtin_sqrt(pointSegmentDistance2(p, a, b));
 }
 
 namespace {
@@ -183,8 +191,10 @@ bool segmentsCross(const Point& a, const Point& b, const Point& c, const Point& 
 
 double segmentDistance(const Point& a, const Point& b, const Point& c, const Point& d) {
   if (segmentsCross(a, b, c, d)) return 0.0;
-  return std::min(std::min(pointSegmentDistance(a, c, d), pointSegmentDistance(b, c, d)),
-                  std::min(pointSegmentDistance(c, a, b), pointSegmentDistance(d, a, b)));
+  // One square root, of the least: the square root is correctly rounded and
+  // never decreasing, so this is the least of the four distances exactly.
+  return __builtin_sqrt(std::min(std::min(pointSegmentDistance2(a, c, d), pointSegmentDistance2(b, c, d)),
+                                 std::min(pointSegmentDistance2(c, a, b), pointSegmentDistance2(d, a, b))));
 }
 
 bool isClearlySimple(const Ring& r) {
@@ -233,15 +243,25 @@ bool isClearlySimple(const Ring& r, const Box& b, double ringArea) {
   }
   // A sweep in x: each edge meets only the edges whose boxes are still open
   // when its own box opens.
-  std::vector<Box> boxes(n);
-  std::vector<std::size_t> order(n);
+  // Scratch kept by each thread; the edges are sorted by their boxes' left
+  // sides as (left, edge) pairs, not through the boxes (the answer does not
+  // depend on the order of ties).
+  thread_local std::vector<Box> boxes;
+  thread_local std::vector<std::pair<double, std::size_t>> order;
+  thread_local std::vector<std::size_t> open;
+  boxes.resize(n);
+  order.resize(n);
+  open.clear();
   for (std::size_t i = 0; i < n; ++i) {
     boxes[i] = edgeBox(i);
-    order[i] = i;
+    order[i] = {boxes[i].minX, i};
   }
-  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return boxes[x].minX < boxes[y].minX; });
-  std::vector<std::size_t> open;
-  for (const std::size_t i : order) {
+  std::sort(order.begin(), order.end(),
+            [](const std::pair<double, std::size_t>& x, const std::pair<double, std::size_t>& y) {
+              return x.first < y.first;
+            });
+  for (const auto& entry : order) {
+    const std::size_t i = entry.second;
     std::size_t kept = 0;
     for (const std::size_t j : open) {
       if (boxes[j].maxX < boxes[i].minX) continue;  // closed before this one opens
