@@ -51,6 +51,7 @@
 
 #include "EarClip.h"
 #include "Simplify.h"
+#include "TextCache.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
 
@@ -88,6 +89,7 @@ void styleText(vtkTextProperty* p, int size, bool bold = false) {
 // figures are drawn one at a time.
 vtkSmartPointer<vtkRenderWindow> offscreenWindow(const FigureOutput& out) {
   requireDisplay();
+  detail::prepareTextRendering();
   static vtkSmartPointer<vtkRenderWindow> window;
   if (!window) {
     window = vtkSmartPointer<vtkRenderWindow>::New();
@@ -562,6 +564,7 @@ void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, c
 void fillHistogramChart(vtkChartXY* chart, const std::string& title, const std::string& xTitle,
                         const std::string& yTitle, const std::vector<double>& edges,
                         const std::vector<HistogramSeries>& series, int height) {
+  detail::prepareTextRendering();
   FigureOutput size;
   size.height = height;
   const std::size_t bins = edges.size() - 1;
@@ -781,6 +784,7 @@ struct MapLayer::Impl {
 };
 
 MapLayer::MapLayer() : impl_(std::make_unique<Impl>()) {
+  detail::prepareTextRendering();  // before the colour bar's first text
   Impl& m = *impl_;
   for (LayerPart& p : m.parts) {
     // The coordinates are local metres around the data's centre: no shift
