@@ -40,8 +40,8 @@ TEST(TextCache, GlyphsAreLoadedOnceThenServedFromTheCache) {
     EXPECT_EQ(again, first);
   }
   ASSERT_TRUE(tools->RenderString(property, text, 72, imageAgain, sizeAgain));
-  // Laying the text out 200 times more took no glyph from the font again: the
-  // only allocations are the second drawing's own (none for its glyphs).
+  // Laying the text out 200 times more and drawing it again took nothing from
+  // FreeType's allocator: every glyph came from the cache.
   EXPECT_EQ(textAllocations(), drawn) << "glyphs were loaded again: the glyph cache dropped them";
   ASSERT_EQ(size[0], sizeAgain[0]);
   ASSERT_EQ(size[1], sizeAgain[1]);
