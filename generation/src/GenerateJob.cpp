@@ -286,7 +286,8 @@ BlockOutcome runBlock(const BlockInputs& inputs, std::size_t entry, const BlockP
     const bool checked = previous && reuse.previousPlan->style == "obb" && !previous->subdivision.failed &&
                          !previous->subdivision.fallback;
     o.subdivision = subdivideObb(inputs.entries[entry].shape, plan.parameters.bounds, plan.seed,
-                                 {reusable ? previous->subdivision.obbSplits.get() : nullptr, reuse.record, checked});
+                                 {reusable ? previous->subdivision.obbSplits.get() : nullptr, reuse.record, checked,
+                                  checked ? previous->subdivision.blockSimple : static_cast<signed char>(-1)});
   } else {
     // The layout checks for itself that it was made for this block and these parameters.
     const SkeletonLayout* layout = previous ? previous->subdivision.skeletonLayout.get() : nullptr;

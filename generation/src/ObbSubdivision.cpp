@@ -55,6 +55,7 @@ struct ObbSplits {
     std::vector<Polygon> parts;  ///< empty: no admissible split (the piece stays, oversize)
     std::vector<char> access;
     std::vector<double> areas;  ///< of the parts (area())
+    std::vector<char> simple;   ///< parts whose outer ring is proven strictly simple (and that have no holes)
   };
   struct Node;
   /// What became of a part: its node (null: it fitted and was never split) and
@@ -93,8 +94,9 @@ constexpr std::size_t kMaxParcelsPerBlock = 200000;
 
 class Subdivider {
 public:
-  Subdivider(const Polygon& block, const ObbParameters& p, Subdivision& out, bool record)
-      : block_(block), outline_{block.outer, {}}, p_(p), out_(out), record_(record) {
+  // `blockSimple` as Subdivision::blockSimple.
+  Subdivider(const Polygon& block, const ObbParameters& p, Subdivision& out, bool record, int blockSimple)
+      : block_(block), outline_{block.outer, {}}, p_(p), out_(out), record_(record), blockSimple_(blockSimple) {
     for (const Point& v : block.outer) contour_.push_back(v);
     for (const Ring& h : block.holes) contour_.insert(contour_.end(), h.begin(), h.end());
     const Box b = bounds(block);
@@ -109,7 +111,7 @@ public:
   /// returns the splits made and reused when recording.
   NodePtr run(std::uint64_t seed, const NodePtr& previous) {
     double width = std::numeric_limits<double>::quiet_NaN();
-    return recurse(block_, area(block_), width, seed, hasAccess(block_), 0, previous);
+    return recurse(block_, area(block_), width, seed, hasAccess(block_), 0, previous, -1);
   }
 
 private:
@@ -184,8 +186,11 @@ private:
   // either way: the exact split's pieces differ from the fast one's by the
   // rounding of the crossing points alone, some 1e-16 of the piece's size,
   // where the clearance is 1e-6 of it.
+  // `pieceSimple`: the piece has no holes and its ring is proven strictly
+  // simple. `simple` receives which parts are (see judge).
   std::vector<Polygon> admissibleSplit(const Polygon& piece, double pieceArea, const Point& through,
-                                       const Point& dir, std::vector<double>& areas) const {
+                                       const Point& dir, bool pieceSimple, std::vector<double>& areas,
+                                       std::vector<char>& simple) const {
     detail::SplitPieces split;
     areas.clear();
     areas.reserve(4);
@@ -197,7 +202,7 @@ private:
       double sum = 0;
       for (const Polygon& part : parts) sum += areas.emplace_back(area(part));
       if (std::fabs(sum - pieceArea) <= 1e-9 * pieceArea) {
-        const Verdict v = judge(parts, areas, through, dir);
+        const Verdict v = judge(parts, areas, through, dir, pieceSimple, simple);
         if (v == Verdict::Admissible) return parts;
         if (v == Verdict::TooSmall || v == Verdict::CutNotClear) return {};
       }
@@ -207,7 +212,9 @@ private:
     std::vector<Polygon> parts = joined(std::move(split));
     areas.clear();
     for (const Polygon& part : parts) areas.push_back(area(part));
-    return judge(parts, areas, through, dir) == Verdict::Admissible ? parts : std::vector<Polygon>{};
+    // (The exact split's parts are judged without the piece's simplicity:
+    // splitPieceIsSimple reasons about the fast split's vertices.)
+    return judge(parts, areas, through, dir, false, simple) == Verdict::Admissible ? parts : std::vector<Polygon>{};
   }
 
   static std::vector<Polygon> joined(detail::SplitPieces&& split) {
@@ -219,8 +226,12 @@ private:
 
   enum class Verdict { Admissible, TooSmall, CutNotClear, Invalid };
   // `areas[k]` is the area of parts[k].
+  // `simple[k]` is set when parts[k] has no holes and its ring is proven
+  // strictly simple; `pieceSimple` (the piece has no holes and a strictly
+  // simple ring) lets a part be proven so from its new edges alone
+  // (splitPieceIsSimple).
   Verdict judge(const std::vector<Polygon>& parts, const std::vector<double>& areas, const Point& through,
-                const Point& dir) const {
+                const Point& dir, bool pieceSimple, std::vector<char>& simple) const {
     thread_local std::vector<Box> boxes;  // of the parts
     boxes.clear();
     for (std::size_t k = 0; k < parts.size(); ++k) {
@@ -234,17 +245,20 @@ private:
       if (a >= p_.wMin * norm(b.width(), b.height()) * (1 + 1e-9)) continue;
       if (minimumAreaBox(part.outer).width < p_.wMin) return Verdict::TooSmall;
     }
+    simple.assign(parts.size(), 0);
     for (std::size_t k = 0; k < parts.size(); ++k) {
       const Polygon& part = parts[k];
       if (!cutIsClean(part, boxes[k], through, dir)) return Verdict::CutNotClear;
       // GEOS validity, skipped for rings proven simple (a ring with no holes
-      // and non-zero area is valid when simple): the conservative test for
-      // short rings (its area, of a ring without holes, is the part's), the
-      // exact sweep (after the conservative test) for long ones.
-      const bool simple =
-          part.holes.empty() && (part.outer.size() <= 16 ? isClearlySimple(part.outer, boxes[k], areas[k])
-                                                         : detail::isStrictlySimple(part.outer));
-      if (!simple && !io::isValid(part)) return Verdict::Invalid;
+      // and non-zero area is valid when simple): from the piece's simplicity
+      // and the part's new edges; else the conservative test for short rings
+      // (its area, of a ring without holes, is the part's), the exact sweep
+      // (after the conservative test) for long ones.
+      simple[k] = part.holes.empty() &&
+                  ((pieceSimple && detail::splitPieceIsSimple(part.outer, boxes[k], through, dir)) ||
+                   (part.outer.size() <= 16 ? isClearlySimple(part.outer, boxes[k], areas[k])
+                                            : detail::isStrictlySimple(part.outer)));
+      if (!simple[k] && !io::isValid(part)) return Verdict::Invalid;
     }
     return Verdict::Admissible;
   }
@@ -297,8 +311,8 @@ private:
   // The split of a piece that does not fit: its parts in a fixed order (along
   // the OBB axes, so seeds follow position) with their access; no parts when
   // no candidate is admissible.
-  ObbSplits::Split split(const Polygon& piece, double pieceArea, const Ring& hull, bool access, bool wantAccess,
-                         double shiftAcross, double shiftAlong) const {
+  ObbSplits::Split split(const Polygon& piece, double pieceArea, const Ring& hull, bool pieceSimple, bool access,
+                         bool wantAccess, double shiftAcross, double shiftAlong) const {
     const OrientedBox box = edgeAlignedBox(piece.outer, hull);
     const Point u = box.u, v{-box.u.y, box.u.x};
     // Scratch kept across calls on this thread (split does not recurse).
@@ -307,6 +321,7 @@ private:
     thread_local std::vector<std::size_t> order;
     thread_local std::vector<Point> centres;
     thread_local std::vector<double> areas;
+    thread_local std::vector<char> partSimple;
     candidates.clear();
     candidates.push_back({false, 0.25 * box.length * shiftAcross});
     bool accessTried = false;
@@ -326,7 +341,7 @@ private:
       bool admissible = false;
       const Point snapped = snap(pivot, dir, near);
       for (const Point& through : {snapped, pivot}) {
-        parts = admissibleSplit(piece, pieceArea, through, dir, areas);
+        parts = admissibleSplit(piece, pieceArea, through, dir, pieceSimple, areas, partSimple);
         admissible = !parts.empty();
         if (admissible || (through.x == pivot.x && through.y == pivot.y)) break;
       }
@@ -363,10 +378,12 @@ private:
       out.parts.reserve(parts.size());
       out.access.reserve(parts.size());
       out.areas.reserve(parts.size());
+      out.simple.reserve(parts.size());
       for (std::size_t k : order) {
         out.parts.push_back(std::move(parts[k]));
         out.access.push_back(partAccess[k]);
         out.areas.push_back(areas[k]);
+        out.simple.push_back(partSimple[k]);
       }
       return out;
     }
@@ -374,9 +391,11 @@ private:
   }
 
   // `a` is the piece's area; `width` its hull's minimum-area box width when
-  // known (NaN otherwise), set here when measured.
+  // known (NaN otherwise), set here when measured. `simple`: 1 when the piece
+  // has no holes and a strictly simple ring, 0 when not known so, -1 for the
+  // block (tested when first needed).
   NodePtr recurse(const Polygon& piece, double a, double& width, std::uint64_t seed, bool access, int depth,
-                  const NodePtr& previous) {
+                  const NodePtr& previous, int simple) {
     // The hull, for the fit test and the split's box, made when first needed
     // (in storage shared by all pieces: it is not needed once the parts recurse).
     bool hullMade = false;
@@ -410,7 +429,8 @@ private:
       node->children = previous->children;  // their nodes and widths, replaced below
     } else {
       node->split = std::make_shared<const ObbSplits::Split>(
-          split(piece, a, hullOf(), access, wantAccess, shiftAcross, shiftAlong));
+          split(piece, a, hullOf(), simple < 0 ? blockSimple() : simple == 1, access, wantAccess, shiftAcross,
+                shiftAlong));
     }
     const ObbSplits::Split& chosen = *node->split;
     if (chosen.parts.empty()) {
@@ -422,9 +442,17 @@ private:
       ObbSplits::Child& child = node->children[k];
       const NodePtr below = std::move(child.node);
       child.node = recurse(chosen.parts[k], chosen.areas[k], child.width, splitmix64(childBase + k),
-                           chosen.access[k] != 0, depth + 1, below);
+                           chosen.access[k] != 0, depth + 1, below, chosen.simple[k] != 0 ? 1 : 0);
     }
     return record_ ? NodePtr(std::move(node)) : nullptr;
+  }
+
+  // Whether the block has no holes and a strictly simple ring, tested once
+  // (when first needed, unless known) and kept in out_.blockSimple.
+  bool blockSimple() {
+    if (blockSimple_ < 0) blockSimple_ = block_.holes.empty() && detail::isStrictlySimple(block_.outer);
+    out_.blockSimple = static_cast<signed char>(blockSimple_);
+    return blockSimple_ == 1;
   }
 
   const Polygon& block_;
@@ -435,6 +463,7 @@ private:
   double accessTolerance_ = 1e-6;
   std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;  // outline_, for the access test
   bool record_ = false;
+  int blockSimple_ = -1;
   Ring hull_;  // the hull of the piece recurse() is deciding on
   std::vector<Vertex> outlineVertices_;  // of block_.outer, by position
 };
@@ -454,12 +483,20 @@ Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, 
   const Point o = detail::exactShiftOrigin(block);
   Polygon local = detail::translated(block, -o.x, -o.y);
   try {
-    if (!normalise(local) || (!reuse.blockChecked && !detail::isValidForSplit(local))) {
+    // A block without holes is valid when its ring is strictly simple (the
+    // first test of the validity check, whose answer the splits use too).
+    int simple = reuse.blockChecked ? reuse.blockSimple : -1;
+    const bool normalised = normalise(local);
+    if (normalised && !reuse.blockChecked) {
+      simple = local.outer.size() >= 3 && local.holes.empty() && detail::isStrictlySimple(local.outer);
+    }
+    if (!normalised || (!reuse.blockChecked && simple != 1 && !detail::isValidForSplit(local))) {
       out.failed = true;
       out.failure = "block is not a valid polygon with holes for exact splitting";
     } else {
+      out.blockSimple = static_cast<signed char>(simple);
       const NodePtr previous = reuse.previous ? reuse.previous->root : nullptr;
-      NodePtr made = Subdivider(local, p, out, reuse.record).run(seed, previous);
+      NodePtr made = Subdivider(local, p, out, reuse.record, simple).run(seed, previous);
       if (reuse.record) {
         auto splits = std::make_shared<ObbSplits>();
         splits->root = std::move(made);

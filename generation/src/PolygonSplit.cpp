@@ -535,4 +535,57 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
   return polygon.holes.empty() ? splitRingFast(polygon, pivot, dir, out) : splitHoledFast(polygon, pivot, dir, out);
 }
 
+// Off the line (by more than `onLine`) lie only vertices of the polygon: the
+// fast split computes its crossings on the line, rounded by some 1e-16 of the
+// coordinates. An edge of the piece with both ends off the line therefore
+// joins two vertices that follow each other in the polygon's ring: it is an
+// edge of the polygon, and two such edges meet only where they did there, at
+// a shared vertex. Every other edge (along a cut, or a polygon edge shortened
+// to a crossing, whose rounding may move it) must be longer than the margin,
+// must not fold back onto its neighbours, and must keep farther than the
+// margin from every edge but its neighbours. The margin, 1e-12 of the
+// coordinates' magnitude, is far above the rounding of the distances computed;
+// `onLine` far above that of the crossings.
+bool splitPieceIsSimple(const Ring& r, const Box& b, const Point& pivot, const Point& dir) {
+  const std::size_t n = r.size();
+  if (n < 3) return false;
+  const double size = b.width() + b.height();
+  const double onLine = 1e-9 * size + 1e-12;
+  const double magnitude =
+      std::max(std::max(std::fabs(b.minX), std::fabs(b.maxX)), std::max(std::fabs(b.minY), std::fabs(b.maxY)));
+  const double margin = 1e-12 * (size + magnitude);
+  if (!(margin > 0) || !std::isfinite(margin)) return false;
+  thread_local std::vector<char> on;
+  on.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    on[i] = std::fabs((r[i].x - pivot.x) * dir.y - (r[i].y - pivot.y) * dir.x) <= onLine;
+  }
+  const auto foldsBack = [](const Point& x, const Point& y, const Point& z) {  // y-z returns along x-y
+    const Point e1{y.x - x.x, y.y - x.y}, e2{z.x - y.x, z.y - y.y};
+    const double cr = e1.x * e2.y - e1.y * e2.x, dot = e1.x * e2.x + e1.y * e2.y;
+    return dot < 0 && std::fabs(cr) <= 1e-9 * norm(e1.x, e1.y) * norm(e2.x, e2.y);
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = (i + 1) % n;
+    if (!on[i] && !on[j]) continue;
+    const Point& p = r[i];
+    const Point& q = r[j];
+    if (!(norm(q.x - p.x, q.y - p.y) > margin)) return false;
+    if (foldsBack(r[(i + n - 1) % n], p, q) || foldsBack(p, q, r[(i + 2) % n])) return false;
+    const Box near =
+        Box{std::min(p.x, q.x), std::min(p.y, q.y), std::max(p.x, q.x), std::max(p.y, q.y)}.expanded(margin);
+    for (std::size_t k = 0; k < n; ++k) {
+      if (k == i || k == j || (k + 1) % n == i) continue;  // itself, its neighbours
+      const Point& c = r[k];
+      const Point& d = r[(k + 1) % n];
+      if (std::max(c.x, d.x) < near.minX || std::min(c.x, d.x) > near.maxX || std::max(c.y, d.y) < near.minY ||
+          std::min(c.y, d.y) > near.maxY) {
+        continue;
+      }
+      if (!(segmentDistance(p, q, c, d) > margin)) return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace parcelscope::generation::detail

@@ -44,4 +44,11 @@ SplitPieces splitByLine(const Polygon& polygon, const Point& pivot, const Point&
 /// be used.
 bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& dir, SplitPieces& out);
 
+/// Proves strictly simple a ring of a piece that splitByLineFast(polygon,
+/// pivot, dir) gave, when `polygon` has no holes and a strictly simple outer
+/// ring, by looking only at the edges the split made or shortened: those with
+/// an end on the line. False when it cannot prove it (the ring may still be
+/// simple). `bounds` are the ring's.
+bool splitPieceIsSimple(const Ring& ring, const Box& bounds, const Point& pivot, const Point& dir);
+
 }  // namespace parcelscope::generation::detail

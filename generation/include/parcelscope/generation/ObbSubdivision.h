@@ -61,6 +61,9 @@ struct Subdivision {
   std::string fallbackReason;     ///< why, when fallback
   int patioParcels = 0;           ///< parcels that are (parts of) inner patios, without street access by design
   std::shared_ptr<const ObbSplits> obbSplits;  ///< OBB only, when asked to record them
+  /// OBB only: 1 when the block has no holes and a strictly simple ring, 0
+  /// when not, -1 when it was not tested (for ObbReuse::blockSimple).
+  signed char blockSimple = -1;
   std::shared_ptr<const SkeletonLayout> skeletonLayout;  ///< skeleton styles only, when asked to record it
 };
 
@@ -73,6 +76,8 @@ struct ObbReuse {
   /// The block passed the validity check in an earlier run that did not fail:
   /// the check is skipped.
   bool blockChecked = false;
+  /// With blockChecked: that run's Subdivision::blockSimple (-1: test again if needed).
+  signed char blockSimple = -1;
 };
 
 /// True when splits recorded with `recorded` serve a run with `wanted`: every
