@@ -645,6 +645,11 @@ void MainWindow::drawReport(const UpdateReport& report) {
   if (const auto it = started_.find(report.serial); it != started_.end()) {
     timings.library = static_cast<double>(it->second.nsecsElapsed()) / 1e6;
   }
+  timings.update = 1e3 * report.seconds;
+  for (const auto& [stage, seconds] : report.result->seconds) {
+    if (stage == "generate") timings.generate = 1e3 * seconds;
+    if (stage == "metrics") timings.metrics = 1e3 * seconds;
+  }
   // The result replaced is freed in the background, not before drawing.
   releaseInBackground(std::exchange(result_, report.result));
   shownRequest_ = report.request;

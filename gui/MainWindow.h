@@ -101,6 +101,8 @@ public:
   /// the views drawn into their buffers. lastLatencyMs is about their sum.
   struct UpdateTimings {
     double library = 0, layers = 0, histogram = 0, text = 0, views = 0;
+    /// Within `library`: the session's update, and its generate and metrics stages.
+    double update = 0, generate = 0, metrics = 0;
   };
   UpdateTimings lastTimings() const { return lastTimings_; }
   /// True while an update is queued or under way.

@@ -299,6 +299,46 @@ void convexHullInto(const std::vector<Point>& points, Ring& hull) {
   hull.resize(k - 1);
 }
 
+void convexHullOfSimpleRing(const Ring& ring, Ring& hull) {
+  const std::size_t n = ring.size();
+  if (n < 4 || cross(ring[0], ring[1], ring[2]) == 0) {
+    convexHullInto(ring, hull);
+    return;
+  }
+  // The hull so far as a deque in an array, both ends holding the last point
+  // added: bottom..top runs counter-clockwise. Each end grows by at most n.
+  thread_local std::vector<Point> d;
+  d.resize(2 * n + 2);
+  std::size_t bottom = n, top = n + 3;
+  d[bottom] = d[top] = ring[2];
+  const bool left = cross(ring[0], ring[1], ring[2]) > 0;
+  d[bottom + 1] = left ? ring[0] : ring[1];
+  d[bottom + 2] = left ? ring[1] : ring[0];
+  for (std::size_t i = 3; i < n; ++i) {
+    const Point& v = ring[i];
+    if (cross(d[bottom], d[bottom + 1], v) > 0 && cross(d[top - 1], d[top], v) > 0) continue;  // inside
+    while (bottom + 1 < top && cross(d[bottom], d[bottom + 1], v) <= 0) ++bottom;
+    d[--bottom] = v;
+    while (bottom + 1 < top && cross(d[top - 1], d[top], v) <= 0) --top;
+    d[++top] = v;
+  }
+  // As convexHullInto gives it: from the lowest point in x-then-y order (a
+  // corner of the hull), counter-clockwise, without collinear points (the
+  // deque may keep one where the ring closes).
+  std::size_t first = bottom;
+  for (std::size_t k = bottom + 1; k < top; ++k) {
+    if (d[k].x < d[first].x || (d[k].x == d[first].x && d[k].y < d[first].y)) first = k;
+  }
+  const std::size_t m = top - bottom;
+  hull.clear();
+  for (std::size_t k = 0; k < m; ++k) {
+    const Point& v = d[bottom + (first - bottom + k) % m];
+    while (hull.size() >= 2 && cross(hull[hull.size() - 2], hull.back(), v) <= 0) hull.pop_back();
+    hull.push_back(v);
+  }
+  while (hull.size() >= 3 && cross(hull[hull.size() - 2], hull.back(), hull.front()) <= 0) hull.pop_back();
+}
+
 Ring convexHull(const std::vector<Point>& points) {
   Ring hull;
   hull.reserve(2 * points.size());

@@ -400,7 +400,14 @@ private:
     // (in storage shared by all pieces: it is not needed once the parts recurse).
     bool hullMade = false;
     const auto hullOf = [&]() -> const Ring& {
-      if (!hullMade) convexHullInto(piece.outer, hull_);
+      if (!hullMade) {
+        // A ring proven simple (and counter-clockwise, as pieces are) needs no sort.
+        if (simple == 1 || (simple < 0 && blockSimple_ == 1)) {
+          convexHullOfSimpleRing(piece.outer, hull_);
+        } else {
+          convexHullInto(piece.outer, hull_);
+        }
+      }
       hullMade = true;
       return hull_;
     };

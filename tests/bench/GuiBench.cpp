@@ -48,6 +48,7 @@ struct Row {
   std::vector<double> firstMs;  // to the first views drawn (a result in between, or the final one)
   // MainWindow::lastTimings of each change, and the time from the views drawn to the screen.
   std::vector<double> library, layers, histogram, text, views, toScreen;
+  std::vector<double> update, generate, metrics;  // within library
 };
 
 double median(std::vector<double> v) {
@@ -64,6 +65,8 @@ void print(const Row& r) {
   std::printf("%-58s medians: library %.1f, layers %.1f, histogram %.1f, text %.1f, views %.1f, to screen %.1f ms\n",
               "", median(r.library), median(r.layers), median(r.histogram), median(r.text), median(r.views),
               median(r.toScreen));
+  std::printf("%-58s (library: session update %.1f, of which generate %.1f and metrics %.1f ms)\n", "",
+              median(r.update), median(r.generate), median(r.metrics));
 }
 
 // When each view last rendered and last reached the screen, on one clock.
@@ -185,6 +188,9 @@ int main(int argc, char** argv) {
       row.text.push_back(t.text);
       row.views.push_back(t.views);
       row.toScreen.push_back(toScreen);
+      row.update.push_back(t.update);
+      row.generate.push_back(t.generate);
+      row.metrics.push_back(t.metrics);
       // (The time to screen of the final views stands in for that of the first.)
       row.firstMs.push_back(w.lastFirstViewMs() + toScreen);
     }

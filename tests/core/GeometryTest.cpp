@@ -95,6 +95,71 @@ TEST(Geometry, ConvexHullDropsInteriorAndCollinearPoints) {
   EXPECT_DOUBLE_EQ(signedArea(hull), 100.0);
 }
 
+// Melkman's hull of a simple ring against the sorting hull: on rings with
+// integer coordinates (exact orientation tests) the very same ring, collinear
+// points dropped alike; on real coordinates, the same in all but rounding.
+TEST(Geometry, HullOfSimpleRingIsTheSortingHull) {
+  std::mt19937_64 rng = test::seededRandom(11, "simple ring hulls");
+  std::uniform_real_distribution<double> u(0, 1);
+  int compared = 0, sameReal = 0, comparedReal = 0;
+  Ring melkman, sorted;
+  for (int i = 0; i < 3000; ++i) {
+    // A star around the origin: angles in order, random radii; every third
+    // integer one with the midpoints of its edges added where they fall on
+    // the grid (collinear points, exactly).
+    const bool integer = i % 2 == 0;
+    const int n = 3 + static_cast<int>(u(rng) * 40);
+    const double start = u(rng) * 2 * kPi;
+    Ring star;
+    for (int k = 0; k < n; ++k) {
+      const double angle = start + 2 * kPi * (k + 0.8 * u(rng)) / n, radius = 5 + 95 * u(rng);
+      Point p{radius * std::cos(angle), radius * std::sin(angle)};
+      if (integer) p = {std::round(p.x), std::round(p.y)};
+      star.push_back(p);
+    }
+    if (integer && i % 3 == 0) {
+      Ring withMidpoints;
+      for (std::size_t k = 0; k < star.size(); ++k) {
+        const Point& a = star[k];
+        const Point& b = star[(k + 1) % star.size()];
+        withMidpoints.push_back(a);
+        if (std::fmod(a.x + b.x, 2) == 0 && std::fmod(a.y + b.y, 2) == 0) {
+          withMidpoints.push_back({(a.x + b.x) / 2, (a.y + b.y) / 2});
+        }
+      }
+      star = withMidpoints;
+    }
+    Polygon p{star, {}};
+    if (!normalise(p) || !isClearlySimple(p.outer)) continue;
+    convexHullOfSimpleRing(p.outer, melkman);
+    convexHullInto(p.outer, sorted);
+    const bool same = melkman.size() == sorted.size() &&
+                      std::equal(melkman.begin(), melkman.end(), sorted.begin(),
+                                 [](const Point& a, const Point& b) { return a.x == b.x && a.y == b.y; });
+    if (integer) {
+      ++compared;
+      EXPECT_TRUE(same) << "ring " << i << " of " << p.outer.size() << " vertices: hulls of " << melkman.size()
+                        << " and " << sorted.size();
+      if (!same) {
+        for (const Point& q : p.outer) std::printf("{%g, %g}, ", q.x, q.y);
+        std::printf("\n");
+      }
+    } else {
+      ++comparedReal;
+      sameReal += same;
+      EXPECT_NEAR(signedArea(melkman), signedArea(sorted), 1e-9 * signedArea(sorted)) << "ring " << i;
+      if (std::fabs(signedArea(melkman) - signedArea(sorted)) > 1e-9 * signedArea(sorted)) {
+        for (const Point& q : p.outer) std::printf("{%.17g, %.17g}, ", q.x, q.y);
+        std::printf("\nmelkman %zu sorted %zu\n", melkman.size(), sorted.size());
+      }
+    }
+  }
+  std::printf("%d integer rings compared, %d of %d real ones the same\n", compared, sameReal, comparedReal);
+  EXPECT_GT(compared, 1000);
+  EXPECT_GT(comparedReal, 1000);
+  EXPECT_GE(sameReal, 99 * comparedReal / 100);
+}
+
 }  // namespace
 }  // namespace parcelscope
 

@@ -83,6 +83,11 @@ Ring convexHull(const std::vector<Point>& points);
 /// The same into `hull` (its storage reused): no allocation once the
 /// calling thread's scratch and `hull` have grown.
 void convexHullInto(const std::vector<Point>& points, Ring& hull);
+/// convexHullInto for a ring known to be simple (no two edges meet but
+/// neighbours), counter-clockwise: Melkman's algorithm, one pass along the
+/// ring without sorting. The same hull, starting at the same vertex, up to
+/// the rounding of orientation tests on nearly collinear points.
+void convexHullOfSimpleRing(const Ring& ring, Ring& hull);
 
 /// An oriented rectangle: centre, unit axis `u` along the long side, and side lengths.
 struct OrientedBox {
