@@ -255,7 +255,7 @@ private:
       // (its area, of a ring without holes, is the part's), the exact sweep
       // (after the conservative test) for long ones.
       simple[k] = part.holes.empty() &&
-                  ((pieceSimple && detail::splitPieceIsSimple(part.outer, boxes[k], through, dir)) ||
+                  ((pieceSimple && detail::splitPieceIsSimple(part.outer, boxes[k], through, dir, true)) ||
                    (part.outer.size() <= 16 ? isClearlySimple(part.outer, boxes[k], areas[k])
                                             : detail::isStrictlySimple(part.outer)));
       if (!simple[k] && !io::isValid(part)) return Verdict::Invalid;

@@ -546,7 +546,7 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
 // margin from every edge but its neighbours. The margin, 1e-12 of the
 // coordinates' magnitude, is far above the rounding of the distances computed;
 // `onLine` far above that of the crossings.
-bool splitPieceIsSimple(const Ring& r, const Box& b, const Point& pivot, const Point& dir) {
+bool splitPieceIsSimple(const Ring& r, const Box& b, const Point& pivot, const Point& dir, bool cutsClear) {
   const std::size_t n = r.size();
   if (n < 3) return false;
   const double size = b.width() + b.height();
@@ -555,6 +555,7 @@ bool splitPieceIsSimple(const Ring& r, const Box& b, const Point& pivot, const P
       std::max(std::max(std::fabs(b.minX), std::fabs(b.maxX)), std::max(std::fabs(b.minY), std::fabs(b.maxY)));
   const double margin = 1e-12 * (size + magnitude);
   if (!(margin > 0) || !std::isfinite(margin)) return false;
+  const bool skipCuts = cutsClear && 1e-6 * size > margin;  // the caller's clearance covers the margin
   thread_local std::vector<char> on;
   on.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -568,6 +569,7 @@ bool splitPieceIsSimple(const Ring& r, const Box& b, const Point& pivot, const P
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t j = (i + 1) % n;
     if (!on[i] && !on[j]) continue;
+    if (skipCuts && on[i] && on[j]) continue;
     const Point& p = r[i];
     const Point& q = r[j];
     if (!(norm(q.x - p.x, q.y - p.y) > margin)) return false;

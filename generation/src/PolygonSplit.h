@@ -48,7 +48,12 @@ bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& di
 /// pivot, dir) gave, when `polygon` has no holes and a strictly simple outer
 /// ring, by looking only at the edges the split made or shortened: those with
 /// an end on the line. False when it cannot prove it (the ring may still be
-/// simple). `bounds` are the ring's.
-bool splitPieceIsSimple(const Ring& ring, const Box& bounds, const Point& pivot, const Point& dir);
+/// simple). `bounds` are the ring's. With `cutsClear`, the caller has
+/// checked that the edges with both ends on the line keep 1e-6 of the ring's
+/// size (bounds width + height) from every edge but their neighbours and do
+/// not fold back (as the OBB split does for every part): they are not
+/// checked again.
+bool splitPieceIsSimple(const Ring& ring, const Box& bounds, const Point& pivot, const Point& dir,
+                        bool cutsClear = false);
 
 }  // namespace parcelscope::generation::detail

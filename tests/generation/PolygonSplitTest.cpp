@@ -373,13 +373,23 @@ TEST(PolygonSplit, PiecesOfSimpleRingsAreProvenSimpleFromTheirNewEdges) {
 
 TEST(PolygonSplit, PieceEdgesCrossingOrNearlyTouchingAreNotProvenSimple) {
   const Point through{0, 0}, along{1, 0};  // the line y = 0
-  const auto proven = [&](const Ring& r) { return splitPieceIsSimple(r, bounds(r), through, along); };
-  // An edge from the line's vertex (0, 0) crosses another edge.
+  const auto proven = [&](const Ring& r, bool cutsClear = false) {
+    return splitPieceIsSimple(r, bounds(r), through, along, cutsClear);
+  };
+  // An edge from the line's vertex (0, 0) crosses another edge; it is
+  // checked even when the edges along the line are known clear.
   EXPECT_FALSE(proven({{0, 0}, {4, 4}, {4, 1}, {-1, 3}}));
+  EXPECT_FALSE(proven({{0, 0}, {4, 4}, {4, 1}, {-1, 3}}, true));
   // A V whose tip comes within 1e-13 of the edge leaving the line, and the
   // same V kept clear of it.
   EXPECT_FALSE(proven({{0, 0}, {10, 1}, {10, 3}, {5, 0.5 + 1e-13}, {0, 3}}));
+  EXPECT_FALSE(proven({{0, 0}, {10, 1}, {10, 3}, {5, 0.5 + 1e-13}, {0, 3}}, true));
   EXPECT_TRUE(proven({{0, 0}, {10, 1}, {10, 3}, {5, 1.5}, {0, 3}}));
+  // An edge along the line that another edge crosses: found unless the
+  // caller vouches for the edges along the line.
+  const Ring crossedCut{{0, 0}, {10, 0}, {10, 5}, {4, -1}, {2, 5}};
+  EXPECT_FALSE(proven(crossedCut));
+  EXPECT_TRUE(proven(crossedCut, true));
   // An edge folding back along the one before it at a vertex on the line.
   EXPECT_FALSE(proven({{0, 0}, {10, 0}, {5, 0}, {5, 5}}));
 }
