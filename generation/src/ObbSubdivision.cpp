@@ -298,11 +298,7 @@ private:
           }
         }
         // Fold-back at either end: the neighbouring edge returns along the cut.
-        for (const auto& [x, y] : {std::pair<Point, Point>{r[(i + n - 1) % n], p}, {q, r[(i + 2) % n]}}) {
-          const Point e1{y.x - x.x, y.y - x.y}, e2{q.x - p.x, q.y - p.y};
-          const double cr = e1.x * e2.y - e1.y * e2.x, dot = e1.x * e2.x + e1.y * e2.y;
-          if (dot < 0 && std::fabs(cr) <= 1e-9 * norm(e1.x, e1.y) * norm(e2.x, e2.y)) return false;
-        }
+        if (detail::foldsBack(r[(i + n - 1) % n], p, q) || detail::foldsBack(p, q, r[(i + 2) % n])) return false;
       }
     }
     return true;

@@ -561,11 +561,6 @@ bool splitPieceIsSimple(const Ring& r, const Box& b, const Point& pivot, const P
   for (std::size_t i = 0; i < n; ++i) {
     on[i] = std::fabs((r[i].x - pivot.x) * dir.y - (r[i].y - pivot.y) * dir.x) <= onLine;
   }
-  const auto foldsBack = [](const Point& x, const Point& y, const Point& z) {  // y-z returns along x-y
-    const Point e1{y.x - x.x, y.y - x.y}, e2{z.x - y.x, z.y - y.y};
-    const double cr = e1.x * e2.y - e1.y * e2.x, dot = e1.x * e2.x + e1.y * e2.y;
-    return dot < 0 && std::fabs(cr) <= 1e-9 * norm(e1.x, e1.y) * norm(e2.x, e2.y);
-  };
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t j = (i + 1) % n;
     if (!on[i] && !on[j]) continue;

@@ -2,6 +2,7 @@
 // Exact splitting of a polygon with holes by a line (CGAL Boolean set
 // operations on the exact-constructions kernel). Pieces on the two sides share
 // their cut vertices exactly, so after rounding to doubles they still tile.
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,14 @@ SplitPieces splitByLine(const Polygon& polygon, const Point& pivot, const Point&
 /// to order, a piece pinched onto itself): then the exact `splitByLine` must
 /// be used.
 bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& dir, SplitPieces& out);
+
+/// True when the edge y-z returns along the edge x-y (they overlap past y):
+/// opposite directions, parallel to 1e-9 of their lengths' product.
+inline bool foldsBack(const Point& x, const Point& y, const Point& z) {
+  const Point e1{y.x - x.x, y.y - x.y}, e2{z.x - y.x, z.y - y.y};
+  const double cr = e1.x * e2.y - e1.y * e2.x, dot = e1.x * e2.x + e1.y * e2.y;
+  return dot < 0 && std::fabs(cr) <= 1e-9 * norm(e1.x, e1.y) * norm(e2.x, e2.y);
+}
 
 /// Proves strictly simple a ring of a piece that splitByLineFast(polygon,
 /// pivot, dir) gave, when `polygon` has no holes and a strictly simple outer
