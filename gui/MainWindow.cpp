@@ -565,6 +565,8 @@ void MainWindow::setColourBy(const QString& quantity) {
     colourBy_->setCurrentText(quantity);
   }
   if (!result_) return;
+  // Not measured yet: the views are coloured when the completed result arrives.
+  if (analysis::parcelQuantity(request_.metric).context && !result_->generated.contextPending.empty()) return;
   Laps lap;
   UpdateTimings timings;
   recolour(false);
@@ -639,6 +641,25 @@ void MainWindow::showReport(const UpdateReport& report) {
 
 void MainWindow::drawReport(const UpdateReport& report) {
   if (report.partial && report.serial != pendingSerial_) return;  // superseded already
+  const bool contextPending = !report.result->generated.contextPending.empty();
+  // Coloured by a quantity not measured yet: the completed result follows.
+  if (contextPending && analysis::parcelQuantity(request_.metric).context) return;
+  if (report.completesContext && report.serial == drawnSerial_ && result_ &&
+      !analysis::parcelQuantity(request_.metric).context) {
+    // Views and histogram show this result's shapes already: only the numbers change.
+    releaseInBackground(std::exchange(result_, report.result));
+    releaseInBackground(std::exchange(finalResult_, report.result));
+    shownRequest_ = finalRequest_ = report.request;
+    shownSerial_ = report.serial;
+    fillNumbers();
+    showBlock();
+    if (const auto it = completeStarted_.find(report.serial); it != completeStarted_.end()) {
+      lastCompleteMs_ = static_cast<double>(it->second.nsecsElapsed()) / 1e6;
+      completeStarted_.erase(completeStarted_.begin(), std::next(it));
+    }
+    emit contextCompleted(report.serial);
+    return;
+  }
   const bool first = !result_ || report.reloaded;
   Laps lap;
   UpdateTimings timings;
@@ -654,9 +675,11 @@ void MainWindow::drawReport(const UpdateReport& report) {
   releaseInBackground(std::exchange(result_, report.result));
   shownRequest_ = report.request;
   if (!report.partial) {
-    releaseInBackground(std::exchange(finalResult_, report.result));
-    finalRequest_ = report.request;
-    shownSerial_ = report.serial;
+    if (!contextPending) {
+      releaseInBackground(std::exchange(finalResult_, report.result));
+      finalRequest_ = report.request;
+      shownSerial_ = report.serial;
+    }
     progress_->setVisible(false);
     cancel_->setVisible(false);
   }
@@ -691,6 +714,8 @@ void MainWindow::drawReport(const UpdateReport& report) {
       values.push_back(q.value(r.generated.metrics[i]));
     }
     proceduralView_->layer().setShapes(shapes, values, blocks);
+    // The layer reads these shapes again when the zoom changes.
+    releaseInBackground(std::exchange(layerResult_, result_));
   }
   const bool observedChanged = recolour(first || selectionChanged_);
   selectionChanged_ = false;
@@ -728,8 +753,14 @@ void MainWindow::drawReport(const UpdateReport& report) {
   if (it != started_.end()) {
     lastLatencyMs_ = static_cast<double>(it->second.nsecsElapsed()) / 1e6;
     lastFirstViewMs_ = firstViewMs_ < 0 ? lastLatencyMs_ : firstViewMs_;
+    if (contextPending) {
+      completeStarted_[report.serial] = it->second;
+    } else {
+      lastCompleteMs_ = lastLatencyMs_;
+    }
     started_.erase(started_.begin(), std::next(it));
   }
+  drawnSerial_ = report.serial;
   firstViewMs_ = -1;
   status_->setText(QString("%1 blocks, %2 observed and %3 procedural parcels; %4 of %5 block parts regenerated; %6 ms")
                        .arg(a.blocks.size())
@@ -864,9 +895,15 @@ void MainWindow::fillNumbers() {
   for (const auto& c : summary.columns) header << QString::fromStdString(c.name);
   while (header.size() < columns) header << QString();
   if (resized) numbers_->setHorizontalHeaderLabels(header);
+  // Street access of parcels whose context is still being measured.
+  const bool pending = !result_->generated.contextPending.empty();
   int row = 0;
   for (const auto& r : summary.rows) {
-    for (std::size_t c = 0; c < r.size(); ++c) put(row, static_cast<int>(c), text(r[c]), false);
+    const bool measuring = pending && std::get<std::string>(r.front()) == "street_access_share";
+    for (std::size_t c = 0; c < r.size(); ++c) {
+      const bool unknown = measuring && std::holds_alternative<double>(r[c]) && std::isnan(std::get<double>(r[c]));
+      put(row, static_cast<int>(c), unknown ? QStringLiteral("measuring...") : text(r[c]), false);
+    }
     ++row;
   }
   for (std::size_t c = 0; c < distances.columns.size(); ++c) {

@@ -92,6 +92,10 @@ public:
   QString lastError() const;
   /// Milliseconds from the last submitted change to views and histograms drawn.
   double lastLatencyMs() const { return lastLatencyMs_; }
+  /// Milliseconds from the last submitted change to every number shown
+  /// (after the views when the neighbours and street access were measured
+  /// afterwards; see UpdateReport::contextPending).
+  double lastCompleteMs() const { return lastCompleteMs_; }
   /// Milliseconds from the last completed change to the first views drawn for
   /// it (a result in between, while many blocks are regenerated, or the final one).
   double lastFirstViewMs() const { return lastFirstViewMs_; }
@@ -114,6 +118,9 @@ signals:
   void errorShown(const QString& message);
   /// A result in between is shown (see viz::CompareSession::PartialFn).
   void partialShown(qint64 serial);
+  /// The numbers of request serial `serial` are complete (its neighbours and
+  /// street access were measured after its views were drawn).
+  void contextCompleted(qint64 serial);
 
 protected:
   void dragEnterEvent(QDragEnterEvent* event) override;
@@ -153,7 +160,11 @@ private:
   qint64 pendingSerial_ = 0, shownSerial_ = 0;
   bool failedOrCancelled_ = false;
   std::map<qint64, QElapsedTimer> started_;
-  double lastLatencyMs_ = 0;
+  std::map<qint64, QElapsedTimer> completeStarted_;  ///< views drawn, numbers not complete yet
+  qint64 drawnSerial_ = 0;  ///< request whose (final) views were drawn last
+  /// The result whose parcels the procedural layer draws (it reads them again on zoom).
+  std::shared_ptr<const viz::CompareResult> layerResult_;
+  double lastLatencyMs_ = 0, lastCompleteMs_ = 0;
   UpdateTimings lastTimings_;
   double firstViewMs_ = -1, lastFirstViewMs_ = 0;
   int selected_ = -1;

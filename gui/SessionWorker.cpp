@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "parcelscope/core/Error.h"
+#include "parcelscope/core/Parallel.h"
 
 namespace parcelscope::gui {
 
@@ -61,7 +62,8 @@ void SessionWorker::process() {
         report.partial = true;
         emit updated(report);
       };
-      const viz::CompareSession::Update u = session_.update(request, progress, partial);
+      const viz::CompareSession::Update u =
+          session_.update(request, progress, partial, 0.5, /*deferContext=*/true);
       UpdateReport report;
       report.result = u.result;
       report.request = request;
@@ -70,7 +72,14 @@ void SessionWorker::process() {
       report.blocksRegenerated = static_cast<int>(u.blocksRegenerated);
       report.blocksTotal = static_cast<int>(u.blocksTotal);
       report.seconds = u.seconds;
+      report.contextPending = !u.result->generated.contextPending.empty();
       emit updated(report);
+      if (report.contextPending && completeContext(serial)) {
+        report.result = session_.current();
+        report.contextPending = false;
+        report.completesContext = true;
+        emit updated(report);
+      }
     } catch (const Error& e) {
       if (e.kind() == Error::Kind::Cancelled) {
         emit cancelled(serial);
@@ -80,6 +89,18 @@ void SessionWorker::process() {
     } catch (const std::exception& e) {
       emit failed(QString("internal error: ") + e.what(), serial);
     }
+  }
+}
+
+bool SessionWorker::completeContext(qint64 serial) {
+  // Only asks whether a newer request is waiting: no progress bar for this step.
+  const ProgressFn stillWanted = [&](double, const std::string&) { return latest_.load() == serial; };
+  try {
+    runAtLowestPriority([&] { session_.completeContext(stillWanted); });
+    return true;
+  } catch (const Error& e) {
+    if (e.kind() == Error::Kind::Cancelled) return false;  // the newer request will measure it
+    throw;
   }
 }
 

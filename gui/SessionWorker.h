@@ -1,7 +1,10 @@
 #pragma once
 // Runs viz::CompareSession::update off the UI thread. The newest request wins:
 // submitting one cancels the update under way (through the progress callback),
-// and the session keeps the blocks it had finished.
+// and the session keeps the blocks it had finished. Each update reports twice
+// when it can: first with the parcels measured by shape (what the views and
+// histograms need), then, measured on threads of the lowest priority so as not
+// to slow the drawing of the first, with their neighbours and street access.
 #include <QObject>
 #include <QString>
 
@@ -26,6 +29,14 @@ struct UpdateReport {
   /// A result in between: `blocksRegenerated` of `blocksTotal` block parts are
   /// new, the others as before; the final report follows.
   bool partial = false;
+  /// The regenerated blocks' neighbours, frontage and street access are still
+  /// being measured (viz::CompareSession::update with deferContext): views
+  /// and histograms of shape quantities are final, and a report with
+  /// `completesContext` and the same serial follows unless a newer request
+  /// supersedes this one.
+  bool contextPending = false;
+  /// The same result as the last report of this serial, with its context measured.
+  bool completesContext = false;
 };
 
 class SessionWorker : public QObject {
@@ -48,6 +59,10 @@ private slots:
   void process();
 
 private:
+  /// Measures what the last update deferred, at the lowest priority; false
+  /// when a newer request stopped it.
+  bool completeContext(qint64 serial);
+
   std::mutex mutex_;
   std::optional<viz::CompareRequest> pending_;
   std::atomic<qint64> latest_{0};

@@ -305,18 +305,34 @@ void rederiveBlockBounds(ObservedAnalysis& a, double k) {
   }
 }
 
-std::vector<ParcelMetrics> measureParcels(const std::vector<Polygon>& shapes, const std::vector<Block>& blocks,
-                                          double tolerance, double minFrontage) {
+std::vector<ParcelMetrics> measureShapes(const std::vector<Polygon>& shapes) {
   std::vector<ParcelMetrics> metrics(shapes.size());
   parallelFor(shapes.size(), [&](std::size_t i) {
     static_cast<ShapeMetrics&>(metrics[i]) = shapeMetrics(shapes[i]);
   });
+  return metrics;
+}
+
+void measureContext(const std::vector<Polygon>& shapes, const std::vector<Block>& blocks, double tolerance,
+                    double minFrontage, std::vector<ParcelMetrics>& metrics) {
+  for (ParcelMetrics& m : metrics) {
+    m.neighbours = 0;
+    m.frontage = 0;
+    m.streetAccess = false;
+  }
   std::vector<const Polygon*> all;
+  all.reserve(shapes.size());
   for (const Polygon& s : shapes) all.push_back(&s);
   // Only whether each pair shares kMinSharedBoundary counts here.
   countNeighbours(detail::contacts(all, std::max(tolerance, 1e-6), sharedTolerance(tolerance), kMinSharedBoundary),
                   metrics);
   parallelFor(blocks.size(), [&](std::size_t b) { measureFrontage(blocks[b], all, tolerance, minFrontage, metrics); });
+}
+
+std::vector<ParcelMetrics> measureParcels(const std::vector<Polygon>& shapes, const std::vector<Block>& blocks,
+                                          double tolerance, double minFrontage) {
+  std::vector<ParcelMetrics> metrics = measureShapes(shapes);
+  measureContext(shapes, blocks, tolerance, minFrontage, metrics);
   return metrics;
 }
 

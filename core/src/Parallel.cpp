@@ -84,6 +84,21 @@ void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
   if (error) std::rethrow_exception(error);
 }
 
+void runAtLowestPriority(const std::function<void()>& work) {
+  std::exception_ptr error;
+  std::thread worker([&] {
+    // Linux gives each thread its own nice value, and threads it starts inherit it.
+    setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), 19);
+    try {
+      work();
+    } catch (...) {
+      error = std::current_exception();
+    }
+  });
+  worker.join();
+  if (error) std::rethrow_exception(error);
+}
+
 namespace {
 
 // One background thread, started on first use and joined at exit (after

@@ -39,6 +39,8 @@ std::vector<ParameterDescription> generationParameterDescriptions() {
 
 namespace {
 constexpr double kDefaultOffsetStyleDepth = 30.0;  // m, style offset without --offset
+// m: edges of generated parcels this close count as shared (they share them exactly).
+constexpr double kContactTolerance = 0.05;
 }  // namespace
 
 Subdivision subdivideBlock(const Polygon& block, const std::string& style, const SkeletonParameters& parameters,
@@ -250,12 +252,17 @@ Subdivision subdivideEntry(const BlockInputs& inputs, std::size_t entry, const B
                         widths ? inputs.widths[entry] : StreetWidths{}, reuse);
 }
 
-std::vector<analysis::ParcelMetrics> measureEntry(const BlockInputs& inputs, std::size_t entry,
-                                                  const Subdivision& s, double minFrontage) {
+Block entryBlock(const BlockInputs& inputs, std::size_t entry, std::size_t parcels) {
   Block block;
   block.parts = {inputs.entries[entry].shape};
-  for (std::size_t i = 0; i < s.parcels.size(); ++i) block.parcels.push_back(static_cast<int>(i));
-  return analysis::measureParcels(s.parcels, {block}, 0.05, minFrontage);
+  for (std::size_t i = 0; i < parcels; ++i) block.parcels.push_back(static_cast<int>(i));
+  return block;
+}
+
+std::vector<analysis::ParcelMetrics> measureEntry(const BlockInputs& inputs, std::size_t entry,
+                                                  const Subdivision& s, double minFrontage) {
+  return analysis::measureParcels(s.parcels, {entryBlock(inputs, entry, s.parcels.size())}, kContactTolerance,
+                                  minFrontage);
 }
 
 }  // namespace
@@ -295,10 +302,23 @@ BlockOutcome runBlock(const BlockInputs& inputs, std::size_t entry, const BlockP
   }
   if (previous && sameParcels(o.subdivision.parcels, previous->subdivision.parcels)) {
     o.metrics = previous->metrics;  // the same parcels in the same block: the same measurements
+    o.contextMeasured = previous->contextMeasured;
+    if (!o.contextMeasured && !reuse.shapesOnly) measureOutcomeContext(inputs, entry, o, minFrontage);
+  } else if (reuse.shapesOnly) {
+    o.metrics = analysis::measureShapes(o.subdivision.parcels);
+    o.contextMeasured = false;
   } else {
     o.metrics = measureEntry(inputs, entry, o.subdivision, minFrontage);
   }
   return o;
+}
+
+void measureOutcomeContext(const BlockInputs& inputs, std::size_t entry, BlockOutcome& outcome, double minFrontage) {
+  if (outcome.contextMeasured) return;
+  const std::vector<Polygon>& parcels = outcome.subdivision.parcels;
+  analysis::measureContext(parcels, {entryBlock(inputs, entry, parcels.size())}, kContactTolerance, minFrontage,
+                           outcome.metrics);
+  outcome.contextMeasured = true;
 }
 
 GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<BlockPlan>& plans,
@@ -316,6 +336,9 @@ GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<Bl
   out.parcels.resize(first[n]);
   out.metrics.resize(first[n]);
   out.blocks.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!outcomes[k]->contextMeasured) out.contextPending.push_back(k);
+  }
   parallelFor(n, [&](std::size_t k) {
     const BlockOutcome& o = *outcomes[k];
     if (o.metrics.size() != o.subdivision.parcels.size()) {

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <future>
 #include <iterator>
+#include <limits>
 #include <numeric>
 #include <optional>
 
@@ -143,6 +144,10 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
     r.observedSides = std::move(sides);
   }
   const std::vector<analysis::PreparedSet>& observedSides = *r.observedSides;
+  // Street access of parcels not measured yet is not known: NaN, not the 0 they hold.
+  constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
+  std::vector<char> pending(a.blocks.size(), 0);
+  for (std::size_t k : r.generated.contextPending) pending[static_cast<std::size_t>(r.generated.blockIds[k])] = 1;
   const bool reuse = keep && keep->size() == a.blocks.size() && r.blocks.size() == a.blocks.size();
   if (!reuse) r.blocks.assign(a.blocks.size(), {});
   std::vector<std::size_t> todo;
@@ -164,7 +169,9 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
     c.blockArea = a.statistics[b].blockArea;
     const analysis::PreparedSet generated = analysis::prepareSet(pick(r.generated.metrics, generatedIn[b]));
     c.comparison = analysis::compareSets(observedSides[b], generated, bins, quantile);
+    if (pending[b]) c.comparison.generated.streetAccessShare = kNotMeasured;
   });
+  if (!r.generated.contextPending.empty()) r.city.generated.streetAccessShare = kNotMeasured;
 }
 
 }  // namespace detail

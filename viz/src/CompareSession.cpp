@@ -41,7 +41,9 @@ struct CompareSession::State {
   std::shared_ptr<const analysis::ObservedData> observed;
   generation::BlockInputs inputs;
   std::vector<generation::BlockPlan> plans;  // one per entry; outcomes[k] was made with plans[k]
-  std::vector<std::shared_ptr<const generation::BlockOutcome>> outcomes;
+  // Owned by the session alone (results hold copies), so completeContext can
+  // fill in what an update deferred.
+  std::vector<std::shared_ptr<generation::BlockOutcome>> outcomes;
   std::shared_ptr<const CompareResult> current;
   // Blocks whose parcels a cancelled update replaced: current->blocks still
   // compares their old parcels, so their comparison is not reused.
@@ -54,7 +56,7 @@ CompareSession::~CompareSession() = default;
 std::shared_ptr<const CompareResult> CompareSession::current() const { return state_->current; }
 
 CompareSession::Update CompareSession::update(const CompareRequest& request, const ProgressFn& progress,
-                                              const PartialFn& partial, double partialSeconds) {
+                                              const PartialFn& partial, double partialSeconds, bool deferContext) {
   const auto started = std::chrono::steady_clock::now();
   detail::checkRequest(request);
   State& s = *state_;
@@ -92,15 +94,16 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   if (std::any_of(plans.begin(), plans.end(), [](const auto& p) { return p.style != "obb"; })) {
     generation::streetWidthsOf(inputs);
   }
-  std::vector<std::shared_ptr<const generation::BlockOutcome>> outcomes =
-      reload ? std::vector<std::shared_ptr<const generation::BlockOutcome>>(plans.size()) : s.outcomes;
+  std::vector<std::shared_ptr<generation::BlockOutcome>> outcomes =
+      reload ? std::vector<std::shared_ptr<generation::BlockOutcome>>(plans.size()) : s.outcomes;
   std::vector<generation::BlockPlan> done = reload ? std::vector<generation::BlockPlan>(plans.size()) : s.plans;
   std::vector<std::size_t> todo;
   for (std::size_t k2 = 0; k2 < plans.size(); ++k2) {
     if (!outcomes[k2] || done[k2] != plans[k2]) todo.push_back(k2);
   }
   const double minFrontage = compareValue(request, "min-frontage");
-  std::vector<std::shared_ptr<const generation::BlockOutcome>> made(todo.size());
+  std::vector<std::shared_ptr<generation::BlockOutcome>> made(todo.size());
+  const bool shapesOnly = deferContext && !analysis::parcelQuantity(request.metric).context;
   // Set (release) once made[t] is written, so the progress tick may read it.
   std::unique_ptr<std::atomic<bool>[]> ready(new std::atomic<bool>[todo.size()]);
   for (std::size_t t = 0; t < todo.size(); ++t) ready[t] = false;
@@ -175,7 +178,8 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
           reuse.previous = outcomes[todo[t]].get();
           reuse.previousPlan = outcomes[todo[t]] ? &done[todo[t]] : nullptr;
           reuse.record = true;
-          made[t] = std::make_shared<const generation::BlockOutcome>(
+          reuse.shapesOnly = shapesOnly;
+          made[t] = std::make_shared<generation::BlockOutcome>(
               generation::runBlock(inputs, todo[t], plans[todo[t]], minFrontage, reuse));
           ready[t].store(true, std::memory_order_release);
         },
@@ -199,6 +203,16 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
     throw;
   }
   keepFinished();
+  // Context an earlier update deferred, of blocks this one did not regenerate.
+  std::vector<std::size_t> completed;
+  if (!shapesOnly) {
+    for (std::size_t k2 = 0; k2 < outcomes.size(); ++k2) {
+      if (!outcomes[k2]->contextMeasured) completed.push_back(k2);
+    }
+    parallelFor(completed.size(), [&](std::size_t t) {
+      generation::measureOutcomeContext(inputs, completed[t], *outcomes[completed[t]], minFrontage);
+    });
+  }
 
   // The result: every block's parcels, measured; per-block comparisons kept
   // where neither side changed.
@@ -216,6 +230,7 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   if (!reload && sameBins) {
     std::vector<char> changed(plans.size(), 0);
     for (std::size_t t : todo) changed[t] = 1;
+    for (std::size_t t : completed) changed[t] = 1;
     keep = keepFlags(changed);
     r.blocks = s.current->blocks;
     r.observedLots = s.current->observedLots;
@@ -230,7 +245,7 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   // freeing every block's parcels and splits took longer than comparing them
   // (12-19 ms on cambridge_ma), on the path to the caller.
   releaseInBackground(
-      std::make_shared<const std::vector<std::shared_ptr<const generation::BlockOutcome>>>(std::move(s.outcomes)));
+      std::make_shared<const std::vector<std::shared_ptr<generation::BlockOutcome>>>(std::move(s.outcomes)));
   releaseInBackground(std::move(s.current));
   if (newInputs) s.inputs = std::move(fresh);
   s.observed = observed;
@@ -245,6 +260,64 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   u.reloaded = reload;
   u.blocksRegenerated = todo.size();
   u.blocksTotal = plans.size();
+  u.seconds = secondsSince(started);
+  return u;
+}
+
+CompareSession::Update CompareSession::completeContext(const ProgressFn& progress) {
+  const auto started = std::chrono::steady_clock::now();
+  State& s = *state_;
+  Update u;
+  u.result = s.current;
+  u.blocksTotal = s.outcomes.size();
+  if (!s.current || s.current->generated.contextPending.empty()) return u;
+  const std::vector<std::size_t> todo = s.current->generated.contextPending;
+  const double minFrontage = compareValue(s.request, "min-frontage");
+  std::unique_ptr<std::atomic<bool>[]> measured(new std::atomic<bool>[todo.size()]);
+  for (std::size_t t = 0; t < todo.size(); ++t) measured[t] = false;
+  try {
+    parallelFor(
+        todo.size(),
+        [&](std::size_t t) {
+          generation::measureOutcomeContext(s.inputs, todo[t], *s.outcomes[todo[t]], minFrontage);
+          measured[t].store(true, std::memory_order_release);
+        },
+        [&](std::size_t n) {
+          reportProgress(progress, static_cast<double>(n) / static_cast<double>(todo.size()), "measuring context");
+        });
+  } catch (const Error&) {
+    // The current result still compares these blocks without their context.
+    for (std::size_t t = 0; t < todo.size(); ++t) {
+      if (measured[t].load(std::memory_order_acquire)) s.staleComparisons.insert(s.inputs.entries[todo[t]].blockId);
+    }
+    throw;
+  }
+
+  CompareResult r;
+  r.observed = s.observed;
+  std::vector<const generation::BlockOutcome*> pointers;
+  for (const auto& o : s.outcomes) pointers.push_back(o.get());
+  r.generated = generation::assembleParcels(s.inputs, s.plans, pointers, runSeedOf(s.request));
+  r.generated.clampedBounds = s.current->generated.clampedBounds;
+  r.observedSides = s.current->observedSides;
+  r.observedLots = s.current->observedLots;
+  r.blocks = s.current->blocks;
+  std::vector<char> keep(s.observed->analysis.blocks.size(), 1);
+  for (std::size_t k : todo) keep[static_cast<std::size_t>(s.inputs.entries[k].blockId)] = 0;
+  for (std::int64_t id : s.staleComparisons) {
+    if (id >= 0 && static_cast<std::size_t>(id) < keep.size()) keep[static_cast<std::size_t>(id)] = 0;
+  }
+  detail::compareStage(r, s.request, &keep);
+  r.seconds = s.current->seconds;
+  for (auto& [stage, seconds] : r.seconds) {
+    if (stage == "metrics") seconds += secondsSince(started);
+  }
+
+  releaseInBackground(std::move(s.current));
+  s.current = std::make_shared<const CompareResult>(std::move(r));
+  s.staleComparisons.clear();
+  u.result = s.current;
+  u.blocksRegenerated = 0;
   u.seconds = secondsSince(started);
   return u;
 }

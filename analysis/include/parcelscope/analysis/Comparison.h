@@ -93,6 +93,9 @@ struct ParcelQuantity {
   std::string name;   ///< aspect_ratio, area, width, neighbours, street_access, p_angle, p_area
   std::string title;  ///< for people, with the unit, e.g. "area (m²)"
   double (*value)(const ParcelMetrics&);
+  /// Measured from the parcel's surroundings (neighbours, block outline) rather
+  /// than its own shape: see measureContext.
+  bool context = false;
 };
 /// Every ParcelQuantity, aspect_ratio (the paper's colour map) first.
 const std::vector<ParcelQuantity>& parcelQuantities();

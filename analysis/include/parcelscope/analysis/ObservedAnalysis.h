@@ -90,6 +90,13 @@ void rederiveBlockBounds(ObservedAnalysis& analysis, double k);
 /// frontage on the outline of their block. `blocks[b].parcels` index `shapes`.
 std::vector<ParcelMetrics> measureParcels(const std::vector<Polygon>& shapes, const std::vector<Block>& blocks,
                                           double tolerance, double minFrontage);
+/// measureParcels in two steps: the shape metrics alone (neighbours, frontage
+/// and street access left at 0), then measureContext, which fills those three
+/// in. An interactive caller can show shapes, areas and widths before the
+/// slower context is measured.
+std::vector<ParcelMetrics> measureShapes(const std::vector<Polygon>& shapes);
+void measureContext(const std::vector<Polygon>& shapes, const std::vector<Block>& blocks, double tolerance,
+                    double minFrontage, std::vector<ParcelMetrics>& metrics);
 
 /// The metric columns shared by observed and generated parcel tables, and one
 /// parcel's values for them (same order).

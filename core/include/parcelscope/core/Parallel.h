@@ -18,6 +18,13 @@ unsigned workerCount();
 void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
                  const std::function<void(std::size_t done)>& tick = {});
 
+/// Runs `work` on a new thread of the lowest scheduling priority (nice 19) and
+/// waits for it; a parallelFor inside runs on threads of that priority too.
+/// For work that should use only the CPU time nothing else wants (what an
+/// interactive update can measure after its result is on screen). Exceptions
+/// from `work` are rethrown here.
+void runAtLowestPriority(const std::function<void()>& work);
+
 /// Drops `garbage` on a background thread of the lowest scheduling priority
 /// (nice 19), so that freeing a large structure (the replaced state of an
 /// interactive update, say) does not delay the caller. When many releases are

@@ -84,6 +84,10 @@ struct GeneratedParcels {
   std::vector<std::int64_t> blockIds;     ///< id of each entry of `blocks` (ids repeat for multipart blocks)
   std::vector<Polygon> parcels;           ///< generated parcels, local metres
   std::vector<analysis::ParcelMetrics> metrics;
+  /// Entries of `blocks` whose outcome was measured by shape only (see
+  /// BlockReuse::shapesOnly): neighbours, frontage and street access of their
+  /// parcels are not known yet (left at 0). Empty: every parcel fully measured.
+  std::vector<std::size_t> contextPending;
   std::int64_t failedBlocks = 0, oversize = 0, withoutAccess = 0;
   std::int64_t clampedBounds = 0;         ///< per-block bounds moved into the parameter ranges
   std::int64_t fallbackBlocks = 0;        ///< skeleton blocks subdivided with OBB instead
@@ -139,6 +143,9 @@ std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInp
 struct BlockOutcome {
   Subdivision subdivision;
   std::vector<analysis::ParcelMetrics> metrics;
+  /// Whether neighbours, frontage and street access are in `metrics` (false
+  /// after a shapes-only run, until measureOutcomeContext).
+  bool contextMeasured = true;
 };
 /// What runBlock may reuse from the block's last run.
 struct BlockReuse {
@@ -148,6 +155,10 @@ struct BlockReuse {
   /// Keep the OBB splits or the skeleton layout in the outcome for the next
   /// run (see ObbSplits and SkeletonReuse).
   bool record = false;
+  /// Measure the new parcels' shapes only; their neighbours, frontage and
+  /// street access are left for measureOutcomeContext (parcels equal to the
+  /// previous ones keep whatever the previous outcome had measured).
+  bool shapesOnly = false;
 };
 /// Runs `plan` on entry `entry` of `inputs` (street widths must have been measured
 /// with streetWidthsOf when the style is not obb). `minFrontage` as the analysis's.
@@ -157,6 +168,11 @@ struct BlockReuse {
 /// the previous ones keep their metrics; the outcome is the same as without.
 BlockOutcome runBlock(const BlockInputs& inputs, std::size_t entry, const BlockPlan& plan, double minFrontage,
                       const BlockReuse& reuse = {});
+
+/// Fills in the neighbours, frontage and street access of an outcome of
+/// entry `entry` measured by shape only; the metrics are then those runBlock
+/// gives without shapesOnly.
+void measureOutcomeContext(const BlockInputs& inputs, std::size_t entry, BlockOutcome& outcome, double minFrontage);
 
 /// The run's result from one outcome per entry (in entry order).
 GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<BlockPlan>& plans,

@@ -55,6 +55,9 @@ struct CompareResult {
   generation::GeneratedParcels generated;
   /// Metrics of the observed parcels that belong to a block (right-of-way left out).
   std::vector<analysis::ParcelMetrics> observedLots;
+  /// While generated.contextPending is not empty (a CompareSession update that
+  /// deferred the context), the generated street access share of the city and
+  /// of the blocks holding pending entries is NaN.
   analysis::Comparison city;
   /// One per observed block, in block order; generated parcels are matched to
   /// blocks by block id (a multipart block's parts are one block).

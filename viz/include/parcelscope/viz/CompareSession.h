@@ -48,8 +48,22 @@ public:
   /// set and the update regenerates blocks that all had a result before, it is
   /// called (on this thread) with a result in between, the first after
   /// partialSeconds / 2, then at most every `partialSeconds`.
+  ///
+  /// With `deferContext`, and when the request's metric is a shape quantity
+  /// (not neighbours or street access), the regenerated blocks' parcels are
+  /// measured by shape only: maps, histograms and distances of area, width and
+  /// aspect ratio are final, while neighbours, frontage and street access wait
+  /// for completeContext() (result.generated.contextPending lists the entries).
+  /// An interactive caller shows the result at once and then completes it.
+  /// Without it, anything left pending by earlier updates is measured too.
   Update update(const CompareRequest& request, const ProgressFn& progress = {}, const PartialFn& partial = {},
-                double partialSeconds = 0.5);
+                double partialSeconds = 0.5, bool deferContext = false);
+
+  /// Measures the neighbours, frontage and street access an update deferred
+  /// and returns the completed result (the current one, unchanged, when
+  /// nothing is pending). On Error(Cancelled) the blocks measured so far are
+  /// kept and current() stays as it was.
+  Update completeContext(const ProgressFn& progress = {});
 
   /// The last result (null before the first update).
   std::shared_ptr<const CompareResult> current() const;
