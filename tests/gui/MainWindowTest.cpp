@@ -251,6 +251,39 @@ private slots:
     }
     QVERIFY2(differing <= 0.02, qPrintable(QString("%1 of the pixels differ").arg(differing)));
   }
+
+  // The views are drawn from the parcels' shapes; their neighbours and street
+  // access are measured after, and the numbers then match the library's.
+  void streetAccessFollowsTheViews() {
+    QSignalSpy drawn(window_, &MainWindow::viewsUpdated);
+    QSignalSpy completed(window_, &MainWindow::contextCompleted);
+    window_->setParameter("omega", 0.45);
+    QVERIFY(settle());
+    QVERIFY(drawn.count() >= 1);
+    QCOMPARE(completed.count(), 1);
+    QCOMPARE(completed.last().at(0).toLongLong(), drawn.last().at(0).toLongLong());
+    QVERIFY(window_->result()->generated.contextPending.empty());
+    QVERIFY(window_->lastCompleteMs() >= window_->lastLatencyMs());
+    const auto expected = parcelscope::viz::compare(window_->request());
+    QCOMPARE(window_->result()->city.generated.streetAccessShare, expected.city.generated.streetAccessShare);
+    QTableWidget* numbers = window_->numbers();
+    int row = 0;
+    while (row < numbers->rowCount() && numbers->item(row, 0)->text() != "street_access_share") ++row;
+    QVERIFY(row < numbers->rowCount());
+    QCOMPARE(numbers->item(row, 3)->text(), QString::number(expected.city.generated.streetAccessShare, 'g', 5));
+
+    // Coloured by street access, the views need it: measured before drawing.
+    window_->setColourBy("street_access");
+    drawn.clear();
+    completed.clear();
+    window_->setParameter("omega", 0.5);
+    QVERIFY(settle());
+    QVERIFY(drawn.count() >= 1);
+    QCOMPARE(completed.count(), 0);
+    QVERIFY(window_->result()->generated.contextPending.empty());
+    QVERIFY2(window_->histogramTitle().contains("street_access"), qPrintable(window_->histogramTitle()));
+    window_->setColourBy("aspect_ratio");
+  }
 };
 
 int main(int argc, char** argv) {

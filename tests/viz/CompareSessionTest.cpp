@@ -32,12 +32,14 @@ CompareRequest sampleRequest(const std::string& style = "obb") {
   return r;
 }
 
-// Same parcels (areas and centroids, in order), same metrics and distances.
-void expectSameResult(const CompareResult& a, const CompareResult& b) {
+// Same parcels (areas and centroids, in order), same metrics and distances;
+// without `context`, neighbours and street access are not compared.
+void expectSameResult(const CompareResult& a, const CompareResult& b, bool context = true) {
   ASSERT_EQ(a.generated.parcels.size(), b.generated.parcels.size());
   for (std::size_t i = 0; i < a.generated.parcels.size(); ++i) {
     EXPECT_NEAR(area(a.generated.parcels[i]), area(b.generated.parcels[i]), 1e-9) << "parcel " << i;
     EXPECT_NEAR(centroid(a.generated.parcels[i]).x, centroid(b.generated.parcels[i]).x, 1e-9) << "parcel " << i;
+    if (!context) continue;
     EXPECT_EQ(a.generated.metrics[i].neighbours, b.generated.metrics[i].neighbours) << "parcel " << i;
     EXPECT_EQ(a.generated.metrics[i].streetAccess, b.generated.metrics[i].streetAccess) << "parcel " << i;
   }
@@ -235,6 +237,121 @@ TEST(CompareSession, CancelledUpdateLeavesTheLastResult) {
   }
   EXPECT_EQ(session.current(), first.result);
   expectSameResult(*session.update(request).result, compare(request));
+}
+
+// Every metric of every generated parcel and every street access share the same.
+void expectSameMeasurements(const CompareResult& a, const CompareResult& b) {
+  ASSERT_EQ(a.generated.metrics.size(), b.generated.metrics.size());
+  for (std::size_t i = 0; i < a.generated.metrics.size(); ++i) {
+    const analysis::ParcelMetrics &x = a.generated.metrics[i], &y = b.generated.metrics[i];
+    EXPECT_EQ(x.area, y.area) << "parcel " << i;
+    EXPECT_EQ(x.width, y.width) << "parcel " << i;
+    EXPECT_EQ(x.pAngle, y.pAngle) << "parcel " << i;
+    EXPECT_EQ(x.neighbours, y.neighbours) << "parcel " << i;
+    EXPECT_EQ(x.frontage, y.frontage) << "parcel " << i;
+    EXPECT_EQ(x.streetAccess, y.streetAccess) << "parcel " << i;
+  }
+  EXPECT_EQ(a.city.generated.streetAccessShare, b.city.generated.streetAccessShare);
+  ASSERT_EQ(a.blocks.size(), b.blocks.size());
+  for (std::size_t k = 0; k < a.blocks.size(); ++k) {
+    const double sa = a.blocks[k].comparison.generated.streetAccessShare;
+    const double sb = b.blocks[k].comparison.generated.streetAccessShare;
+    EXPECT_TRUE((std::isnan(sa) && std::isnan(sb)) || sa == sb) << "block " << k << ": " << sa << " against " << sb;
+  }
+}
+
+// A deferred update measures shapes only: the same parcels, shape metrics,
+// histograms and distances as compare(), street access not known (NaN, not 0);
+// completeContext then gives compare()'s result exactly.
+TEST(CompareSession, DeferredContextIsMeasuredLaterWithTheSameResult) {
+  CompareRequest request = sampleRequest();
+  CompareSession session;
+  const auto shapes = session.update(request, {}, {}, 0.5, /*deferContext=*/true);
+  const CompareResult expected = compare(request);
+  const CompareResult& r = *shapes.result;
+  EXPECT_EQ(r.generated.contextPending.size(), 10u);
+  expectSameResult(r, expected, /*context=*/false);
+  ASSERT_EQ(r.generated.metrics.size(), expected.generated.metrics.size());
+  int expectedNeighbours = 0;
+  for (std::size_t i = 0; i < r.generated.metrics.size(); ++i) {
+    EXPECT_EQ(r.generated.metrics[i].aspectRatio, expected.generated.metrics[i].aspectRatio) << "parcel " << i;
+    EXPECT_EQ(r.generated.metrics[i].neighbours, 0) << "parcel " << i;
+    EXPECT_EQ(r.generated.metrics[i].frontage, 0.0) << "parcel " << i;
+    expectedNeighbours += expected.generated.metrics[i].neighbours;
+  }
+  EXPECT_GT(expectedNeighbours, 0);
+  EXPECT_TRUE(std::isnan(r.city.generated.streetAccessShare));
+  EXPECT_FALSE(std::isnan(expected.city.generated.streetAccessShare));
+  for (const auto& b : r.blocks) EXPECT_TRUE(std::isnan(b.comparison.generated.streetAccessShare));
+  ASSERT_EQ(r.histograms.size(), expected.histograms.size());
+  for (std::size_t h = 0; h < r.histograms.size(); ++h) {
+    EXPECT_EQ(r.histograms[h].edges, expected.histograms[h].edges);
+    EXPECT_EQ(r.histograms[h].b, expected.histograms[h].b);
+  }
+
+  const auto complete = session.completeContext();
+  EXPECT_TRUE(complete.result->generated.contextPending.empty());
+  EXPECT_EQ(session.current(), complete.result);
+  expectSameResult(*complete.result, expected);
+  expectSameMeasurements(*complete.result, expected);
+  EXPECT_EQ(session.completeContext().result, complete.result) << "nothing left to measure";
+
+  // A deferred global change, then an update that does not defer: it measures
+  // what the first left, in the blocks it does not regenerate too.
+  request.parameters["omega"] = 0.7;
+  request.explicitParameters.insert("omega");
+  EXPECT_EQ(session.update(request, {}, {}, 0.5, true).result->generated.contextPending.size(), 10u);
+  request.overrides[2].parameters = {{"w-max", 14.0}};
+  const auto one = session.update(request);
+  EXPECT_EQ(one.blocksRegenerated, 1u);
+  EXPECT_TRUE(one.result->generated.contextPending.empty());
+  const CompareResult fresh = compare(request);
+  expectSameResult(*one.result, fresh);
+  expectSameMeasurements(*one.result, fresh);
+}
+
+// Colouring by neighbours or street access needs them at once: nothing is deferred.
+TEST(CompareSession, ContextQuantitiesAreNotDeferred) {
+  for (const char* metric : {"street_access", "neighbours"}) {
+    CompareRequest request = sampleRequest();
+    request.metric = metric;
+    CompareSession session;
+    const auto u = session.update(request, {}, {}, 0.5, true);
+    EXPECT_TRUE(u.result->generated.contextPending.empty()) << metric;
+    expectSameMeasurements(*u.result, compare(request));
+  }
+}
+
+// Stopped completions keep the blocks they measured and leave the result as
+// it was; later updates and completions still give compare()'s result.
+TEST(CompareSession, CancelledContextCompletionLeavesTheResultAndLosesNothing) {
+  TempDir dir;
+  CompareRequest request = sampleRequest();
+  request.input = {};
+  request.input.path = gridOfBlocks(dir);
+  CompareSession session;
+  const auto shapes = session.update(request, {}, {}, 0.5, true);
+  ASSERT_EQ(shapes.result->generated.contextPending.size(), 48u);
+  const ProgressFn stop = [](double, const std::string&) { return false; };
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    try {
+      session.completeContext(stop);
+      FAIL() << "expected Error(Cancelled)";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), Error::Kind::Cancelled);
+    }
+    EXPECT_EQ(session.current(), shapes.result);
+  }
+  // A deferred one-block edit after the stopped completions, then the completion.
+  request.overrides[5].parameters = {{"w-max", 15.0}};
+  const auto edit = session.update(request, {}, {}, 0.5, true);
+  EXPECT_EQ(edit.blocksRegenerated, 1u);
+  EXPECT_FALSE(edit.result->generated.contextPending.empty());
+  const auto complete = session.completeContext();
+  EXPECT_TRUE(complete.result->generated.contextPending.empty());
+  const CompareResult expected = compare(request);
+  expectSameResult(*complete.result, expected);
+  expectSameMeasurements(*complete.result, expected);
 }
 
 TEST(CompareSession, OverrideOfAMissingBlockIsAUsageError) {
