@@ -173,13 +173,19 @@ std::string gridOfBlocks(const TempDir& dir) {
                                         features + "]}");
 }
 
+// The sample's request on gridOfBlocks.
+CompareRequest gridRequest(const TempDir& dir) {
+  CompareRequest request = sampleRequest();
+  request.input = {};
+  request.input.path = gridOfBlocks(dir);
+  return request;
+}
+
 // While many blocks are regenerated, results in between mix new and old
 // blocks, each block still tiled; the final result equals compare().
 TEST(CompareSession, ResultsInBetweenTileEveryBlock) {
   TempDir dir;
-  CompareRequest request = sampleRequest();
-  request.input = {};
-  request.input.path = gridOfBlocks(dir);
+  CompareRequest request = gridRequest(dir);
   request.parameters["a-max"] = 300;
   request.parameters["w-max"] = 12;
   request.explicitParameters = {"a-max", "w-max"};
@@ -209,9 +215,7 @@ TEST(CompareSession, ResultsInBetweenTileEveryBlock) {
 // must not reuse those blocks' old comparisons.
 TEST(CompareSession, BlocksFinishedBeforeACancelAreComparedAgain) {
   TempDir dir;
-  CompareRequest request = sampleRequest();
-  request.input = {};
-  request.input.path = gridOfBlocks(dir);
+  CompareRequest request = gridRequest(dir);
   CompareSession session;
   session.update(request);
   request.style = "skeleton";
@@ -326,9 +330,7 @@ TEST(CompareSession, ContextQuantitiesAreNotDeferred) {
 // it was; later updates and completions still give compare()'s result.
 TEST(CompareSession, CancelledContextCompletionLeavesTheResultAndLosesNothing) {
   TempDir dir;
-  CompareRequest request = sampleRequest();
-  request.input = {};
-  request.input.path = gridOfBlocks(dir);
+  CompareRequest request = gridRequest(dir);
   CompareSession session;
   const auto shapes = session.update(request, {}, {}, 0.5, true);
   ASSERT_EQ(shapes.result->generated.contextPending.size(), 48u);
