@@ -99,8 +99,15 @@ bool SessionWorker::completeContext(qint64 serial) {
     runAtLowestPriority([&] { session_.completeContext(stillWanted); });
     return true;
   } catch (const Error& e) {
-    if (e.kind() == Error::Kind::Cancelled) return false;  // the newer request will measure it
-    throw;
+    if (e.kind() != Error::Kind::Cancelled) throw;
+    // A newer request measures it; without one (cancel()), the window hears of it.
+    bool newer;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      newer = pending_.has_value();
+    }
+    if (!newer) emit cancelled(serial);
+    return false;
   }
 }
 
