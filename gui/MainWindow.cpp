@@ -624,7 +624,8 @@ void MainWindow::submit() {
   // delay drawing a quick result.
   QTimer::singleShot(250, this, [this, serial = pendingSerial_] {
     // A result in between already says how far the update is.
-    if (serial == pendingSerial_ && serial != shownSerial_ && !failedOrCancelled_ && firstViewMs_ < 0) {
+    if (serial == pendingSerial_ && serial != shownSerial_ && serial != drawnSerial_ && !failedOrCancelled_ &&
+        firstViewMs_ < 0) {
       status_->setText("updating...");
     }
   });
@@ -653,14 +654,12 @@ void MainWindow::drawReport(const UpdateReport& report) {
     shownSerial_ = report.serial;
     fillNumbers();
     showBlock();
-    if (const auto it = completeStarted_.find(report.serial); it != completeStarted_.end()) {
-      lastCompleteMs_ = static_cast<double>(it->second.nsecsElapsed()) / 1e6;
-      completeStarted_.erase(completeStarted_.begin(), std::next(it));
-    }
-    emit contextCompleted(report.serial);
+    noteContextCompleted(report.serial);
     return;
   }
-  const bool first = !result_ || report.reloaded;
+  // (A completion drawn in full, as the colouring changed to what it brings,
+  // is not a new input when its first report was drawn.)
+  const bool first = !result_ || (report.reloaded && report.serial != drawnSerial_);
   Laps lap;
   UpdateTimings timings;
   if (const auto it = started_.find(report.serial); it != started_.end()) {
@@ -761,6 +760,7 @@ void MainWindow::drawReport(const UpdateReport& report) {
     started_.erase(started_.begin(), std::next(it));
   }
   drawnSerial_ = report.serial;
+  if (report.completesContext) noteContextCompleted(report.serial);
   firstViewMs_ = -1;
   status_->setText(QString("%1 blocks, %2 observed and %3 procedural parcels; %4 of %5 block parts regenerated; %6 ms")
                        .arg(a.blocks.size())
@@ -774,6 +774,14 @@ void MainWindow::drawReport(const UpdateReport& report) {
                                                "were refused; first: " + r.generated.failures.front()));
   }
   emit viewsUpdated(report.serial);
+}
+
+void MainWindow::noteContextCompleted(qint64 serial) {
+  if (const auto it = completeStarted_.find(serial); it != completeStarted_.end()) {
+    lastCompleteMs_ = static_cast<double>(it->second.nsecsElapsed()) / 1e6;
+    completeStarted_.erase(completeStarted_.begin(), std::next(it));
+  }
+  emit contextCompleted(serial);
 }
 
 viz::CompareRequest MainWindow::shown() const {

@@ -132,6 +132,8 @@ private:
   void submit();
   void showReport(const UpdateReport& report);
   void drawReport(const UpdateReport& report);
+  /// The numbers of request `serial` are complete: timing and contextCompleted.
+  void noteContextCompleted(qint64 serial);
   /// The request of the result shown, with the colouring chosen now.
   viz::CompareRequest shown() const;
   void showError(const QString& message);

@@ -35,7 +35,7 @@ void SessionWorker::process() {
     qint64 serial;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      if (!pending_) return;
+      if (!pending_) break;
       request = std::move(*pending_);
       pending_.reset();
       serial = latest_.load();
@@ -74,11 +74,9 @@ void SessionWorker::process() {
       report.seconds = u.seconds;
       report.contextPending = !u.result->generated.contextPending.empty();
       emit updated(report);
-      if (report.contextPending && completeContext(serial)) {
-        report.result = session_.current();
-        report.contextPending = false;
-        report.completesContext = true;
-        emit updated(report);
+      if (report.contextPending) {
+        awaiting_ = std::move(report);
+        finishAwaited();
       }
     } catch (const Error& e) {
       if (e.kind() == Error::Kind::Cancelled) {
@@ -90,25 +88,45 @@ void SessionWorker::process() {
       emit failed(QString("internal error: ") + e.what(), serial);
     }
   }
+  // Nothing queued. A result whose completion a newer request stopped, and
+  // that request then failed or was cancelled, is still on screen: complete it.
+  finishAwaited();
 }
 
-bool SessionWorker::completeContext(qint64 serial) {
-  // Only asks whether a newer request is waiting: no progress bar for this step.
-  const ProgressFn stillWanted = [&](double, const std::string&) { return latest_.load() == serial; };
+void SessionWorker::finishAwaited() {
+  if (!awaiting_) return;
+  UpdateReport report = std::move(*awaiting_);
+  awaiting_.reset();
+  if (session_.current() != report.result) return;  // replaced by a newer result, which reports itself
+  // Stopped by any newer request (or cancel()); no progress bar for this step.
+  const qint64 at = latest_.load();
+  const ProgressFn stillWanted = [&](double, const std::string&) { return latest_.load() == at; };
   try {
     runAtLowestPriority([&] { session_.completeContext(stillWanted); });
-    return true;
   } catch (const Error& e) {
-    if (e.kind() != Error::Kind::Cancelled) throw;
-    // A newer request measures it; without one (cancel()), the window hears of it.
+    if (e.kind() != Error::Kind::Cancelled) {
+      emit failed(QString::fromStdString(e.what()), report.serial);
+      return;
+    }
     bool newer;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       newer = pending_.has_value();
     }
+    const qint64 serial = report.serial;
+    awaiting_ = std::move(report);  // should the newer request fail, this one is completed after it
     if (!newer) emit cancelled(serial);
-    return false;
+    return;
+  } catch (const std::exception& e) {
+    emit failed(QString("internal error: ") + e.what(), report.serial);
+    return;
   }
+  // Still pending when the session's last update was cancelled: the next update measures it.
+  if (!session_.current()->generated.contextPending.empty()) return;
+  report.result = session_.current();
+  report.contextPending = false;
+  report.completesContext = true;
+  emit updated(report);
 }
 
 }  // namespace parcelscope::gui

@@ -59,14 +59,17 @@ private slots:
   void process();
 
 private:
-  /// Measures what the last update deferred, at the lowest priority; false
-  /// when a newer request stopped it.
-  bool completeContext(qint64 serial);
+  /// Measures what the update of `awaiting_` deferred, at the lowest priority,
+  /// and reports the completed result. A newer request stops it (awaiting_ is
+  /// then kept, in case that request fails).
+  void finishAwaited();
 
   std::mutex mutex_;
   std::optional<viz::CompareRequest> pending_;
   std::atomic<qint64> latest_{0};
   viz::CompareSession session_;
+  /// The last report drawn with its context pending (worker thread only).
+  std::optional<UpdateReport> awaiting_;
 };
 
 }  // namespace parcelscope::gui

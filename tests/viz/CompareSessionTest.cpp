@@ -344,10 +344,18 @@ TEST(CompareSession, CancelledContextCompletionLeavesTheResultAndLosesNothing) {
     }
     EXPECT_EQ(session.current(), shapes.result);
   }
+  // After a cancelled update the session's blocks are not those of current():
+  // nothing is completed, and the next update measures what it needs.
+  CompareRequest other = request;
+  other.style = "skeleton";
+  EXPECT_THROW(session.update(other, [](double f, const std::string&) { return f < 0.3; }, {}, 0.5, true), Error);
+  EXPECT_EQ(session.completeContext().result, shapes.result);
+  EXPECT_FALSE(session.current()->generated.contextPending.empty());
   // A deferred one-block edit after the stopped completions, then the completion.
   request.overrides[5].parameters = {{"w-max", 15.0}};
   const auto edit = session.update(request, {}, {}, 0.5, true);
-  EXPECT_EQ(edit.blocksRegenerated, 1u);
+  // (with the blocks the cancelled update had made skeleton blocks)
+  EXPECT_GE(edit.blocksRegenerated, 1u);
   EXPECT_FALSE(edit.result->generated.contextPending.empty());
   const auto complete = session.completeContext();
   EXPECT_TRUE(complete.result->generated.contextPending.empty());

@@ -48,6 +48,9 @@ struct CompareSession::State {
   // Blocks whose parcels a cancelled update replaced: current->blocks still
   // compares their old parcels, so their comparison is not reused.
   std::set<std::int64_t> staleComparisons;
+  // False after a cancelled update: outcomes and plans then hold blocks of a
+  // request current was not made from, until the next update commits.
+  bool outcomesMatchCurrent = true;
 };
 
 CompareSession::CompareSession() : state_(std::make_unique<State>()) {}
@@ -197,6 +200,7 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
       for (std::size_t t = 0; t < todo.size(); ++t) {
         if (made[t]) s.staleComparisons.insert(inputs.entries[todo[t]].blockId);
       }
+      s.outcomesMatchCurrent = false;
       s.outcomes = std::move(outcomes);
       s.plans = std::move(done);
     }
@@ -209,6 +213,9 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
     for (std::size_t k2 = 0; k2 < outcomes.size(); ++k2) {
       if (!outcomes[k2]->contextMeasured) completed.push_back(k2);
     }
+    // Measured in place, in outcomes the state shares: should anything below
+    // throw, current's comparisons of these blocks are not to be reused.
+    for (std::size_t k2 : completed) s.staleComparisons.insert(inputs.entries[k2].blockId);
     parallelFor(completed.size(), [&](std::size_t t) {
       generation::measureOutcomeContext(inputs, completed[t], *outcomes[completed[t]], minFrontage);
     });
@@ -254,6 +261,7 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   s.request = request;
   s.current = std::make_shared<const CompareResult>(std::move(r));
   s.staleComparisons.clear();
+  s.outcomesMatchCurrent = true;
   reportProgress(progress, 1.0, "done");
 
   u.result = s.current;
@@ -270,28 +278,18 @@ CompareSession::Update CompareSession::completeContext(const ProgressFn& progres
   Update u;
   u.result = s.current;
   u.blocksTotal = s.outcomes.size();
-  if (!s.current || s.current->generated.contextPending.empty()) return u;
+  if (!s.current || s.current->generated.contextPending.empty() || !s.outcomesMatchCurrent) return u;
   const std::vector<std::size_t> todo = s.current->generated.contextPending;
   const double minFrontage = compareValue(s.request, "min-frontage");
-  std::unique_ptr<std::atomic<bool>[]> measured(new std::atomic<bool>[todo.size()]);
-  for (std::size_t t = 0; t < todo.size(); ++t) measured[t] = false;
-  try {
-    parallelFor(
-        todo.size(),
-        [&](std::size_t t) {
-          generation::measureOutcomeContext(s.inputs, todo[t], *s.outcomes[todo[t]], minFrontage);
-          measured[t].store(true, std::memory_order_release);
-        },
-        [&](std::size_t n) {
-          reportProgress(progress, static_cast<double>(n) / static_cast<double>(todo.size()), "measuring context");
-        });
-  } catch (const Error&) {
-    // The current result still compares these blocks without their context.
-    for (std::size_t t = 0; t < todo.size(); ++t) {
-      if (measured[t].load(std::memory_order_acquire)) s.staleComparisons.insert(s.inputs.entries[todo[t]].blockId);
-    }
-    throw;
-  }
+  // Measured in place, in outcomes the state shares: from here on (a cancel
+  // included) current's comparisons of these blocks are not to be reused.
+  for (std::size_t k : todo) s.staleComparisons.insert(s.inputs.entries[k].blockId);
+  parallelFor(
+      todo.size(),
+      [&](std::size_t t) { generation::measureOutcomeContext(s.inputs, todo[t], *s.outcomes[todo[t]], minFrontage); },
+      [&](std::size_t n) {
+        reportProgress(progress, static_cast<double>(n) / static_cast<double>(todo.size()), "measuring context");
+      });
 
   CompareResult r;
   r.observed = s.observed;
@@ -303,7 +301,6 @@ CompareSession::Update CompareSession::completeContext(const ProgressFn& progres
   r.observedLots = s.current->observedLots;
   r.blocks = s.current->blocks;
   std::vector<char> keep(s.observed->analysis.blocks.size(), 1);
-  for (std::size_t k : todo) keep[static_cast<std::size_t>(s.inputs.entries[k].blockId)] = 0;
   for (std::int64_t id : s.staleComparisons) {
     if (id >= 0 && static_cast<std::size_t>(id) < keep.size()) keep[static_cast<std::size_t>(id)] = 0;
   }

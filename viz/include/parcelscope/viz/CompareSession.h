@@ -61,8 +61,9 @@ public:
 
   /// Measures the neighbours, frontage and street access an update deferred
   /// and returns the completed result (the current one, unchanged, when
-  /// nothing is pending). On Error(Cancelled) the blocks measured so far are
-  /// kept and current() stays as it was.
+  /// nothing is pending, or when the last update was cancelled: the next
+  /// update measures what its result needs). On Error(Cancelled) the blocks
+  /// measured so far are kept and current() stays as it was.
   Update completeContext(const ProgressFn& progress = {});
 
   /// The last result (null before the first update).
