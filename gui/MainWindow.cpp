@@ -643,10 +643,10 @@ void MainWindow::showReport(const UpdateReport& report) {
 void MainWindow::drawReport(const UpdateReport& report) {
   if (report.partial && report.serial != pendingSerial_) return;  // superseded already
   const bool contextPending = !report.result->generated.contextPending.empty();
+  const bool colouredByContext = analysis::parcelQuantity(request_.metric).context;
   // Coloured by a quantity not measured yet: the completed result follows.
-  if (contextPending && analysis::parcelQuantity(request_.metric).context) return;
-  if (report.completesContext && report.serial == drawnSerial_ && result_ &&
-      !analysis::parcelQuantity(request_.metric).context) {
+  if (contextPending && colouredByContext) return;
+  if (report.completesContext && report.serial == drawnSerial_ && result_ && !colouredByContext) {
     // Views and histogram show this result's shapes already: only the numbers change.
     releaseInBackground(std::exchange(result_, report.result));
     releaseInBackground(std::exchange(finalResult_, report.result));

@@ -303,7 +303,7 @@ BlockOutcome runBlock(const BlockInputs& inputs, std::size_t entry, const BlockP
   if (previous && sameParcels(o.subdivision.parcels, previous->subdivision.parcels)) {
     o.metrics = previous->metrics;  // the same parcels in the same block: the same measurements
     o.contextMeasured = previous->contextMeasured;
-    if (!o.contextMeasured && !reuse.shapesOnly) measureOutcomeContext(inputs, entry, o, minFrontage);
+    if (!reuse.shapesOnly) measureOutcomeContext(inputs, entry, o, minFrontage);  // when still deferred
   } else if (reuse.shapesOnly) {
     o.metrics = analysis::measureShapes(o.subdivision.parcels);
     o.contextMeasured = false;

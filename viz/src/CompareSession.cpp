@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <set>
 
 #include "CompareStages.h"
@@ -32,6 +33,38 @@ bool sameBlocks(const CompareRequest& a, const CompareRequest& b) {
     if (d.name != "k" && compareValue(a, d.name) != compareValue(b, d.name)) return false;
   }
   return true;
+}
+
+// Which observed blocks' comparisons a new result may take from the last one:
+// all but the blocks of changed entries and the stale ones.
+std::vector<char> comparisonsToKeep(std::size_t blocks, const generation::BlockInputs& inputs,
+                                    const std::vector<char>& changedEntries, const std::set<std::int64_t>& stale) {
+  std::vector<char> keep(blocks, 1);
+  for (std::size_t e = 0; e < changedEntries.size(); ++e) {
+    if (changedEntries[e]) keep[static_cast<std::size_t>(inputs.entries[e].blockId)] = 0;
+  }
+  for (std::int64_t id : stale) {
+    if (id >= 0 && static_cast<std::size_t>(id) < keep.size()) keep[static_cast<std::size_t>(id)] = 0;
+  }
+  return keep;
+}
+
+// Measures the deferred context of `entries` in place. Their blocks join
+// `stale` first: the outcomes are shared with the state, so should anything
+// throw later (a cancel included), the last result's comparisons of those
+// blocks are not reused.
+void measureDeferred(const generation::BlockInputs& inputs,
+                     const std::vector<std::shared_ptr<generation::BlockOutcome>>& outcomes,
+                     const std::vector<std::size_t>& entries, double minFrontage, const ProgressFn& progress,
+                     std::set<std::int64_t>& stale) {
+  for (std::size_t k : entries) stale.insert(inputs.entries[k].blockId);
+  parallelFor(
+      entries.size(),
+      [&](std::size_t t) { generation::measureOutcomeContext(inputs, entries[t], *outcomes[entries[t]], minFrontage); },
+      progress ? std::function<void(std::size_t)>([&](std::size_t n) {
+        reportProgress(progress, static_cast<double>(n) / static_cast<double>(entries.size()), "measuring context");
+      })
+               : std::function<void(std::size_t)>());
 }
 
 }  // namespace
@@ -115,14 +148,7 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   const bool sameBins = s.current && compareValue(s.request, "bins") == compareValue(request, "bins") &&
                         compareValue(s.request, "histogram-quantile") == compareValue(request, "histogram-quantile");
   auto keepFlags = [&](const std::vector<char>& changedEntries) {
-    std::vector<char> keep(observed->analysis.blocks.size(), 1);
-    for (std::size_t e = 0; e < changedEntries.size(); ++e) {
-      if (changedEntries[e]) keep[static_cast<std::size_t>(inputs.entries[e].blockId)] = 0;
-    }
-    for (std::int64_t id : s.staleComparisons) {
-      if (id >= 0 && static_cast<std::size_t>(id) < keep.size()) keep[static_cast<std::size_t>(id)] = 0;
-    }
-    return keep;
+    return comparisonsToKeep(observed->analysis.blocks.size(), inputs, changedEntries, s.staleComparisons);
   };
   const std::uint64_t seed = runSeedOf(request);
   const bool partials = partial && !newInputs && sameBins &&
@@ -213,12 +239,7 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
     for (std::size_t k2 = 0; k2 < outcomes.size(); ++k2) {
       if (!outcomes[k2]->contextMeasured) completed.push_back(k2);
     }
-    // Measured in place, in outcomes the state shares: should anything below
-    // throw, current's comparisons of these blocks are not to be reused.
-    for (std::size_t k2 : completed) s.staleComparisons.insert(inputs.entries[k2].blockId);
-    parallelFor(completed.size(), [&](std::size_t t) {
-      generation::measureOutcomeContext(inputs, completed[t], *outcomes[completed[t]], minFrontage);
-    });
+    measureDeferred(inputs, outcomes, completed, minFrontage, {}, s.staleComparisons);
   }
 
   // The result: every block's parcels, measured; per-block comparisons kept
@@ -281,15 +302,7 @@ CompareSession::Update CompareSession::completeContext(const ProgressFn& progres
   if (!s.current || s.current->generated.contextPending.empty() || !s.outcomesMatchCurrent) return u;
   const std::vector<std::size_t> todo = s.current->generated.contextPending;
   const double minFrontage = compareValue(s.request, "min-frontage");
-  // Measured in place, in outcomes the state shares: from here on (a cancel
-  // included) current's comparisons of these blocks are not to be reused.
-  for (std::size_t k : todo) s.staleComparisons.insert(s.inputs.entries[k].blockId);
-  parallelFor(
-      todo.size(),
-      [&](std::size_t t) { generation::measureOutcomeContext(s.inputs, todo[t], *s.outcomes[todo[t]], minFrontage); },
-      [&](std::size_t n) {
-        reportProgress(progress, static_cast<double>(n) / static_cast<double>(todo.size()), "measuring context");
-      });
+  measureDeferred(s.inputs, s.outcomes, todo, minFrontage, progress, s.staleComparisons);
 
   CompareResult r;
   r.observed = s.observed;
@@ -300,10 +313,8 @@ CompareSession::Update CompareSession::completeContext(const ProgressFn& progres
   r.observedSides = s.current->observedSides;
   r.observedLots = s.current->observedLots;
   r.blocks = s.current->blocks;
-  std::vector<char> keep(s.observed->analysis.blocks.size(), 1);
-  for (std::int64_t id : s.staleComparisons) {
-    if (id >= 0 && static_cast<std::size_t>(id) < keep.size()) keep[static_cast<std::size_t>(id)] = 0;
-  }
+  const std::vector<char> keep =
+      comparisonsToKeep(s.observed->analysis.blocks.size(), s.inputs, {}, s.staleComparisons);
   detail::compareStage(r, s.request, &keep);
   r.seconds = s.current->seconds;
   for (auto& [stage, seconds] : r.seconds) {
