@@ -5,12 +5,13 @@
 
 #include "Args.h"
 #include "TermProgress.h"
-#include "parcelscope/analysis/StatsJob.h"
+#include "parcelscope/pipeline/StatsJob.h"
 #include "parcelscope/core/Error.h"
-#include "parcelscope/generation/GenerateJob.h"
+#include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/analysis/Comparison.h"
-#include "parcelscope/viz/CompareJob.h"
-#include "parcelscope/viz/CompareSession.h"
+#include "parcelscope/pipeline/CompareJob.h"
+#include "parcelscope/pipeline/CompareSession.h"
+#include "parcelscope/viz/CompareFigures.h"
 
 namespace parcelscope::cli {
 
@@ -59,7 +60,7 @@ std::set<std::string> givenParameters(const Args& a, const std::vector<Parameter
 }
 
 // Prints a finished job's summary (unless --quiet) and returns the exit code.
-int reportOutcome(const analysis::JobOutcome& outcome, const Args& a) {
+int reportOutcome(const pipeline::JobOutcome& outcome, const Args& a) {
   if (!a.has("quiet")) std::fprintf(stderr, "%s\nwritten to %s\n", outcome.summary.c_str(), a.value("out")->c_str());
   return 0;
 }
@@ -84,7 +85,7 @@ int dispatch(const std::vector<std::string>& args) {
   }
   const std::vector<std::string> rest(args.begin() + 1, args.end());
   if (args[0] == "version" || args[0] == "--version") {
-    std::printf("parcelscope %s\n", analysis::version().c_str());
+    std::printf("parcelscope %s\n", pipeline::version().c_str());
     return 0;
   }
   if (args[0] == "stats") return statsCommand(rest);
@@ -105,7 +106,7 @@ int statsCommand(const std::vector<std::string>& args) {
   }
   const Args a(args, flags, params);
   return reportOutcome(
-      analysis::runStats(readOptions(a), a.parameters(), *a.value("out"), terminalProgress(a.has("quiet"))), a);
+      pipeline::runStats(readOptions(a), a.parameters(), *a.value("out"), terminalProgress(a.has("quiet"))), a);
 }
 
 int generateCommand(const std::vector<std::string>& args) {
@@ -127,13 +128,13 @@ int generateCommand(const std::vector<std::string>& args) {
     return 0;
   }
   const Args a(args, flags, params);
-  generation::GenerateRequest request;
+  pipeline::GenerateRequest request;
   request.input = readOptions(a);
   request.fromParcels = a.has("from-parcels");
   request.style = a.value("style").value_or("obb");
   request.parameters = a.parameters();
   request.explicitParameters = givenParameters(a, params);
-  return reportOutcome(generation::runGenerate(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
+  return reportOutcome(pipeline::runGenerate(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
 }
 
 int compareCommand(const std::vector<std::string>& args) {
@@ -151,7 +152,7 @@ int compareCommand(const std::vector<std::string>& args) {
                               "      INPUT and options given here win"});
   flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
   flags.push_back({"quiet", "no progress or summary on stderr", false});
-  const auto params = viz::compareParameters();
+  const auto params = pipeline::compareParameters();
   if (wantsHelp(args)) {
     std::fputs(usageText("parcelscope compare INPUT|--session FILE [--style obb|skeleton|offset|auto] [--k 2] [--seed N] [options] --out DIR", flags,
                          params)
@@ -167,10 +168,10 @@ int compareCommand(const std::vector<std::string>& args) {
     return 0;
   }
   const Args a(args, flags, params);
-  viz::CompareRequest request;
+  pipeline::CompareRequest request;
   if (const auto session = a.value("session")) {
     // The session's request, with what the command line gives on top.
-    request = viz::readSession(*session);
+    request = pipeline::readSession(*session);
     if (!a.value("out")) throw usageError("--out DIR is required");
     if (a.positional().size() > 1) throw usageError("expected at most one INPUT file");
     if (a.positional().size() == 1) request.input.path = a.positional()[0];

@@ -51,8 +51,9 @@
 #include "parcelscope/analysis/Comparison.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
-#include "parcelscope/generation/GenerateJob.h"
+#include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/io/ParcelReader.h"
+#include "parcelscope/viz/CompareFigures.h"
 #include "parcelscope/viz/Scenes.h"
 
 namespace parcelscope::gui {
@@ -93,7 +94,7 @@ const char* kBounds[] = {"a-min", "a-max", "w-min", "w-max"};
 const char* kBlockParameters[] = {"a-min", "a-max", "w-min", "w-max", "omega", "offset", "seed"};
 
 std::vector<ParameterDescription> panelParameters() {
-  const auto all = viz::compareParameters();
+  const auto all = pipeline::compareParameters();
   std::vector<ParameterDescription> out;
   for (const char* name : kFirst) {
     for (const auto& d : all) {
@@ -113,7 +114,7 @@ std::vector<ParameterDescription> panelParameters() {
 }
 
 const ParameterDescription& describe(const std::string& name) {
-  static const auto all = viz::compareParameters();
+  static const auto all = pipeline::compareParameters();
   for (const auto& d : all) {
     if (d.name == name) return d;
   }
@@ -139,7 +140,7 @@ QString sampleDirectory() { return QStringLiteral(PARCELSCOPE_SAMPLE_DIR); }
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new SessionWorker) {
   setWindowTitle("ParcelScope");
   setAcceptDrops(true);
-  request_.parameters = defaultValues(viz::compareParameters());
+  request_.parameters = defaultValues(pipeline::compareParameters());
   request_.parameters["figures"] = 0;
   request_.explicitParameters = {"seed"};
 
@@ -186,7 +187,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
   maps->addWidget(proceduralView_);
   for (MapView* v : {observedView_, proceduralView_}) {
     connect(v, &MapView::clicked, this, [this](double x, double y) {
-      if (result_) selectBlock(viz::blockAt(*result_, {x, y}));
+      if (result_) selectBlock(pipeline::blockAt(*result_, {x, y}));
     });
   }
 
@@ -422,7 +423,7 @@ void MainWindow::askForCrs() {
 }
 
 void MainWindow::openFile(const QString& path, const QString& layer, const QString& where, const QString& crs) {
-  viz::CompareRequest next = request_;
+  pipeline::CompareRequest next = request_;
   next.input = {};
   next.input.path = path.toStdString();
   next.input.where = where.toStdString();
@@ -460,7 +461,7 @@ void MainWindow::openSample() {
 
 void MainWindow::openSession(const QString& path) {
   try {
-    viz::CompareRequest next = viz::readSession(path.toStdString());
+    pipeline::CompareRequest next = pipeline::readSession(path.toStdString());
     next.parameters["figures"] = 0;
     request_ = next;
   } catch (const std::exception& e) {
@@ -484,7 +485,7 @@ void MainWindow::openSession(const QString& path) {
 
 void MainWindow::saveSession(const QString& path) {
   try {
-    viz::exportSession(request_, path.toStdString());
+    pipeline::exportSession(request_, path.toStdString());
     status_->setText("session saved to " + path);
   } catch (const std::exception& e) {
     showError(e.what());
@@ -504,12 +505,12 @@ void MainWindow::exportFigure(const QString& name, const QString& path, int widt
 
 void MainWindow::exportTables(const QString& folder) {
   exportWith("tables exported to " + folder,
-             [&] { viz::exportTables(*finalResult_, folder.toStdString(), {finalRequest_.input.path}); });
+             [&] { pipeline::exportTables(*finalResult_, folder.toStdString(), {finalRequest_.input.path}); });
 }
 
 void MainWindow::exportParcels(const QString& path) {
   exportWith("generated parcels exported to " + path,
-             [&] { viz::exportParcels(*finalResult_, path.toStdString(), {finalRequest_.input.path}); });
+             [&] { pipeline::exportParcels(*finalResult_, path.toStdString(), {finalRequest_.input.path}); });
 }
 
 void MainWindow::exportWith(const QString& done, const std::function<void()>& write) {
@@ -599,7 +600,7 @@ void MainWindow::selectBlock(int block) {
 
 void MainWindow::overrideSelectedBlock(const QString& style, const ParameterValues& parameters) {
   if (!result_ || selected_ < 0) return showError("select a block first (click it in either view)");
-  generation::BlockOverride o;
+  pipeline::BlockOverride o;
   o.style = style.toStdString();
   o.parameters = parameters;
   request_.overrides[result_->observed->analysis.blocks[selected_].id] = o;
@@ -682,7 +683,7 @@ void MainWindow::drawReport(const UpdateReport& report) {
     progress_->setVisible(false);
     cancel_->setVisible(false);
   }
-  const viz::CompareResult& r = *result_;
+  const pipeline::CompareResult& r = *result_;
   if (first) selected_ = -1;
 
   // Geometry: the observed parcels only when the input was read again.
@@ -784,15 +785,15 @@ void MainWindow::noteContextCompleted(qint64 serial) {
   emit contextCompleted(serial);
 }
 
-viz::CompareRequest MainWindow::shown() const {
-  viz::CompareRequest r = shownRequest_;
+pipeline::CompareRequest MainWindow::shown() const {
+  pipeline::CompareRequest r = shownRequest_;
   r.metric = request_.metric;
   return r;
 }
 
 bool MainWindow::recolour(bool observedChanged) {
   if (!result_) return false;
-  const viz::CompareResult& r = *result_;
+  const pipeline::CompareResult& r = *result_;
   const analysis::ParcelQuantity& q = analysis::parcelQuantity(request_.metric);
   // The observed view changes only with its data, the quantity or the scale.
   observedChanged = observedChanged || q.name != shownQuantity_;
@@ -933,7 +934,7 @@ void MainWindow::showBlock() {
     setBlockInfo("Click a block in either view.");
     return;
   }
-  const viz::CompareResult& r = *result_;
+  const pipeline::CompareResult& r = *result_;
   const Block& block = r.observed->analysis.blocks[selected_];
   for (const Polygon& part : block.parts) outline.push_back(&part);
   observedView_->outline().setShapes(outline);

@@ -1,7 +1,7 @@
 #pragma once
 // The ParcelScope window: observed and procedural parcels side by side with
 // linked cameras, overlaid histograms and the comparison numbers, a parameter
-// panel and a block panel. Every change builds a viz::CompareRequest and hands
+// panel and a block panel. Every change builds a pipeline::CompareRequest and hands
 // it to a SessionWorker, which calls the same library code as `parcelscope
 // compare`; this class only gathers input and shows results.
 #include <QElapsedTimer>
@@ -19,7 +19,8 @@
 #include <vtkSmartPointer.h>
 
 #include "SessionWorker.h"
-#include "parcelscope/viz/CompareSession.h"
+#include "parcelscope/pipeline/CompareSession.h"
+#include "parcelscope/viz/Figures.h"
 
 class QCheckBox;
 class QComboBox;
@@ -76,8 +77,8 @@ public:
   /// (which QWidget::grab leaves out, as each view is a native window).
   QImage screenshot();
 
-  const viz::CompareRequest& request() const { return request_; }
-  std::shared_ptr<const viz::CompareResult> result() const { return result_; }
+  const pipeline::CompareRequest& request() const { return request_; }
+  std::shared_ptr<const pipeline::CompareResult> result() const { return result_; }
   ParameterPanel* parameterPanel() const { return panel_; }
   MapView* observedView() const { return observedView_; }
   MapView* proceduralView() const { return proceduralView_; }
@@ -116,7 +117,7 @@ signals:
   /// Views, histograms and numbers show the result of request serial `serial`.
   void viewsUpdated(qint64 serial);
   void errorShown(const QString& message);
-  /// A result in between is shown (see viz::CompareSession::PartialFn).
+  /// A result in between is shown (see pipeline::CompareSession::PartialFn).
   void partialShown(qint64 serial);
   /// The numbers of request serial `serial` are complete (its neighbours and
   /// street access were measured after its views were drawn).
@@ -135,7 +136,7 @@ private:
   /// The numbers of request `serial` are complete: timing and contextCompleted.
   void noteContextCompleted(qint64 serial);
   /// The request of the result shown, with the colouring chosen now.
-  viz::CompareRequest shown() const;
+  pipeline::CompareRequest shown() const;
   void showError(const QString& message);
   void setBlockInfo(const QString& html);
   /// Recolours the views; returns whether the observed view changed (it is
@@ -153,11 +154,11 @@ private:
 
   QThread thread_;
   SessionWorker* worker_;
-  viz::CompareRequest request_;
-  std::shared_ptr<const viz::CompareResult> result_;  ///< shown (possibly a result in between)
-  viz::CompareRequest shownRequest_;                    ///< the request of result_
-  std::shared_ptr<const viz::CompareResult> finalResult_;  ///< the last complete result (exports)
-  viz::CompareRequest finalRequest_;                       ///< its request
+  pipeline::CompareRequest request_;
+  std::shared_ptr<const pipeline::CompareResult> result_;  ///< shown (possibly a result in between)
+  pipeline::CompareRequest shownRequest_;                    ///< the request of result_
+  std::shared_ptr<const pipeline::CompareResult> finalResult_;  ///< the last complete result (exports)
+  pipeline::CompareRequest finalRequest_;                       ///< its request
   bool loaded_ = false;
   qint64 pendingSerial_ = 0, shownSerial_ = 0;
   bool failedOrCancelled_ = false;
@@ -165,7 +166,7 @@ private:
   std::map<qint64, QElapsedTimer> completeStarted_;  ///< views drawn, numbers not complete yet
   qint64 drawnSerial_ = 0;  ///< request whose (final) views were drawn last
   /// The result whose parcels the procedural layer draws (it reads them again on zoom).
-  std::shared_ptr<const viz::CompareResult> layerResult_;
+  std::shared_ptr<const pipeline::CompareResult> layerResult_;
   double lastLatencyMs_ = 0, lastCompleteMs_ = 0;
   UpdateTimings lastTimings_;
   double firstViewMs_ = -1, lastFirstViewMs_ = 0;

@@ -12,7 +12,7 @@ namespace parcelscope::gui {
 SessionWorker::SessionWorker() { qRegisterMetaType<parcelscope::gui::UpdateReport>(); }
 SessionWorker::~SessionWorker() = default;
 
-qint64 SessionWorker::submit(const viz::CompareRequest& request) {
+qint64 SessionWorker::submit(const pipeline::CompareRequest& request) {
   qint64 serial;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -31,7 +31,7 @@ void SessionWorker::cancel() {
 
 void SessionWorker::process() {
   for (;;) {
-    viz::CompareRequest request;
+    pipeline::CompareRequest request;
     qint64 serial;
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -50,7 +50,7 @@ void SessionWorker::process() {
       return latest_.load() == serial;
     };
     try {
-      const auto partial = [&](std::shared_ptr<const viz::CompareResult> result, std::size_t done,
+      const auto partial = [&](std::shared_ptr<const pipeline::CompareResult> result, std::size_t done,
                                std::size_t total) {
         if (latest_.load() != serial) return;  // a newer request is waiting: no point drawing this one
         UpdateReport report;
@@ -62,7 +62,7 @@ void SessionWorker::process() {
         report.partial = true;
         emit updated(report);
       };
-      const viz::CompareSession::Update u =
+      const pipeline::CompareSession::Update u =
           session_.update(request, progress, partial, 0.5, /*deferContext=*/true);
       UpdateReport report;
       report.result = u.result;

@@ -1,5 +1,5 @@
 #pragma once
-// Runs viz::CompareSession::update off the UI thread. The newest request wins:
+// Runs pipeline::CompareSession::update off the UI thread. The newest request wins:
 // submitting one cancels the update under way (through the progress callback),
 // and the session keeps the blocks it had finished. Each update reports twice
 // when it can: first with the parcels measured by shape (what the views and
@@ -13,14 +13,14 @@
 #include <mutex>
 #include <optional>
 
-#include "parcelscope/viz/CompareSession.h"
+#include "parcelscope/pipeline/CompareSession.h"
 
 namespace parcelscope::gui {
 
 /// What one finished update brings to the window.
 struct UpdateReport {
-  std::shared_ptr<const viz::CompareResult> result;
-  viz::CompareRequest request;
+  std::shared_ptr<const pipeline::CompareResult> result;
+  pipeline::CompareRequest request;
   qint64 serial = 0;
   bool reloaded = false;
   int blocksRegenerated = 0;
@@ -30,7 +30,7 @@ struct UpdateReport {
   /// new, the others as before; the final report follows.
   bool partial = false;
   /// The regenerated blocks' neighbours, frontage and street access are still
-  /// being measured (viz::CompareSession::update with deferContext): views
+  /// being measured (pipeline::CompareSession::update with deferContext): views
   /// and histograms of shape quantities are final, and a report with
   /// `completesContext` and the same serial follows unless a newer request
   /// supersedes this one.
@@ -45,7 +45,7 @@ public:
   SessionWorker();
   ~SessionWorker() override;
   /// Queues `request` (thread-safe) and returns its serial number.
-  qint64 submit(const viz::CompareRequest& request);
+  qint64 submit(const pipeline::CompareRequest& request);
   /// Cancels the update under way and drops any queued request.
   void cancel();
 
@@ -65,9 +65,9 @@ private:
   void finishAwaited();
 
   std::mutex mutex_;
-  std::optional<viz::CompareRequest> pending_;
+  std::optional<pipeline::CompareRequest> pending_;
   std::atomic<qint64> latest_{0};
-  viz::CompareSession session_;
+  pipeline::CompareSession session_;
   /// The last report drawn with its context pending (worker thread only).
   std::optional<UpdateReport> awaiting_;
 };

@@ -8,7 +8,7 @@
 #include "Contacts.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
-#include "parcelscope/io/GeometryOps.h"
+#include "parcelscope/core/GeosOps.h"
 
 namespace parcelscope::analysis {
 
@@ -253,7 +253,7 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
         const std::size_t b = bySize[k];
         std::vector<const Polygon*> members;
         for (int i : out.blocks[b].parcels) members.push_back(shapes[i]);
-        out.blocks[b].parts = io::unionAndClose(members, tol);
+        out.blocks[b].parts = geos::unionAndClose(members, tol);
       },
       [&](std::size_t done) {
         reportProgress(progress, 0.5 + 0.4 * static_cast<double>(done) / static_cast<double>(out.blocks.size()),

@@ -9,7 +9,8 @@
 #include "PolygonSplit.h"
 #include "Random.h"
 #include "parcelscope/analysis/Metrics.h"
-#include "parcelscope/io/GeometryOps.h"
+#include "parcelscope/core/GeosOps.h"
+#include "BlockFailure.h"
 
 namespace parcelscope::generation {
 
@@ -258,7 +259,7 @@ private:
                   ((pieceSimple && detail::splitPieceIsSimple(part.outer, boxes[k], through, dir, true)) ||
                    (part.outer.size() <= 16 ? isClearlySimple(part.outer, boxes[k], areas[k])
                                             : detail::isStrictlySimple(part.outer)));
-      if (!simple[k] && !io::isValid(part)) return Verdict::Invalid;
+      if (!simple[k] && !geos::isValid(part)) return Verdict::Invalid;
     }
     return Verdict::Admissible;
   }
@@ -507,6 +508,7 @@ Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, 
       }
     }
   } catch (const std::exception& e) {
+    detail::rethrowUnlessBlockFailure();
     out = Subdivision{};
     out.failed = true;
     out.failure = e.what();

@@ -19,7 +19,8 @@
 #include "PolygonSplit.h"
 #include "Random.h"
 #include "parcelscope/analysis/Metrics.h"
-#include "parcelscope/io/GeometryOps.h"
+#include "parcelscope/core/GeosOps.h"
+#include "BlockFailure.h"
 
 namespace parcelscope::generation {
 
@@ -1039,7 +1040,7 @@ private:
       if (!rounded(patio, shape)) continue;
       // A patio can pinch to a corridor of no width where a ridge runs at the
       // offset depth: once rounded, its lobes are separate patios.
-      for (Polygon& part : io::validParts(shape)) {
+      for (Polygon& part : geos::validParts(shape)) {
         if (!p_.subdividePatios) {
           out.parcels.push_back(std::move(part));
           ++out.patioParcels;
@@ -1090,7 +1091,7 @@ void finish(const Polygon& block, const Point& o, Subdivision& out, double minFr
     // A parcel of no width (all corridor) vanishes; the area check below
     // catches anything of substance lost.
     if (!normalise(parcel)) continue;
-    std::vector<Polygon> parts = io::validParts(parcel);
+    std::vector<Polygon> parts = geos::validParts(parcel);
     double partsArea = 0;
     for (const Polygon& q : parts) partsArea += area(q);
     if (std::fabs(partsArea - area(parcel)) > 1e-9 * area(parcel)) throw Fallback("a parcel is not valid once rounded");
@@ -1114,7 +1115,7 @@ void finish(const Polygon& block, const Point& o, Subdivision& out, double minFr
 void checkTiling(const Polygon& block, const Subdivision& out) {
   double sum = 0;
   for (const Polygon& parcel : out.parcels) {
-    if (!io::isValid(parcel)) throw Fallback("a parcel is not a valid polygon once rounded");
+    if (!geos::isValid(parcel)) throw Fallback("a parcel is not a valid polygon once rounded");
     sum += area(parcel);
   }
   const double a = area(block);
@@ -1203,6 +1204,7 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
     finish(block, o, out, p.bounds.minFrontage);
     checkTiling(block, out);
   } catch (const std::exception& e) {
+    detail::rethrowUnlessBlockFailure();
     reason = e.what();
   }
   if (!reason.empty()) {

@@ -21,11 +21,12 @@
 #include <filesystem>
 #include <map>
 
-#include "parcelscope/analysis/StatsJob.h"
+#include "parcelscope/pipeline/StatsJob.h"
 #include "parcelscope/io/Writers.h"
-#include "parcelscope/generation/GenerateJob.h"
-#include "parcelscope/viz/CompareJob.h"
-#include "parcelscope/viz/CompareSession.h"
+#include "parcelscope/pipeline/GenerateJob.h"
+#include "parcelscope/pipeline/CompareJob.h"
+#include "parcelscope/pipeline/CompareSession.h"
+#include "parcelscope/viz/CompareFigures.h"
 #include "parcelscope/viz/Scenes.h"
 
 namespace {
@@ -66,7 +67,7 @@ void StatsPipeline(benchmark::State& state) {
   in.path = kCambridge;
   std::size_t parcels = 0, blocks = 0;
   for (auto _ : state) {
-    const auto d = parcelscope::analysis::loadObserved(in, params);
+    const auto d = parcelscope::pipeline::loadObserved(in, params);
     parcels = d.layer.parcels.size();
     blocks = d.analysis.blocks.size();
   }
@@ -80,16 +81,16 @@ BENCHMARK(StatsPipeline)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(
 // The blocks of an analysed input and their plans under `style` with default
 // parameters, as generate() makes them (per-block bounds, each block's seed,
 // street widths for the skeleton styles).
-std::pair<parcelscope::generation::BlockInputs, std::vector<parcelscope::generation::BlockPlan>> plannedBlocks(
-    const parcelscope::analysis::ObservedData& observed, const std::string& style) {
-  parcelscope::generation::GenerateRequest request;
+std::pair<parcelscope::pipeline::BlockInputs, std::vector<parcelscope::pipeline::BlockPlan>> plannedBlocks(
+    const parcelscope::pipeline::ObservedData& observed, const std::string& style) {
+  parcelscope::pipeline::GenerateRequest request;
   request.fromParcels = true;
   request.observed = &observed;
   request.style = style;
   request.parameters = parcelscope::defaultValues(parcelscope::generation::generationParameterDescriptions());
-  auto inputs = parcelscope::generation::prepareBlocks(request);
-  if (style != "obb") parcelscope::generation::streetWidthsOf(inputs);
-  auto plans = parcelscope::generation::planBlocks(request, inputs);
+  auto inputs = parcelscope::pipeline::prepareBlocks(request);
+  if (style != "obb") parcelscope::pipeline::streetWidthsOf(inputs);
+  auto plans = parcelscope::pipeline::planBlocks(request, inputs);
   return {std::move(inputs), std::move(plans)};
 }
 
@@ -99,7 +100,7 @@ void ObbSubdivisionPerBlock(benchmark::State& state) {
   if (!haveData(state)) return;
   parcelscope::io::ReadOptions in;
   in.path = kCambridge;
-  const auto d = parcelscope::analysis::loadObserved(
+  const auto d = parcelscope::pipeline::loadObserved(
       in, parcelscope::defaultValues(parcelscope::analysis::analysisParameters()));
   const auto [inputs, plans] = plannedBlocks(d, "obb");
   std::size_t blocks = 0, parcels = 0;
@@ -120,7 +121,7 @@ BENCHMARK(ObbSubdivisionPerBlock)->Unit(benchmark::kMillisecond)->UseRealTime()-
 
 // Runs `compare` into `out` and adds the seconds of each stage (summary.json)
 // to `seconds`; returns the summary.
-CPLJSONObject runTimed(const parcelscope::viz::CompareRequest& request, const std::filesystem::path& out,
+CPLJSONObject runTimed(const parcelscope::pipeline::CompareRequest& request, const std::filesystem::path& out,
                        std::map<std::string, double>& seconds) {
   std::filesystem::remove_all(out);
   parcelscope::viz::runCompare(request, out.string());
@@ -138,10 +139,10 @@ CPLJSONObject runTimed(const parcelscope::viz::CompareRequest& request, const st
 void CompareCambridge(benchmark::State& state) {
   if (!haveData(state)) return;
   const bool figures = std::getenv("DISPLAY") != nullptr;
-  parcelscope::viz::CompareRequest request;
+  parcelscope::pipeline::CompareRequest request;
   request.input.path = kCambridge;
   request.input.where = "ML <> 'ROAD'";
-  request.parameters = parcelscope::defaultValues(parcelscope::viz::compareParameters());
+  request.parameters = parcelscope::defaultValues(parcelscope::pipeline::compareParameters());
   request.parameters["figures"] = figures ? 1 : 0;
   const auto out = std::filesystem::temp_directory_path() / "parcelscope-bench-compare";
   std::map<std::string, double> seconds;
@@ -200,9 +201,9 @@ std::filesystem::path tiledCambridge(std::size_t target) {
 
 void CompareTiled500k(benchmark::State& state) {
   if (!haveData(state)) return;
-  parcelscope::viz::CompareRequest request;
+  parcelscope::pipeline::CompareRequest request;
   request.input.path = tiledCambridge(500000).string();
-  request.parameters = parcelscope::defaultValues(parcelscope::viz::compareParameters());
+  request.parameters = parcelscope::defaultValues(parcelscope::pipeline::compareParameters());
   request.parameters["figures"] = 0;
   const auto out = std::filesystem::temp_directory_path() / "parcelscope-bench-compare-tiled";
   std::map<std::string, double> seconds;
@@ -230,7 +231,7 @@ void SkeletonSubdivisionPerBlock(benchmark::State& state) {
   namespace gen = parcelscope::generation;
   parcelscope::io::ReadOptions in;
   in.path = kCambridge;
-  const auto d = parcelscope::analysis::loadObserved(
+  const auto d = parcelscope::pipeline::loadObserved(
       in, parcelscope::defaultValues(parcelscope::analysis::analysisParameters()));
   const auto [inputs, plans] = plannedBlocks(d, "skeleton");
   std::size_t parcels = 0, fallbacks = 0;
@@ -276,16 +277,16 @@ void SessionUpdate(benchmark::State& state) {
   if (!haveData(state)) return;
   const bool global = state.range(0) == 1;
   const bool wMax = state.range(0) == 2;
-  parcelscope::viz::CompareRequest request;
+  parcelscope::pipeline::CompareRequest request;
   request.input.path = kCambridge;
   request.input.where = "ML <> 'ROAD'";
   request.style = state.range(1) == 1 ? "skeleton" : "obb";
-  request.parameters = parcelscope::defaultValues(parcelscope::viz::compareParameters());
+  request.parameters = parcelscope::defaultValues(parcelscope::pipeline::compareParameters());
   request.parameters["figures"] = 0;
   if (wMax) {  // as the application does once a bound slider moves: all four bounds set
     for (const char* bound : {"a-min", "a-max", "w-min", "w-max"}) request.explicitParameters.insert(bound);
   }
-  parcelscope::viz::CompareSession session;
+  parcelscope::pipeline::CompareSession session;
   session.update(request);
   int i = 0;
   std::size_t regenerated = 0;
@@ -339,15 +340,15 @@ BENCHMARK(SessionUpdate)
 // grouped by block as the application does (MapLayer::setShapes).
 void MapLayerUpdate(benchmark::State& state) {
   if (!haveData(state)) return;
-  parcelscope::viz::CompareRequest request;
+  parcelscope::pipeline::CompareRequest request;
   request.input.path = kCambridge;
   request.input.where = "ML <> 'ROAD'";
   request.style = "obb";
-  request.parameters = parcelscope::defaultValues(parcelscope::viz::compareParameters());
+  request.parameters = parcelscope::defaultValues(parcelscope::pipeline::compareParameters());
   request.parameters["figures"] = 0;
   request.explicitParameters.insert("omega");
-  parcelscope::viz::CompareSession session;
-  std::array<std::shared_ptr<const parcelscope::viz::CompareResult>, 2> results;
+  parcelscope::pipeline::CompareSession session;
+  std::array<std::shared_ptr<const parcelscope::pipeline::CompareResult>, 2> results;
   for (int k = 0; k < 2; ++k) {
     request.parameters["omega"] = k == 0 ? 0.25 : 0.35;
     results[static_cast<std::size_t>(k)] = session.update(request).result;
@@ -358,7 +359,7 @@ void MapLayerUpdate(benchmark::State& state) {
   layer.setMetresPerPixel(static_cast<double>(state.range(0)));
   std::size_t i = 0, shapes = 0;
   for (auto _ : state) {
-    const parcelscope::viz::CompareResult& r = *results[++i % 2];
+    const parcelscope::pipeline::CompareResult& r = *results[++i % 2];
     std::vector<const parcelscope::Polygon*> polygons;
     std::vector<int> blocks(r.generated.parcels.size(), -1);
     for (std::size_t b = 0; b < r.generated.blocks.size(); ++b) {

@@ -9,7 +9,7 @@
 
 #include "parcelscope/analysis/Metrics.h"
 #include "parcelscope/core/Geometry.h"
-#include "parcelscope/io/GeometryOps.h"
+#include "parcelscope/core/GeosOps.h"
 
 namespace parcelscope::test {
 
@@ -28,7 +28,7 @@ inline TilingReport checkTiling(const Polygon& block, const std::vector<Polygon>
   for (const Polygon& p : parcels) {
     sum += area(p);
     boxes.push_back(bounds(p));
-    if (!io::isValid(p)) ++r.invalid;
+    if (!geos::isValid(p)) ++r.invalid;
     if (!pointInPolygon(interiorPoint(p), block)) ++r.outside;
   }
   r.areaError = std::fabs(sum - blockArea) / blockArea;
@@ -36,7 +36,7 @@ inline TilingReport checkTiling(const Polygon& block, const std::vector<Polygon>
     for (std::size_t j = i + 1; j < parcels.size(); ++j) {
       if (!boxes[i].intersects(boxes[j])) continue;
       try {
-        r.maxOverlap = std::max(r.maxOverlap, io::intersectionArea(parcels[i], parcels[j]) / blockArea);
+        r.maxOverlap = std::max(r.maxOverlap, geos::intersectionArea(parcels[i], parcels[j]) / blockArea);
       } catch (const std::exception&) {
         r.maxOverlap = 1.0;  // GEOS could not intersect them: count as overlapping
       }

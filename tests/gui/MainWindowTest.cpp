@@ -28,7 +28,7 @@
 #include "MapView.h"
 #include "ParameterPanel.h"
 #include "parcelscope/io/Writers.h"
-#include "parcelscope/viz/CompareJob.h"
+#include "parcelscope/pipeline/CompareJob.h"
 #include "viz/ImageCheck.h"
 
 using parcelscope::gui::MainWindow;
@@ -60,7 +60,7 @@ private:
   }
 
   int libraryParcelCount() {
-    return static_cast<int>(parcelscope::viz::compare(window_->request()).generated.parcels.size());
+    return static_cast<int>(parcelscope::pipeline::compare(window_->request()).generated.parcels.size());
   }
 
 private slots:
@@ -198,7 +198,7 @@ private slots:
     QVERIFY(QDir(d).entryList(QStringList() << ".*partial*", QDir::Hidden | QDir::Files).isEmpty());
     // The session restores the overrides and parameters: the same parcels.
     const auto shown = window_->result();
-    const auto session = parcelscope::viz::readSession((d + "/session.json").toStdString());
+    const auto session = parcelscope::pipeline::readSession((d + "/session.json").toStdString());
     QCOMPARE(session.overrides.size(), std::size_t(1));
     QCOMPARE(session.parameters.at("w-max"), window_->request().parameters.at("w-max"));
     window_->setParameter("seed", 9);
@@ -264,7 +264,7 @@ private slots:
     QCOMPARE(completed.last().at(0).toLongLong(), drawn.last().at(0).toLongLong());
     QVERIFY(window_->result()->generated.contextPending.empty());
     QVERIFY(window_->lastCompleteMs() >= window_->lastLatencyMs());
-    const auto expected = parcelscope::viz::compare(window_->request());
+    const auto expected = parcelscope::pipeline::compare(window_->request());
     QCOMPARE(window_->result()->city.generated.streetAccessShare, expected.city.generated.streetAccessShare);
     QTableWidget* numbers = window_->numbers();
     int row = 0;

@@ -3,9 +3,9 @@
 #include <chrono>
 #include <vector>
 
-#include "parcelscope/viz/CompareJob.h"
+#include "parcelscope/pipeline/CompareJob.h"
 
-namespace parcelscope::viz::detail {
+namespace parcelscope::pipeline::detail {
 
 inline double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -17,13 +17,13 @@ inline double secondsSince(std::chrono::steady_clock::time_point start) {
 void compareStage(CompareResult& r, const CompareRequest& request, const std::vector<char>* keep = nullptr);
 
 /// The generation request of a compare request over observed data already read.
-generation::GenerateRequest generateRequest(const CompareRequest& request, const analysis::ObservedData* observed);
+pipeline::GenerateRequest generateRequest(const CompareRequest& request, const pipeline::ObservedData* observed);
 
 /// Throws Error(Input) when `observed` has no block to compare.
-void requireBlocks(const CompareRequest& request, const analysis::ObservedData& observed);
+void requireBlocks(const CompareRequest& request, const pipeline::ObservedData& observed);
 
 /// Throws Error(Usage) when a value of `request` is outside its parameter's
 /// range, or its metric is not a parcel quantity.
 void checkRequest(const CompareRequest& request);
 
-}  // namespace parcelscope::viz::detail
+}  // namespace parcelscope::pipeline::detail

@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include "TestUtil.h"
-#include "parcelscope/generation/GenerateJob.h"
+#include "parcelscope/pipeline/GenerateJob.h"
 
-namespace parcelscope::generation {
+namespace parcelscope::pipeline {
 namespace {
+
+using namespace generation;
 
 TEST(GenerateJob, ObservedDataPassedInGivesTheSameParcelsAsReadingTheInput) {
   GenerateRequest request;
@@ -18,7 +20,7 @@ TEST(GenerateJob, ObservedDataPassedInGivesTheSameParcelsAsReadingTheInput) {
     request.parameters.emplace(name, value);
   }
   const GeneratedParcels read = generate(request);
-  const analysis::ObservedData observed = analysis::loadObserved(request.input, request.parameters);
+  const pipeline::ObservedData observed = pipeline::loadObserved(request.input, request.parameters);
   request.observed = &observed;
   const GeneratedParcels given = generate(request);
 
@@ -44,4 +46,4 @@ TEST(GenerateJob, ObservedDataPassedInGivesTheSameParcelsAsReadingTheInput) {
 }
 
 }  // namespace
-}  // namespace parcelscope::generation
+}  // namespace parcelscope::pipeline

@@ -1,4 +1,4 @@
-#include "parcelscope/analysis/StatsJob.h"
+#include "parcelscope/pipeline/StatsJob.h"
 
 #include <sstream>
 
@@ -9,7 +9,9 @@
 #define PARCELSCOPE_VERSION "unknown"
 #endif
 
-namespace parcelscope::analysis {
+namespace parcelscope::pipeline {
+
+using namespace analysis;
 
 std::string version() { return PARCELSCOPE_VERSION; }
 
@@ -117,4 +119,4 @@ JobOutcome runStats(const io::ReadOptions& input, const ParameterValues& paramet
   return {run, summarize(data)};
 }
 
-}  // namespace parcelscope::analysis
+}  // namespace parcelscope::pipeline

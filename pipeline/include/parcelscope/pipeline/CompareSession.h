@@ -16,9 +16,9 @@
 #include <string>
 
 #include "parcelscope/core/Json.h"
-#include "parcelscope/viz/CompareJob.h"
+#include "parcelscope/pipeline/CompareJob.h"
 
-namespace parcelscope::viz {
+namespace parcelscope::pipeline {
 
 class CompareSession {
 public:
@@ -84,4 +84,4 @@ Json sessionJson(const CompareRequest& request);
 /// Error(Input) naming the file and the member that is wrong.
 CompareRequest readSession(const std::string& path);
 
-}  // namespace parcelscope::viz
+}  // namespace parcelscope::pipeline

@@ -7,11 +7,11 @@
 #include "parcelscope/core/Json.h"
 #include "parcelscope/io/ParcelReader.h"
 
-namespace parcelscope::analysis {
+namespace parcelscope::pipeline {
 
 struct ObservedData {
   io::ParcelLayer layer;
-  ObservedAnalysis analysis;
+  analysis::ObservedAnalysis analysis;
 };
 
 /// Reads `input` and analyses it with `parameters` (names of analysisParameters()).
@@ -45,4 +45,4 @@ std::string version();
 /// parameter values.
 Json runRecord(const std::string& command, const ParameterValues& parameters);
 
-}  // namespace parcelscope::analysis
+}  // namespace parcelscope::pipeline

@@ -11,40 +11,20 @@
 #include <vector>
 
 #include "parcelscope/analysis/ObservedAnalysis.h"
-#include "parcelscope/analysis/StatsJob.h"
+#include "parcelscope/pipeline/StatsJob.h"
 #include "parcelscope/core/Json.h"
 #include "parcelscope/generation/ObbSubdivision.h"
 #include "parcelscope/generation/SkeletonSubdivision.h"
+#include "parcelscope/generation/Styles.h"
 #include "parcelscope/io/ParcelReader.h"
 
-namespace parcelscope::generation {
+namespace parcelscope::pipeline {
 
-/// The subdivision styles `generate` offers, each with a one-line description:
-///  - obb: OBB recursive subdivision (Vanegas et al. 2012, 4.3);
-///  - skeleton: straight-skeleton strips (4.2), d_offset from --offset (0: none);
-///  - offset: skeleton with a finite offset (30 m unless --offset is given) and
-///    the patios subdivided with the OBB style;
-///  - auto: per block, skeleton where at least 90 % of its observed parcels have
-///    street access (the paper's first variety: every parcel on a street, rears
-///    abutting), obb otherwise; blocks without observed parcels (a block layer
-///    without a street_access_share field) use skeleton.
-const std::vector<std::pair<std::string, std::string>>& generationStyles();
-
-/// Every parameter `generate` takes: OBB, skeleton and block-building ones, each
-/// name once (CLI flags, GUI sliders, run record).
-std::vector<ParameterDescription> generationParameterDescriptions();
-
-/// Subdivides one block with a concrete style (obb, skeleton or offset; not
-/// auto): `parameters.bounds` for obb, all of `parameters` for the skeleton
-/// styles (offset: d_offset 30 m when 0, patios always subdivided).
-/// `streetWidths` (per contour edge, see StreetWidths) feed the StreetWidth rule;
-/// `reuse` serves the skeleton styles.
-Subdivision subdivideBlock(const Polygon& block, const std::string& style, const SkeletonParameters& parameters,
-                           std::uint64_t seed, const StreetWidths& streetWidths = {},
-                           const SkeletonReuse& reuse = {});
-
-/// Share of observed parcels with street access at or above which `auto` picks skeleton.
-constexpr double kAutoSkeletonAccessShare = 0.9;
+using generation::ObbParameters;
+using generation::SkeletonParameters;
+using generation::SkeletonReuse;
+using generation::StreetWidths;
+using generation::Subdivision;
 
 /// One block's own style and parameters, set by the user over the run's.
 struct BlockOverride {
@@ -72,7 +52,7 @@ struct GenerateRequest {
   std::set<std::string> explicitParameters;
   /// With fromParcels: the input already read and analysed with `parameters`
   /// (as `compare` does before generating); used instead of reading it again.
-  const analysis::ObservedData* observed = nullptr;
+  const pipeline::ObservedData* observed = nullptr;
   /// Per-block style and parameters; a block id no block has is Error(Usage).
   BlockOverrides overrides;
 };
@@ -191,7 +171,7 @@ Table generatedParcelTable(const GeneratedParcels& g, std::vector<std::vector<Po
 /// Runs `generate` and writes DIR/parcels.gpkg (layer `parcels`, input CRS, field
 /// block_id and the metrics), DIR/parcels.csv and DIR/run.json, all at once when
 /// complete.
-analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::string& outDir,
+pipeline::JobOutcome runGenerate(const GenerateRequest& request, const std::string& outDir,
                                  const ProgressFn& progress = {});
 
-}  // namespace parcelscope::generation
+}  // namespace parcelscope::pipeline

@@ -13,11 +13,13 @@
 #include "TestUtil.h"
 #include "parcelscope/core/Coverage.h"
 #include "parcelscope/core/Parallel.h"
-#include "parcelscope/analysis/StatsJob.h"
+#include "parcelscope/pipeline/StatsJob.h"
 #include "parcelscope/core/Error.h"
 
 namespace parcelscope::analysis {
 namespace {
+
+using namespace pipeline;
 
 struct Expect {
   const char* file;
@@ -68,7 +70,7 @@ TEST_P(SharedDataset, ReadsWithPlausibleParcelAndBlockCounts) {
 }
 
 // Block outlines by cancelling shared edges (the fast path of
-// io::unionAndClose) against GEOS's general union of the same parcels, on
+// geos::unionAndClose) against GEOS's general union of the same parcels, on
 // every block the fast path accepts: the same area to 1e-9, and a symmetric
 // difference of no area.
 TEST_P(SharedDataset, DissolvedBlocksEqualGeosUnion) {

@@ -8,12 +8,14 @@
 
 #include "TestUtil.h"
 #include "generation/TilingCheck.h"
-#include "parcelscope/analysis/StatsJob.h"
+#include "parcelscope/pipeline/StatsJob.h"
 #include "parcelscope/core/Parallel.h"
-#include "parcelscope/generation/GenerateJob.h"
+#include "parcelscope/pipeline/GenerateJob.h"
 
-namespace parcelscope::generation {
+namespace parcelscope::pipeline {
 namespace {
+
+using namespace generation;
 
 struct Dataset {
   const char* file;
@@ -27,7 +29,7 @@ class RealBlocks : public ::testing::TestWithParam<std::tuple<Dataset, const cha
 // The blocks and their plans as generate() makes them: per-block bounds
 // clamped into range, the block's seed, street widths for the skeleton.
 struct Planned {
-  analysis::ObservedData observed;
+  pipeline::ObservedData observed;
   GenerateRequest request;
   BlockInputs inputs;
   std::vector<BlockPlan> plans;
@@ -38,7 +40,7 @@ std::unique_ptr<Planned> plan(const Dataset& dataset, const std::string& style) 
   in.path = test::sharedDataset(dataset.file);
   in.crsOverride = dataset.crs;
   auto d = std::make_unique<Planned>();
-  d->observed = analysis::loadObserved(in, defaultValues(analysis::analysisParameters()));
+  d->observed = pipeline::loadObserved(in, defaultValues(analysis::analysisParameters()));
   d->request.fromParcels = true;
   d->request.observed = &d->observed;
   d->request.style = style;
@@ -192,4 +194,4 @@ TEST(PlanBlocks, UserValuesOverridePerBlockValuesWhichOverrideDefaults) {
 }
 
 }  // namespace
-}  // namespace parcelscope::generation
+}  // namespace parcelscope::pipeline

@@ -1,62 +1,23 @@
-#include "parcelscope/generation/GenerateJob.h"
+#include "parcelscope/pipeline/GenerateJob.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
-#include "parcelscope/analysis/StatsJob.h"
 #include "parcelscope/analysis/StreetWidth.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
 #include "parcelscope/io/OutputDirectory.h"
 #include "parcelscope/io/Writers.h"
 
-namespace parcelscope::generation {
+namespace parcelscope::pipeline {
 
-const std::vector<std::pair<std::string, std::string>>& generationStyles() {
-  static const std::vector<std::pair<std::string, std::string>> styles = {
-      {"obb", "OBB recursive subdivision (Vanegas et al. 2012, 4.3)"},
-      {"skeleton", "straight-skeleton strips along the streets (4.2); --offset M leaves patios"},
-      {"offset", "skeleton with a finite offset (30 m unless --offset) and patios subdivided by OBB"},
-      {"auto", "per block: skeleton where >= 90 % of observed parcels have street access, else obb"},
-  };
-  return styles;
-}
-
-std::vector<ParameterDescription> generationParameterDescriptions() {
-  std::vector<ParameterDescription> params = obbParameterDescriptions();
-  auto add = [&](const std::vector<ParameterDescription>& more) {
-    for (const auto& d : more) {
-      bool seen = false;
-      for (const auto& p : params) seen = seen || p.name == d.name;
-      if (!seen) params.push_back(d);
-    }
-  };
-  add(skeletonParameterDescriptions());
-  add(analysis::analysisParameters());
-  return params;
-}
+using namespace generation;
 
 namespace {
-constexpr double kDefaultOffsetStyleDepth = 30.0;  // m, style offset without --offset
 // m: edges of generated parcels this close count as shared (they share them exactly).
 constexpr double kContactTolerance = 0.05;
-}  // namespace
 
-Subdivision subdivideBlock(const Polygon& block, const std::string& style, const SkeletonParameters& parameters,
-                           std::uint64_t seed, const StreetWidths& streetWidths, const SkeletonReuse& reuse) {
-  if (style == "obb") return subdivideObb(block, parameters.bounds, seed);
-  SkeletonParameters p = parameters;
-  if (style == "offset") {
-    if (p.offset <= 0) p.offset = kDefaultOffsetStyleDepth;
-    p.subdividePatios = true;
-  } else if (style != "skeleton") {
-    throw usageError("no subdivision style '" + style + "'");
-  }
-  return subdivideSkeleton(block, p, seed, streetWidths, reuse);
-}
-
-namespace {
 // A block's seed key: its centroid in the input CRS, rounded to about 0.1 m, so
 // that adding, removing or renumbering other blocks does not reseed it.
 std::int64_t positionKey(const Polygon& shape, const io::LocalFrame& frame) {
@@ -105,9 +66,9 @@ bool BlockPlan::operator==(const BlockPlan& o) const {
 BlockInputs prepareBlocks(const GenerateRequest& request, const ProgressFn& progress) {
   BlockInputs in;
   if (request.fromParcels) {
-    analysis::ObservedData loaded;
-    if (!request.observed) loaded = analysis::loadObserved(request.input, request.parameters, progress);
-    const analysis::ObservedData& observed = request.observed ? *request.observed : loaded;
+    pipeline::ObservedData loaded;
+    if (!request.observed) loaded = pipeline::loadObserved(request.input, request.parameters, progress);
+    const pipeline::ObservedData& observed = request.observed ? *request.observed : loaded;
     for (std::size_t b = 0; b < observed.analysis.blocks.size(); ++b) {
       const auto& s = observed.analysis.statistics[b];
       for (const Polygon& shape : observed.analysis.blocks[b].parts) {
@@ -427,7 +388,7 @@ Table generatedParcelTable(const GeneratedParcels& g, std::vector<std::vector<Po
   return table;
 }
 
-analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::string& outDir,
+pipeline::JobOutcome runGenerate(const GenerateRequest& request, const std::string& outDir,
                                  const ProgressFn& progress) {
   io::OutputDirectory out(outDir, {request.input.path});
   const GeneratedParcels g = generate(request, scaledProgress(progress, 0.0, 0.9));
@@ -446,7 +407,7 @@ analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::stri
   for (const auto& m : g.metrics) withAccess += m.streetAccess;
   Json failures = Json::array();
   for (const auto& f : g.failures) failures.push(f);
-  Json run = analysis::runRecord("generate", request.parameters)
+  Json run = pipeline::runRecord("generate", request.parameters)
                  .set("style", request.style)
                  .set("from_parcels", request.fromParcels)
                  .set("seed", static_cast<std::int64_t>(g.seed))
@@ -488,4 +449,4 @@ analysis::JobOutcome runGenerate(const GenerateRequest& request, const std::stri
   return {run, summary};
 }
 
-}  // namespace parcelscope::generation
+}  // namespace parcelscope::pipeline

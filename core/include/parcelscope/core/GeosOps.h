@@ -1,12 +1,12 @@
 #pragma once
-// Robust polygon operations backed by GEOS through GDAL/OGR. io/ is the only
-// module that links GDAL, so the few overlay operations the analysis needs are
-// offered here on ParcelScope's plain types.
+// Robust polygon operations through the GEOS C API, on ParcelScope's plain
+// types. A target of its own (parcelscope_geos) so that the algorithms
+// (analysis/, generation/) reach GEOS without linking GDAL.
 #include <vector>
 
 #include "parcelscope/core/Geometry.h"
 
-namespace parcelscope::io {
+namespace parcelscope::geos {
 
 /// Union of `polygons`, then a morphological closing by `closeDistance` metres
 /// (buffer out by half of it, back in by half of it) so that parts separated by
@@ -19,6 +19,7 @@ namespace parcelscope::io {
 std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, double closeDistance);
 
 /// True when the polygon is valid in the OGC simple-features sense (GEOS IsValid).
+/// A ring GEOS cannot even build (fewer than 4 points once closed) is invalid.
 bool isValid(const Polygon& polygon);
 
 /// The polygon as valid polygons (GEOS make-valid, structure method: rings
@@ -31,4 +32,4 @@ std::vector<Polygon> validParts(const Polygon& polygon);
 /// Throws Error(Geometry) if GEOS fails.
 double intersectionArea(const Polygon& a, const Polygon& b);
 
-}  // namespace parcelscope::io
+}  // namespace parcelscope::geos

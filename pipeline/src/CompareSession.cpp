@@ -1,4 +1,4 @@
-#include "parcelscope/viz/CompareSession.h"
+#include "parcelscope/pipeline/CompareSession.h"
 
 #include <algorithm>
 #include <atomic>
@@ -12,7 +12,7 @@
 #include "parcelscope/core/Parallel.h"
 #include "parcelscope/io/Writers.h"
 
-namespace parcelscope::viz {
+namespace parcelscope::pipeline {
 
 namespace {
 
@@ -37,7 +37,7 @@ bool sameBlocks(const CompareRequest& a, const CompareRequest& b) {
 
 // Which observed blocks' comparisons a new result may take from the last one:
 // all but the blocks of changed entries and the stale ones.
-std::vector<char> comparisonsToKeep(std::size_t blocks, const generation::BlockInputs& inputs,
+std::vector<char> comparisonsToKeep(std::size_t blocks, const pipeline::BlockInputs& inputs,
                                     const std::vector<char>& changedEntries, const std::set<std::int64_t>& stale) {
   std::vector<char> keep(blocks, 1);
   for (std::size_t e = 0; e < changedEntries.size(); ++e) {
@@ -53,14 +53,14 @@ std::vector<char> comparisonsToKeep(std::size_t blocks, const generation::BlockI
 // `stale` first: the outcomes are shared with the state, so should anything
 // throw later (a cancel included), the last result's comparisons of those
 // blocks are not reused.
-void measureDeferred(const generation::BlockInputs& inputs,
-                     const std::vector<std::shared_ptr<generation::BlockOutcome>>& outcomes,
+void measureDeferred(const pipeline::BlockInputs& inputs,
+                     const std::vector<std::shared_ptr<pipeline::BlockOutcome>>& outcomes,
                      const std::vector<std::size_t>& entries, double minFrontage, const ProgressFn& progress,
                      std::set<std::int64_t>& stale) {
   for (std::size_t k : entries) stale.insert(inputs.entries[k].blockId);
   parallelFor(
       entries.size(),
-      [&](std::size_t t) { generation::measureOutcomeContext(inputs, entries[t], *outcomes[entries[t]], minFrontage); },
+      [&](std::size_t t) { pipeline::measureOutcomeContext(inputs, entries[t], *outcomes[entries[t]], minFrontage); },
       progress ? std::function<void(std::size_t)>([&](std::size_t n) {
         reportProgress(progress, static_cast<double>(n) / static_cast<double>(entries.size()), "measuring context");
       })
@@ -71,12 +71,12 @@ void measureDeferred(const generation::BlockInputs& inputs,
 
 struct CompareSession::State {
   CompareRequest request;  // of the last completed update
-  std::shared_ptr<const analysis::ObservedData> observed;
-  generation::BlockInputs inputs;
-  std::vector<generation::BlockPlan> plans;  // one per entry; outcomes[k] was made with plans[k]
+  std::shared_ptr<const pipeline::ObservedData> observed;
+  pipeline::BlockInputs inputs;
+  std::vector<pipeline::BlockPlan> plans;  // one per entry; outcomes[k] was made with plans[k]
   // Owned by the session alone (results hold copies), so completeContext can
   // fill in what an update deferred.
-  std::vector<std::shared_ptr<generation::BlockOutcome>> outcomes;
+  std::vector<std::shared_ptr<pipeline::BlockOutcome>> outcomes;
   std::shared_ptr<const CompareResult> current;
   // Blocks whose parcels a cancelled update replaced: current->blocks still
   // compares their old parcels, so their comparison is not reused.
@@ -102,43 +102,43 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   const bool reload = !s.observed || !sameInput(s.request.input, request.input) || !sameBlocks(s.request, request);
   const double k = compareValue(request, "k");
   const bool rederive = !reload && compareValue(s.request, "k") != k;
-  std::shared_ptr<const analysis::ObservedData> observed = s.observed;
+  std::shared_ptr<const pipeline::ObservedData> observed = s.observed;
   double readSeconds = 0, blockSeconds = 0;
   if (reload) {
-    auto loaded = std::make_shared<analysis::ObservedData>(
-        analysis::loadObserved(request.input, request.parameters, scaledProgress(progress, 0.0, 0.5)));
+    auto loaded = std::make_shared<pipeline::ObservedData>(
+        pipeline::loadObserved(request.input, request.parameters, scaledProgress(progress, 0.0, 0.5)));
     detail::requireBlocks(request, *loaded);
     for (const auto& stage : loaded->layer.timings.stages()) readSeconds += stage.second;
     for (const auto& stage : loaded->analysis.timings.stages()) blockSeconds += stage.second;
     observed = std::move(loaded);
   } else if (rederive) {
-    auto copy = std::make_shared<analysis::ObservedData>(*observed);
+    auto copy = std::make_shared<pipeline::ObservedData>(*observed);
     analysis::rederiveBlockBounds(copy->analysis, k);
     observed = std::move(copy);
   }
-  generation::BlockInputs fresh;
+  pipeline::BlockInputs fresh;
   const bool newInputs = reload || rederive;
-  if (newInputs) fresh = generation::prepareBlocks(detail::generateRequest(request, observed.get()));
-  generation::BlockInputs& inputs = newInputs ? fresh : s.inputs;
+  if (newInputs) fresh = pipeline::prepareBlocks(detail::generateRequest(request, observed.get()));
+  pipeline::BlockInputs& inputs = newInputs ? fresh : s.inputs;
   if (newInputs && !reload) inputs.widths = s.inputs.widths;  // same blocks, same streets
 
   // Plans, and the entries whose plan changed.
   const auto generateStart = std::chrono::steady_clock::now();
-  const generation::GenerateRequest g = detail::generateRequest(request, observed.get());
+  const pipeline::GenerateRequest g = detail::generateRequest(request, observed.get());
   std::int64_t clamped = 0;
-  const std::vector<generation::BlockPlan> plans = generation::planBlocks(g, inputs, &clamped);
+  const std::vector<pipeline::BlockPlan> plans = pipeline::planBlocks(g, inputs, &clamped);
   if (std::any_of(plans.begin(), plans.end(), [](const auto& p) { return p.style != "obb"; })) {
-    generation::streetWidthsOf(inputs);
+    pipeline::streetWidthsOf(inputs);
   }
-  std::vector<std::shared_ptr<generation::BlockOutcome>> outcomes =
-      reload ? std::vector<std::shared_ptr<generation::BlockOutcome>>(plans.size()) : s.outcomes;
-  std::vector<generation::BlockPlan> done = reload ? std::vector<generation::BlockPlan>(plans.size()) : s.plans;
+  std::vector<std::shared_ptr<pipeline::BlockOutcome>> outcomes =
+      reload ? std::vector<std::shared_ptr<pipeline::BlockOutcome>>(plans.size()) : s.outcomes;
+  std::vector<pipeline::BlockPlan> done = reload ? std::vector<pipeline::BlockPlan>(plans.size()) : s.plans;
   std::vector<std::size_t> todo;
   for (std::size_t k2 = 0; k2 < plans.size(); ++k2) {
     if (!outcomes[k2] || done[k2] != plans[k2]) todo.push_back(k2);
   }
   const double minFrontage = compareValue(request, "min-frontage");
-  std::vector<std::shared_ptr<generation::BlockOutcome>> made(todo.size());
+  std::vector<std::shared_ptr<pipeline::BlockOutcome>> made(todo.size());
   const bool shapesOnly = deferContext && !analysis::parcelQuantity(request.metric).context;
   // Set (release) once made[t] is written, so the progress tick may read it.
   std::unique_ptr<std::atomic<bool>[]> ready(new std::atomic<bool>[todo.size()]);
@@ -161,8 +161,8 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
                          std::chrono::duration<double>(0.5 * partialSeconds));
   std::size_t partialDone = 0;
   auto emitPartial = [&] {
-    std::vector<const generation::BlockOutcome*> pointers;
-    std::vector<generation::BlockPlan> mixed = done;
+    std::vector<const pipeline::BlockOutcome*> pointers;
+    std::vector<pipeline::BlockPlan> mixed = done;
     for (const auto& o : outcomes) pointers.push_back(o.get());
     std::size_t n = 0;
     std::vector<char> changed(plans.size(), 0);
@@ -179,7 +179,7 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
     partialDone = n;
     CompareResult r;
     r.observed = observed;
-    r.generated = generation::assembleParcels(inputs, mixed, pointers, seed);
+    r.generated = pipeline::assembleParcels(inputs, mixed, pointers, seed);
     r.blocks = s.current->blocks;
     r.observedLots = s.current->observedLots;
     r.observedSides = s.current->observedSides;
@@ -203,13 +203,13 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
         todo.size(),
         [&](std::size_t t) {
           // The block's last run, whose splits and measurements the new plan may reuse.
-          generation::BlockReuse reuse;
+          pipeline::BlockReuse reuse;
           reuse.previous = outcomes[todo[t]].get();
           reuse.previousPlan = outcomes[todo[t]] ? &done[todo[t]] : nullptr;
           reuse.record = true;
           reuse.shapesOnly = shapesOnly;
-          made[t] = std::make_shared<generation::BlockOutcome>(
-              generation::runBlock(inputs, todo[t], plans[todo[t]], minFrontage, reuse));
+          made[t] = std::make_shared<pipeline::BlockOutcome>(
+              pipeline::runBlock(inputs, todo[t], plans[todo[t]], minFrontage, reuse));
           ready[t].store(true, std::memory_order_release);
         },
         tick ? std::function<void(std::size_t)>([&](std::size_t n) {
@@ -246,9 +246,9 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   // where neither side changed.
   CompareResult r;
   r.observed = observed;
-  std::vector<const generation::BlockOutcome*> pointers;
+  std::vector<const pipeline::BlockOutcome*> pointers;
   for (const auto& o : outcomes) pointers.push_back(o.get());
-  r.generated = generation::assembleParcels(inputs, plans, pointers, seed);
+  r.generated = pipeline::assembleParcels(inputs, plans, pointers, seed);
   r.generated.clampedBounds = clamped;
   const double generateSeconds = secondsSince(generateStart);
 
@@ -273,7 +273,7 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   // freeing every block's parcels and splits took longer than comparing them
   // (12-19 ms on cambridge_ma), on the path to the caller.
   releaseInBackground(
-      std::make_shared<const std::vector<std::shared_ptr<generation::BlockOutcome>>>(std::move(s.outcomes)));
+      std::make_shared<const std::vector<std::shared_ptr<pipeline::BlockOutcome>>>(std::move(s.outcomes)));
   releaseInBackground(std::move(s.current));
   if (newInputs) s.inputs = std::move(fresh);
   s.observed = observed;
@@ -306,9 +306,9 @@ CompareSession::Update CompareSession::completeContext(const ProgressFn& progres
 
   CompareResult r;
   r.observed = s.observed;
-  std::vector<const generation::BlockOutcome*> pointers;
+  std::vector<const pipeline::BlockOutcome*> pointers;
   for (const auto& o : s.outcomes) pointers.push_back(o.get());
-  r.generated = generation::assembleParcels(s.inputs, s.plans, pointers, runSeedOf(s.request));
+  r.generated = pipeline::assembleParcels(s.inputs, s.plans, pointers, runSeedOf(s.request));
   r.generated.clampedBounds = s.current->generated.clampedBounds;
   r.observedSides = s.current->observedSides;
   r.observedLots = s.current->observedLots;
@@ -420,7 +420,7 @@ CompareRequest readSession(const std::string& path) {
       const std::string where = "overrides[" + std::to_string(index++) + "].";
       const Json* id = item.find("block_id");
       if (!id || !id->isNumber()) throw bad("member " + where + "block_id is missing or not a number");
-      generation::BlockOverride override;
+      pipeline::BlockOverride override;
       override.style = text(item, "style", where);
       if (const Json* p = item.find("parameters")) {
         if (!p->isObject()) throw bad("member " + where + "parameters is not an object");
@@ -432,4 +432,4 @@ CompareRequest readSession(const std::string& path) {
   return request;
 }
 
-}  // namespace parcelscope::viz
+}  // namespace parcelscope::pipeline

@@ -1,7 +1,8 @@
 // CompareSession: the incremental compare behind the GUI gives what compare()
 // gives for the same request, regenerating only the blocks whose plan changed;
 // session files round-trip.
-#include "parcelscope/viz/CompareSession.h"
+#include "parcelscope/pipeline/CompareSession.h"
+#include "parcelscope/viz/CompareFigures.h"
 
 #include <gtest/gtest.h>
 
@@ -15,8 +16,13 @@
 #include "parcelscope/core/Error.h"
 #include "parcelscope/io/Writers.h"
 
-namespace parcelscope::viz {
+namespace parcelscope::pipeline {
 namespace {
+
+using viz::ColourScale;
+using viz::QuantityHistogram;
+using viz::quantityHistogram;
+using viz::quantityScale;
 
 using test::TempDir;
 
@@ -497,4 +503,4 @@ TEST(SessionFile, BadMembersAreNamed) {
 }
 
 }  // namespace
-}  // namespace parcelscope::viz
+}  // namespace parcelscope::pipeline

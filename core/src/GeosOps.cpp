@@ -1,0 +1,243 @@
+#include "parcelscope/core/GeosOps.h"
+
+#include <geos_c.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "parcelscope/core/Coverage.h"
+#include "parcelscope/core/Error.h"
+
+namespace parcelscope::geos {
+
+namespace {
+// A vertex within this distance (m) of a neighbour's edge is taken to lie on
+// it when dissolving a block: far below any surveyed precision, far above
+// the rounding of projected coordinates near the origin.
+constexpr double kCoverageSnap = 1e-6;
+
+void quiet(const char*, void*) {}
+
+// One GEOS context per thread, silent (failures are reported by the caller).
+GEOSContextHandle_t context() {
+  struct Context {
+    GEOSContextHandle_t handle = GEOS_init_r();
+    Context() {
+      GEOSContext_setNoticeMessageHandler_r(handle, quiet, nullptr);
+      GEOSContext_setErrorMessageHandler_r(handle, quiet, nullptr);
+    }
+    ~Context() { GEOS_finish_r(handle); }
+    Context(const Context&) = delete;
+    Context& operator=(const Context&) = delete;
+  };
+  thread_local Context c;
+  return c.handle;
+}
+
+// Owns a GEOS geometry of the calling thread's context.
+struct Destroy {
+  void operator()(GEOSGeometry* g) const { GEOSGeom_destroy_r(context(), g); }
+};
+using Geom = std::unique_ptr<GEOSGeometry, Destroy>;
+
+GEOSGeometry* ringToGeos(GEOSContextHandle_t ctx, const Ring& ring) {
+  std::vector<double> xy;
+  xy.reserve(2 * ring.size() + 2);
+  for (const Point& p : ring) {
+    xy.push_back(p.x);
+    xy.push_back(p.y);
+  }
+  // Closed; a ring of fewer than 4 points is padded with its first point (as
+  // GDAL does before handing it to GEOS), so that GEOS builds it and then
+  // finds it invalid.
+  while (!ring.empty() && (xy.size() < 8 || xy.size() == 2 * ring.size())) {
+    xy.push_back(ring.front().x);
+    xy.push_back(ring.front().y);
+  }
+  GEOSCoordSequence* seq =
+      GEOSCoordSeq_copyFromBuffer_r(ctx, xy.data(), static_cast<unsigned>(xy.size() / 2), 0, 0);
+  return seq ? GEOSGeom_createLinearRing_r(ctx, seq) : nullptr;  // takes the sequence, even on failure
+}
+
+// The polygon with closed rings; null when GEOS refuses a ring.
+Geom toGeos(const Polygon& polygon) {
+  GEOSContextHandle_t ctx = context();
+  GEOSGeometry* shell = ringToGeos(ctx, polygon.outer);
+  if (!shell) return nullptr;
+  std::vector<GEOSGeometry*> holes;
+  for (const Ring& h : polygon.holes) {
+    GEOSGeometry* hole = ringToGeos(ctx, h);
+    if (!hole) {
+      GEOSGeom_destroy_r(ctx, shell);
+      for (GEOSGeometry* built : holes) GEOSGeom_destroy_r(ctx, built);
+      return nullptr;
+    }
+    holes.push_back(hole);
+  }
+  return Geom(GEOSGeom_createPolygon_r(ctx, shell, holes.data(), static_cast<unsigned>(holes.size())));
+}
+
+Geom toGeos(const std::vector<const Polygon*>& parts) {
+  GEOSContextHandle_t ctx = context();
+  std::vector<GEOSGeometry*> built;
+  for (const Polygon* p : parts) {
+    Geom g = toGeos(*p);
+    if (!g) {
+      for (GEOSGeometry* b : built) GEOSGeom_destroy_r(ctx, b);
+      return nullptr;
+    }
+    built.push_back(g.release());
+  }
+  return Geom(GEOSGeom_createCollection_r(ctx, GEOS_MULTIPOLYGON, built.data(), static_cast<unsigned>(built.size())));
+}
+
+Ring ringFromGeos(GEOSContextHandle_t ctx, const GEOSGeometry* ring) {
+  const GEOSCoordSequence* seq = GEOSGeom_getCoordSeq_r(ctx, ring);
+  unsigned n = 0;
+  if (!seq || !GEOSCoordSeq_getSize_r(ctx, seq, &n) || n == 0) return {};
+  std::vector<double> xy(2 * std::size_t(n));
+  GEOSCoordSeq_copyToBuffer_r(ctx, seq, xy.data(), 0, 0);
+  Ring out(n);
+  for (unsigned i = 0; i < n; ++i) out[i] = {xy[2 * i], xy[2 * i + 1]};
+  return out;
+}
+
+// Appends every polygon of `g` (polygons, multipolygons, collections), normalised.
+void collectPolygons(const GEOSGeometry* g, std::vector<Polygon>& out) {
+  GEOSContextHandle_t ctx = context();
+  if (GEOSisEmpty_r(ctx, g) == 1) return;
+  switch (GEOSGeomTypeId_r(ctx, g)) {
+    case GEOS_POLYGON: {
+      Polygon p;
+      p.outer = ringFromGeos(ctx, GEOSGetExteriorRing_r(ctx, g));
+      const int holes = GEOSGetNumInteriorRings_r(ctx, g);
+      for (int i = 0; i < holes; ++i) p.holes.push_back(ringFromGeos(ctx, GEOSGetInteriorRingN_r(ctx, g, i)));
+      if (normalise(p)) out.push_back(std::move(p));
+      return;
+    }
+    case GEOS_MULTIPOLYGON:
+    case GEOS_GEOMETRYCOLLECTION: {
+      const int n = GEOSGetNumGeometries_r(ctx, g);
+      for (int i = 0; i < n; ++i) collectPolygons(GEOSGetGeometryN_r(ctx, g, i), out);
+      return;
+    }
+    default:
+      return;
+  }
+}
+
+bool valid(const GEOSGeometry* g) { return g && GEOSisValid_r(context(), g) == 1; }
+
+// GEOS buffer with mitred joins.
+Geom mitreBuffer(const GEOSGeometry* g, double distance) {
+  constexpr double kMitreLimit = 5.0;  // spikes sharper than ~23 degrees are bevelled
+  return Geom(GEOSBufferWithStyle_r(context(), g, distance, 8, GEOSBUF_CAP_FLAT, GEOSBUF_JOIN_MITRE, kMitreLimit));
+}
+
+// Union of parcels that form a clean coverage (shared edges identical): GEOS's
+// coverage union only drops the edges that occur twice, far faster than a
+// general overlay. Its result is trusted only when it is valid and keeps the
+// total area (overlaps, gaps with T-junctions or mismatched edges fail one of
+// the two); otherwise null, and the caller uses the general union.
+Geom coverageUnion(const GEOSGeometry* multi, double totalArea) {
+  GEOSContextHandle_t ctx = context();
+  Geom u(GEOSCoverageUnion_r(ctx, multi));
+  double a = 0;
+  if (u && GEOSisValid_r(ctx, u.get()) == 1 && GEOSArea_r(ctx, u.get(), &a) == 1 &&
+      std::fabs(a - totalArea) <= 1e-9 * totalArea) {
+    return u;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, double closeDistance) {
+  if (polygons.empty()) return {};
+  GEOSContextHandle_t ctx = context();
+  // Parcels that share their edges vertex for vertex (most blocks), also after
+  // splitting edges at a neighbour's vertex lying on them: cancel the shared
+  // edges, and keep the rings left when GEOS finds them valid. Otherwise GEOS
+  // unions them: its coverage union, then a general union.
+  Geom result;
+  for (const double snap : {0.0, kCoverageSnap}) {
+    auto dissolved = dissolveCoverage(polygons, {snap});
+    if (!dissolved || dissolved->empty()) continue;
+    const bool single = dissolved->size() == 1;
+    std::vector<const Polygon*> parts;
+    for (const Polygon& p : *dissolved) parts.push_back(&p);
+    Geom outline = single ? toGeos(dissolved->front()) : toGeos(parts);
+    if (!valid(outline.get())) continue;
+    if (single && dissolved->front().holes.empty()) return std::move(*dissolved);  // nothing to close
+    result = std::move(outline);
+    break;
+  }
+  if (!result) {
+    double totalArea = 0;
+    for (const Polygon* p : polygons) totalArea += area(*p);
+    Geom multi = toGeos(polygons);
+    if (multi) {
+      result = coverageUnion(multi.get(), totalArea);
+      if (!result) result.reset(GEOSUnionCascaded_r(ctx, multi.get()));
+      if (!result) result.reset(GEOSBuffer_r(ctx, multi.get(), 0.0, 30));
+    }
+  }
+  const bool simple = result && GEOSGeomTypeId_r(ctx, result.get()) == GEOS_POLYGON &&
+                      GEOSGetNumInteriorRings_r(ctx, result.get()) == 0;
+  if (result && closeDistance > 0 && !simple) {
+    // Gaps or holes: close them where narrower than the tolerance. Buffering
+    // out unions the parts; buffering back in restores the outline. Mitred
+    // joins give corners back exactly (round joins would cut them).
+    if (Geom grown = mitreBuffer(result.get(), 0.5 * closeDistance)) result = mitreBuffer(grown.get(), -0.5 * closeDistance);
+  }
+  if (!result) throw geometryError("union of " + std::to_string(polygons.size()) + " parcels failed");
+  // Parts smaller than half a tolerance square are artefacts of the closing.
+  const double minArea = closeDistance > 0 ? 0.5 * closeDistance * closeDistance : 1e-6;
+  std::vector<Polygon> all, parts;
+  collectPolygons(result.get(), all);
+  double largest = 0;
+  for (const Polygon& p : all) largest = std::max(largest, area(p));
+  for (auto& p : all) {
+    const double a = area(p);
+    if (a >= minArea || a == largest) parts.push_back(std::move(p));  // never drop the whole block
+  }
+  return parts;
+}
+
+bool isValid(const Polygon& polygon) { return valid(toGeos(polygon).get()); }
+
+std::vector<Polygon> validParts(const Polygon& polygon) {
+  GEOSContextHandle_t ctx = context();
+  Geom geometry = toGeos(polygon);
+  if (valid(geometry.get())) return {polygon};
+  std::vector<Polygon> out;
+  if (!geometry) return out;
+  GEOSMakeValidParams* params = GEOSMakeValidParams_create_r(ctx);
+  GEOSMakeValidParams_setMethod_r(ctx, params, GEOS_MAKE_VALID_STRUCTURE);
+  GEOSMakeValidParams_setKeepCollapsed_r(ctx, params, 0);
+  Geom fixed(GEOSMakeValidWithParams_r(ctx, geometry.get(), params));
+  GEOSMakeValidParams_destroy_r(ctx, params);
+  if (fixed) collectPolygons(fixed.get(), out);
+  return out;
+}
+
+double intersectionArea(const Polygon& a, const Polygon& b) {
+  // Snap-rounded overlay on a 1e-6 m grid: floating overlay (GEOS 3.11) can
+  // return a whole polygon as the intersection of two polygons whose shared
+  // edge differs in the last bits; snap rounding is fully robust.
+  constexpr double kGrid = 1e-6;
+  GEOSContextHandle_t ctx = context();
+  double result = -1;
+  Geom ga = toGeos(a), gb = toGeos(b);
+  if (ga && gb) {
+    if (Geom i{GEOSIntersectionPrec_r(ctx, ga.get(), gb.get(), kGrid)}) {
+      if (GEOSArea_r(ctx, i.get(), &result) != 1) result = -1;
+    }
+  }
+  if (result < 0) throw geometryError("intersection failed");
+  return result;
+}
+
+}  // namespace parcelscope::geos

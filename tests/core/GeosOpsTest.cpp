@@ -1,0 +1,112 @@
+#include <gtest/gtest.h>
+#include <ogr_api.h>
+#include <ogr_geometry.h>
+
+#include <memory>
+#include <random>
+
+#include "OgrTestUtil.h"
+#include "TestUtil.h"
+#include "parcelscope/core/GeosOps.h"
+
+namespace parcelscope::geos {
+namespace {
+
+using test::rect;
+
+TEST(GeosOps, UnionClosesGapsNarrowerThanTheTolerance) {
+  const Polygon a = rect(0, 0, 10, 10), b = rect(10.4, 0, 20, 10), c = rect(30, 0, 40, 10);
+  const auto joined = unionAndClose({&a, &b}, 1.0);
+  ASSERT_EQ(joined.size(), 1u);
+  EXPECT_NEAR(area(joined[0]), 100.0 + 96.0 + 0.4 * 10, 1e-6);  // both lots and the closed gap
+  EXPECT_EQ(unionAndClose({&a, &c}, 1.0).size(), 2u);
+  // Holes wider than the tolerance are kept.
+  const Polygon ring1 = rect(0, 0, 30, 10), ring2 = rect(0, 20, 30, 30), ring3 = rect(0, 10, 10, 20),
+                ring4 = rect(20, 10, 30, 20);
+  const auto courtyard = unionAndClose({&ring1, &ring2, &ring3, &ring4}, 1.0);
+  ASSERT_EQ(courtyard.size(), 1u);
+  EXPECT_EQ(courtyard[0].holes.size(), 1u);
+  EXPECT_NEAR(area(courtyard[0]), 800.0, 1e-6);
+}
+
+// Rows of 10 m cells on an exact grid where random runs of cells are one lot
+// (a rectangle without the inner corners): their long edges pass through the
+// corners of the lots above and below (T-junctions).
+std::vector<Polygon> mergedRows(std::mt19937& rng, int nx, int ny) {
+  std::vector<Polygon> lots;
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx;) {
+      const int run = 1 + static_cast<int>(rng() % 3);
+      const int end = std::min(nx, i + run);
+      lots.push_back(rect(10.0 * i, 10.0 * j, 10.0 * end, 10.0 * (j + 1)));
+      i = end;
+    }
+  }
+  return lots;
+}
+
+// Jittered grids with cells left out (holes, separate parts, corners where
+// only two cells meet) and rows of merged cells (T-junctions): the union
+// equals GEOS's general union of the same lots.
+TEST(GeosOps, UnionOfRandomGridsMatchesGeosUnion) {
+  const unsigned seed = std::random_device{}();
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  std::mt19937 rng(seed);
+  for (int round = 0; round < 30; ++round) {
+    std::vector<Polygon> lots =
+        test::jitteredGrid(rng, 2 + static_cast<int>(rng() % 5), 2 + static_cast<int>(rng() % 5), 0.8);
+    if (round % 2) lots = mergedRows(rng, 2 + static_cast<int>(rng() % 5), 2 + static_cast<int>(rng() % 5));
+    if (lots.empty()) continue;
+    std::vector<const Polygon*> members;
+    OGRMultiPolygon all;
+    for (const Polygon& p : lots) {
+      members.push_back(&p);
+      all.addGeometryDirectly(test::toOgr(p).release());
+    }
+    const auto ours = unionAndClose(members, 0.0);
+    std::unique_ptr<OGRGeometry> geos(all.UnionCascaded());
+    ASSERT_NE(geos, nullptr);
+    const auto mine = test::toOgr(ours);
+    EXPECT_TRUE(mine->IsValid());
+    std::unique_ptr<OGRGeometry> difference(mine->SymDifference(geos.get()));
+    ASSERT_NE(difference, nullptr);
+    double ourArea = 0;
+    for (const Polygon& p : ours) ourArea += area(p);
+    const double differenceArea = difference->IsEmpty() ? 0.0 : OGR_G_Area(OGRGeometry::ToHandle(difference.get()));
+    EXPECT_LE(differenceArea, 1e-9 * ourArea);
+    EXPECT_NEAR(OGR_G_Area(OGRGeometry::ToHandle(geos.get())), ourArea, 1e-9 * ourArea);
+  }
+}
+
+TEST(GeosOps, ValidityAndIntersection) {
+  EXPECT_TRUE(isValid(rect(0, 0, 1, 1)));
+  EXPECT_FALSE(isValid(test::poly({{0, 0}, {1, 1}, {1, 0}, {0, 1}})));
+  EXPECT_NEAR(intersectionArea(rect(0, 0, 2, 2), rect(1, 1, 3, 3)), 1.0, 1e-12);
+}
+
+TEST(GeosOps, RingsOfTooFewPointsAreInvalidAndHaveNoValidParts) {
+  Polygon twoPoints;
+  twoPoints.outer = {{0, 0}, {1, 0}};
+  EXPECT_FALSE(isValid(twoPoints));
+  EXPECT_TRUE(validParts(twoPoints).empty());
+}
+
+TEST(GeosOps, ValidPartsSplitsABowTieAndKeepsValidPolygonsAsTheyAre) {
+  const Polygon square = rect(0, 0, 1, 1);
+  const auto same = validParts(square);
+  ASSERT_EQ(same.size(), 1u);
+  ASSERT_EQ(same[0].outer.size(), square.outer.size());
+  for (std::size_t i = 0; i < square.outer.size(); ++i) {
+    EXPECT_EQ(same[0].outer[i].x, square.outer[i].x);
+    EXPECT_EQ(same[0].outer[i].y, square.outer[i].y);
+  }
+  const auto parts = validParts(test::poly({{0, 0}, {2, 2}, {2, 0}, {0, 2}}));
+  ASSERT_EQ(parts.size(), 2u);
+  for (const Polygon& p : parts) {
+    EXPECT_TRUE(isValid(p));
+    EXPECT_NEAR(area(p), 1.0, 1e-12);
+  }
+}
+
+}  // namespace
+}  // namespace parcelscope::geos

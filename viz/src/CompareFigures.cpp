@@ -1,0 +1,277 @@
+#include "parcelscope/viz/CompareFigures.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iterator>
+#include <numeric>
+#include <optional>
+
+#include "parcelscope/core/Error.h"
+#include "parcelscope/io/OutputDirectory.h"
+
+namespace parcelscope::viz {
+
+namespace {
+
+double value(const CompareRequest& request, const std::string& name) { return pipeline::compareValue(request, name); }
+
+std::string generatedName(const CompareRequest& request, const CompareResult& r) {
+  std::string name = "procedural (" + request.style + ", seed " + std::to_string(r.generated.seed);
+  if (!request.overrides.empty()) name += ", " + std::to_string(request.overrides.size()) + " blocks overridden";
+  return name + ")";
+}
+
+std::string inputName(const CompareRequest& request) {
+  return std::filesystem::path(request.input.path).filename().string();
+}
+
+// Histograms, figures and extra files drawn by compare, by quantity name.
+bool drawnAnyway(const std::string& quantity, bool histogram) {
+  if (histogram) return quantity == "area" || quantity == "width" || quantity == "aspect_ratio";
+  return quantity == "aspect_ratio";
+}
+
+}  // namespace
+
+ColourScale quantityScale(const CompareResult& r, const CompareRequest& request, const std::string& quantity) {
+  const analysis::ParcelQuantity& q = analysis::parcelQuantity(quantity);
+  ColourScale scale;
+  char title[160];
+  if (q.name == "aspect_ratio") {
+    scale.kind = ColourScale::Kind::RedToGreen;
+    scale.minimum = 1;
+    scale.maximum = value(request, "map-aspect-ratio-max");
+    std::snprintf(title, sizeof title, "Aspect ratio (length / width; %g and above drawn green)", scale.maximum);
+    scale.title = title;
+    return scale;
+  }
+  scale.kind = ColourScale::Kind::Sequential;
+  scale.title = q.title;
+  scale.title[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(scale.title[0])));
+  if (q.name == "street_access") {
+    scale.minimum = 0;
+    scale.maximum = 1;
+    return scale;
+  }
+  // The observed parcels set the range, so that a change to the generated
+  // parcels (a slider) leaves the scale, and the observed view, as they were;
+  // the generated parcels set it only when no observed parcel has a value.
+  std::vector<double> sample = analysis::quantitySample(r.observedLots, q);
+  if (sample.empty()) sample = analysis::quantitySample(r.generated.metrics, q);
+  if (sample.empty()) {
+    scale.minimum = 0;
+    scale.maximum = 1;
+    return scale;
+  }
+  std::sort(sample.begin(), sample.end());
+  const double quantile = value(request, "histogram-quantile");
+  scale.minimum = sample.front();
+  // The nearest-rank quantile, as the histograms' bins (analysis::sharedHistogram).
+  const auto rank = static_cast<std::size_t>(std::ceil(quantile * static_cast<double>(sample.size())));
+  scale.maximum = sample[std::min(sample.size(), std::max<std::size_t>(rank, 1)) - 1];
+  if (!(scale.maximum > scale.minimum)) scale.maximum = scale.minimum + 1;
+  std::snprintf(title, sizeof title, "; %.4g and above drawn darkest", scale.maximum);
+  scale.title += title;
+  return scale;
+}
+
+void renderQuantityMap(const CompareResult& r, const CompareRequest& request, const std::string& quantity,
+                       const FigureOutput& output) {
+  const analysis::ParcelQuantity& q = analysis::parcelQuantity(quantity);
+  MapPanel observed, generated;
+  const auto& parcels = r.observed->layer.parcels;
+  for (std::size_t i = 0; i < parcels.size(); ++i) {
+    if (r.observed->analysis.blockOf[i] < 0) continue;
+    observed.shapes.push_back(&parcels[i].shape);
+    observed.values.push_back(q.value(r.observed->analysis.metrics[i]));
+  }
+  for (std::size_t i = 0; i < r.generated.parcels.size(); ++i) {
+    generated.shapes.push_back(&r.generated.parcels[i]);
+    generated.values.push_back(q.value(r.generated.metrics[i]));
+  }
+  observed.title = "Observed: " + std::to_string(observed.shapes.size()) + " parcels";
+  generated.title = "Procedural (" + request.style + "): " + std::to_string(generated.shapes.size()) + " parcels";
+  std::string what = q.title.substr(0, q.title.find(" ("));
+  what[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(what[0])));
+  renderMaps("Parcel " + (q.name == "aspect_ratio" ? std::string("aspect ratio") : q.name) + ", observed and " +
+                 generatedName(request, r) + ": " + inputName(request),
+             {observed, generated}, quantityScale(r, request, quantity), output);
+}
+
+QuantityHistogram quantityHistogram(const CompareResult& r, const CompareRequest& request,
+                                    const std::string& quantity, HistogramTexts texts) {
+  const bool numbers = texts == HistogramTexts::WithNumbers;
+  const analysis::ParcelQuantity& q = analysis::parcelQuantity(quantity);
+  const int bins = static_cast<int>(value(request, "bins"));
+  const double quantile = value(request, "histogram-quantile");
+  // The compared metrics' histograms were made with the comparison, on the same bins.
+  const analysis::SharedHistogram* made = nullptr;
+  for (std::size_t k = 0; k < std::size(analysis::kComparedMetrics); ++k) {
+    if (q.name == analysis::metricName(analysis::kComparedMetrics[k]) && r.histograms.size() > k &&
+        r.histogramBins == bins && r.histogramQuantile == quantile) {
+      made = &r.histograms[k];
+      break;
+    }
+  }
+  const analysis::SharedHistogram h =
+      made ? *made
+           : analysis::sharedHistogram(analysis::quantitySample(r.observedLots, q),
+                                       analysis::quantitySample(r.generated.metrics, q), bins, quantile);
+  QuantityHistogram out;
+  out.edges = h.edges;
+  out.xTitle = q.title;
+  if (h.aOverflow + h.bOverflow > 0) {
+    char note[96];
+    std::snprintf(note, sizeof note, "; the last bin holds every value above %.4g", h.edges.back());
+    out.xTitle += numbers ? note : "; the last bin holds every higher value";
+  }
+  out.yTitle = "parcels (count)";
+  auto counts = [&](const std::vector<int>& c) {
+    return numbers ? " (n = " + std::to_string(std::accumulate(c.begin(), c.end(), 0)) + ")" : std::string();
+  };
+  out.series = {{"observed" + counts(h.a), h.a, {0.84, 0.15, 0.16}},
+                {"procedural, " + request.style + counts(h.b), h.b, {0.12, 0.38, 0.75}}};
+  const std::string what = q.name == "aspect_ratio" ? std::string("Parcel aspect ratio") : "Parcel " + q.name;
+  out.title = what + ": observed and " + generatedName(request, r) + ", " + inputName(request);
+  return out;
+}
+
+void renderQuantityHistogram(const CompareResult& r, const CompareRequest& request, const std::string& quantity,
+                             const FigureOutput& output) {
+  const QuantityHistogram h = quantityHistogram(r, request, quantity);
+  if (h.edges.empty()) throw usageError(output.png + ": no finite " + quantity + " value on either side to draw");
+  renderHistogram(h.title, h.xTitle, h.yTitle, h.edges, h.series, output);
+}
+
+void renderBlocksMap(const CompareResult& r, const CompareRequest& request, const FigureOutput& output) {
+  MapPanel blocks;
+  int withValue = 0;
+  const analysis::ObservedAnalysis& a = r.observed->analysis;
+  for (std::size_t b = 0; b < a.blocks.size(); ++b) {
+    const double ks = r.blocks[b].comparison.area.ks;
+    withValue += !std::isnan(ks);
+    for (const Polygon& part : a.blocks[b].parts) {
+      blocks.shapes.push_back(&part);
+      blocks.values.push_back(ks);
+    }
+  }
+  blocks.title = std::to_string(a.blocks.size()) + " blocks (" + std::to_string(withValue) +
+                 " with parcels on both sides)";
+  ColourScale scale;
+  scale.kind = ColourScale::Kind::Sequential;
+  scale.minimum = 0;
+  scale.maximum = 1;
+  scale.title = "KS statistic of parcel area (0: same distribution, 1: disjoint)";
+  renderMaps("Per-block difference in parcel area, observed and " + generatedName(request, r) + ": " +
+                 inputName(request),
+             {blocks}, scale, output);
+}
+
+std::vector<std::string> figureNames() {
+  std::vector<std::string> names;
+  for (const auto& q : analysis::parcelQuantities()) names.push_back("map_" + q.name);
+  for (const auto& q : analysis::parcelQuantities()) names.push_back("hist_" + q.name);
+  names.push_back("map_blocks");
+  return names;
+}
+
+void exportFigure(const CompareResult& r, const CompareRequest& request, const std::string& name,
+                  const std::string& path, int width, int height) {
+  const auto names = figureNames();
+  if (std::find(names.begin(), names.end(), name) == names.end()) {
+    throw usageError("no figure named '" + name + "'");
+  }
+  const std::string extension = std::filesystem::path(path).extension().string();
+  const bool histogram = name.rfind("hist_", 0) == 0;
+  if (extension != ".png" && !(histogram && (extension == ".svg" || extension == ".pdf"))) {
+    throw usageError(path + ": " + name + " is written as " + (histogram ? ".png, .svg or .pdf" : ".png"));
+  }
+  const std::vector<std::string> inputs = {request.input.path};
+  io::StagedFile file(path, inputs);
+  std::optional<io::StagedFile> bitmap;  // the PNG every render writes, thrown away for a vector export
+  FigureOutput o;
+  o.width = width;
+  o.height = height;
+  if (extension == ".png") {
+    o.png = file.path();
+  } else {
+    bitmap.emplace(path + ".png", inputs);
+    o.png = bitmap->path();
+    o.vector = file.path();
+  }
+  if (name == "map_blocks") {
+    renderBlocksMap(r, request, o);
+  } else if (histogram) {
+    renderQuantityHistogram(r, request, name.substr(5), o);
+  } else {
+    renderQuantityMap(r, request, name.substr(4), o);
+  }
+  file.commit();
+}
+
+namespace {
+
+// The figures of one run of compare, staged in its output folder.
+struct FigureSet {
+  const CompareRequest& request;
+  const std::function<std::string(const std::string&)>& stage;
+  std::vector<std::string> written;
+
+  FigureOutput output(const std::string& name) {
+    // Charts also go to SVG. Maps are PNG only: VTK 9.1's GL2PS export
+    // rasterises 3D props, Debian's GL2PS cannot embed images in SVG, and a PDF
+    // would hold an uncompressed bitmap of the PNG (about 5 MB) and nothing more.
+    FigureOutput o;
+    written.push_back("figures/" + name + ".png");
+    o.png = stage(written.back());
+    if (name.rfind("map_", 0) != 0) {
+      written.push_back("figures/" + name + "." + request.vectorFormat);
+      o.vector = stage(written.back());
+    }
+    o.width = static_cast<int>(value(request, "figure-width"));
+    o.height = static_cast<int>(value(request, "figure-height"));
+    return o;
+  }
+};
+
+std::vector<std::string> drawCompareFigures(const CompareResult& r, const CompareRequest& request,
+                                            const std::function<std::string(const std::string&)>& stage,
+                                            const ProgressFn& progress) {
+  FigureSet f{request, stage, {}};
+  renderQuantityMap(r, request, "aspect_ratio", f.output("map_aspect_ratio"));
+  reportProgress(progress, 0.4, "figures");
+  std::size_t index = 0;
+  for (analysis::ComparedMetric m : analysis::kComparedMetrics) {
+    // Nothing to draw when neither side has a finite value.
+    if (!r.histograms[index++].edges.empty()) {
+      renderQuantityHistogram(r, request, analysis::metricName(m),
+                              f.output(std::string("hist_") + analysis::metricName(m)));
+    }
+  }
+  reportProgress(progress, 0.7, "figures");
+  renderBlocksMap(r, request, f.output("map_blocks"));
+  if (!drawnAnyway(request.metric, false)) {
+    renderQuantityMap(r, request, request.metric, f.output("map_" + request.metric));
+  }
+  if (!drawnAnyway(request.metric, true)) {
+    renderQuantityHistogram(r, request, request.metric, f.output("hist_" + request.metric));
+  }
+  return f.written;
+}
+
+}  // namespace
+
+const pipeline::FigureRenderer& compareFigureRenderer() {
+  static const pipeline::FigureRenderer renderer{requireDisplay, drawCompareFigures, vtkVersionString()};
+  return renderer;
+}
+
+pipeline::JobOutcome runCompare(const CompareRequest& request, const std::string& outDir,
+                                const ProgressFn& progress) {
+  return pipeline::runCompare(request, outDir, progress, &compareFigureRenderer());
+}
+
+}  // namespace parcelscope::viz
