@@ -1,6 +1,5 @@
 #include "Args.h"
 
-#include <cstdlib>
 #include <sstream>
 
 #include "parcelscope/core/Error.h"
@@ -38,11 +37,7 @@ Args::Args(const std::vector<std::string>& args, const std::vector<FlagSpec>& fl
       val = args[++i];
     }
     if (param) {
-      char* end = nullptr;
-      const double v = std::strtod(val.c_str(), &end);
-      if (val.empty() || *end != '\0') throw usageError("--" + name + " " + val + " is not a number");
-      checkValue(*param, v);
-      parameters_[name] = v;
+      parameters_[name] = parseValue(*param, val);
       given_.insert(name);
     } else {
       values_[name] = val;
@@ -56,19 +51,50 @@ std::optional<std::string> Args::value(const std::string& flag) const {
   return it->second;
 }
 
+namespace {
+
+// After the flag: "X  [0, 50] m, default 1", "N  [2, 500], default 30",
+// "LABEL  0 street-width, 1 street-length; default street-width",
+// "yes|no  (or 1|0, true|false), default yes".
+std::string valueSummary(const ParameterDescription& p) {
+  std::ostringstream s;
+  s.precision(12);
+  switch (p.kind) {
+    case ParameterKind::Enum:
+      s << "LABEL ";
+      for (std::size_t i = 0; i < p.labels.size(); ++i) {
+        s << (i ? ", " : " ") << p.minimum + static_cast<double>(i) << " " << p.labels[i];
+      }
+      s << ";";
+      break;
+    case ParameterKind::Boolean:
+      s << "yes|no  (or 1|0, true|false),";
+      break;
+    case ParameterKind::Integer:
+    case ParameterKind::Real:
+      s << (p.integer() ? "N" : "X") << "  [" << p.minimum << ", " << p.maximum << "]"
+        << (p.unit.empty() ? "" : " " + p.unit) << ",";
+      break;
+  }
+  s << " default " << formatValue(p, p.defaultValue);
+  return s.str();
+}
+
+}  // namespace
+
 std::string usageText(const std::string& synopsis, const std::vector<FlagSpec>& flags,
                       const std::vector<ParameterDescription>& parameters) {
   std::ostringstream s;
-  s.precision(12);
   s << "usage: " << synopsis << "\n\noptions:\n";
   for (const auto& f : flags) {
     s << "  --" << f.name << (f.takesValue ? " VALUE" : "") << "\n      " << f.help << "\n";
   }
   if (!parameters.empty()) s << "\nparameters:\n";
-  for (const auto& p : parameters) {
-    s << "  --" << p.name << " " << (p.integer ? "N" : "X") << "  [" << p.minimum << ", " << p.maximum
-      << "]" << (p.unit.empty() ? "" : " " + p.unit) << ", default " << p.defaultValue << "\n      "
-      << p.help << "\n";
+  for (const auto& [group, members] : groupParameters(parameters)) {
+    s << "  " << group << "\n";
+    for (const auto& p : members) {
+      s << "    --" << p.name << " " << valueSummary(p) << "\n        " << p.help << "\n";
+    }
   }
   return s.str();
 }

@@ -20,7 +20,9 @@ struct FlagSpec {
 class Args {
 public:
   /// Parses `args` (after the subcommand). Throws Error(Usage) on an unknown
-  /// flag, a missing value, a parameter that is not a number or is out of range.
+  /// flag, a missing value, a parameter value that is not valid (parseValue():
+  /// numbers for every parameter, an enum's labels, true/false/yes/no for a
+  /// boolean) or is out of range.
   Args(const std::vector<std::string>& args, const std::vector<FlagSpec>& flags,
        const std::vector<ParameterDescription>& parameters);
 
@@ -39,7 +41,9 @@ private:
   std::set<std::string> given_;
 };
 
-/// Help text listing flags and parameters (name, unit, range, default, help).
+/// Help text listing flags, then the parameters by group (ParameterDescription::group,
+/// in order of first appearance), each with unit, range, default and help, and an
+/// enum's labels with their numbers.
 std::string usageText(const std::string& synopsis, const std::vector<FlagSpec>& flags,
                       const std::vector<ParameterDescription>& parameters);
 

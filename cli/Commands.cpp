@@ -27,6 +27,7 @@ const char* kOverview =
     "  generate  subdivide blocks into procedural parcels (OBB, skeleton or offset style)\n"
     "  compare   generate parcels in the blocks of observed ones and compare the two sets:\n"
     "            per-block and city-wide tables, distances, layers and figures\n"
+    "  metrics   print the table of parcel metrics (Markdown, as in docs/user/metrics.md)\n"
     "  version   print the version\n"
     "\n"
     "'parcelscope COMMAND --help' describes a command's options.\n";
@@ -34,7 +35,9 @@ const char* kOverview =
 std::vector<FlagSpec> inputFlags() {
   return {{"layer", "layer to read (default: the first)"},
           {"where", "OGR SQL attribute filter, e.g. \"ML <> 'ROAD'\""},
-          {"crs", "CRS of the input (e.g. EPSG:2286), replacing a missing or wrong one"}};
+          {"crs", "CRS of the input (e.g. EPSG:2286), replacing a missing or wrong one"},
+          {"key-field", "field whose value is each feature's stable key (parcel_key, block_key); default: the "
+                        "features' geometries"}};
 }
 
 FlagSpec styleFlag() {
@@ -74,6 +77,7 @@ io::ReadOptions readOptions(const Args& a) {
   input.layer = a.value("layer").value_or("");
   input.where = a.value("where").value_or("");
   input.crsOverride = a.value("crs").value_or("");
+  input.keyField = a.value("key-field").value_or("");
   return input;
 }
 }  // namespace
@@ -88,10 +92,34 @@ int dispatch(const std::vector<std::string>& args) {
     std::printf("parcelscope %s\n", pipeline::version().c_str());
     return 0;
   }
+  if (args[0] == "metrics") return metricsCommand(rest);
   if (args[0] == "stats") return statsCommand(rest);
   if (args[0] == "generate") return generateCommand(rest);
   if (args[0] == "compare") return compareCommand(rest);
-  throw usageError("unknown command '" + args[0] + "' (commands: stats, generate, compare, version)");
+  throw usageError("unknown command '" + args[0] + "' (commands: stats, generate, compare, metrics, version)");
+}
+
+int metricsCommand(const std::vector<std::string>& args) {
+  if (wantsHelp(args)) {
+    std::fputs("usage: parcelscope metrics\n\nPrints every parcel metric (name, unit, formula, range, source) as a\n"
+               "Markdown table: the table of docs/user/metrics.md, made from the metric registry.\n",
+               stdout);
+    return 0;
+  }
+  if (!args.empty()) throw usageError("metrics takes no arguments");
+  // A vertical bar inside a cell is escaped, so the table stays a table.
+  auto cell = [](std::string text) {
+    if (text.empty()) return std::string("-");
+    for (std::size_t i = text.find('|'); i != std::string::npos; i = text.find('|', i + 2)) text.insert(i, "\\");
+    return text;
+  };
+  std::printf("| metric | unit | formula | range | source |\n|---|---|---|---|---|\n");
+  for (const auto& q : analysis::parcelMetrics()) {
+    const std::string formula = q.formula + (q.context ? "; measured against the parcel's surroundings" : "");
+    std::printf("| `%s` | %s | %s | %s | %s |\n", q.name.c_str(), cell(q.unit).c_str(), cell(formula).c_str(),
+                cell(q.range).c_str(), cell(q.source).c_str());
+  }
+  return 0;
 }
 
 int statsCommand(const std::vector<std::string>& args) {
@@ -163,7 +191,7 @@ int compareCommand(const std::vector<std::string>& args) {
                "are given; both sets are measured alike and compared. Writes DIR/parcels.gpkg, blocks.gpkg,\n"
                "observed_parcels.csv, generated_parcels.csv, blocks.csv, summary.csv, distances.csv,\n"
                "summary.json, run.json and DIR/figures/*.png and *.svg or *.pdf (figures need an X server: use\n"
-               "'xvfb-run -a' without a screen, or --figures 0).\n",
+               "'xvfb-run -a' without a screen, or --figures no).\n",
                stdout);
     return 0;
   }
@@ -178,6 +206,7 @@ int compareCommand(const std::vector<std::string>& args) {
     if (auto v = a.value("layer")) request.input.layer = *v;
     if (auto v = a.value("where")) request.input.where = *v;
     if (auto v = a.value("crs")) request.input.crsOverride = *v;
+    if (auto v = a.value("key-field")) request.input.keyField = *v;
     const ParameterValues values = a.parameters();
     for (const auto& name : givenParameters(a, params)) {
       request.parameters[name] = values.at(name);

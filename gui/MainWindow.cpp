@@ -87,28 +87,17 @@ private:
   double last_ = 0;
 };
 
-// Parameters the panel shows first (the list), then every other
-// parameter of compare except the figure settings, which only exports use.
-const char* kFirst[] = {"k", "a-min", "a-max", "w-min", "w-max", "omega", "xi", "offset", "seed"};
+// The per-block bounds, and the parameters a block override offers.
 const char* kBounds[] = {"a-min", "a-max", "w-min", "w-max"};
 const char* kBlockParameters[] = {"a-min", "a-max", "w-min", "w-max", "omega", "offset", "seed"};
 
+// Every parameter of compare, in its groups, but the settings of written files
+// (outputOnly: figures and their size, the layers' index), which exports take
+// from their dialogs.
 std::vector<ParameterDescription> panelParameters() {
-  const auto all = pipeline::compareParameters();
   std::vector<ParameterDescription> out;
-  for (const char* name : kFirst) {
-    for (const auto& d : all) {
-      if (d.name == name) out.push_back(d);
-    }
-  }
-  for (const auto& d : all) {
-    // Options of written files, not of the parcels.
-    if (d.name == "figures" || d.name == "spatial-index" || d.name == "figure-width" || d.name == "figure-height") {
-      continue;
-    }
-    bool seen = false;
-    for (const auto& o : out) seen = seen || o.name == d.name;
-    if (!seen) out.push_back(d);
+  for (const auto& d : pipeline::compareParameters()) {
+    if (!d.outputOnly) out.push_back(d);
   }
   return out;
 }
@@ -336,7 +325,7 @@ QWidget* MainWindow::buildControls() {
     auto* check = new QCheckBox(QString::fromStdString(d.name));
     auto* spin = new QDoubleSpinBox;
     spin->setRange(d.minimum, d.maximum);
-    spin->setDecimals(d.integer ? 0 : 2);
+    spin->setDecimals(d.integer() ? 0 : 2);
     spin->setValue(d.defaultValue);
     spin->setEnabled(false);
     connect(check, &QCheckBox::toggled, spin, &QWidget::setEnabled);
@@ -430,6 +419,7 @@ void MainWindow::openFile(const QString& path, const QString& layer, const QStri
   next.input.crsOverride = crs.toStdString();
   next.input.layer = layer.toStdString();
   next.overrides.clear();
+  next.overridesById.clear();
   if (layer.isEmpty()) {
     try {
       const auto names = io::layerNames(next.input.path);
@@ -603,13 +593,17 @@ void MainWindow::overrideSelectedBlock(const QString& style, const ParameterValu
   pipeline::BlockOverride o;
   o.style = style.toStdString();
   o.parameters = parameters;
-  request_.overrides[result_->observed->analysis.blocks[selected_].id] = o;
+  const Block& block = result_->observed->analysis.blocks[selected_];
+  request_.overridesById.erase(block.id);  // a version 1 session's override of the same block
+  request_.overrides[block.key] = o;
   submit();
 }
 
 void MainWindow::clearSelectedOverride() {
   if (!result_ || selected_ < 0) return;
-  request_.overrides.erase(result_->observed->analysis.blocks[selected_].id);
+  const Block& block = result_->observed->analysis.blocks[selected_];
+  request_.overrides.erase(block.key);
+  request_.overridesById.erase(block.id);
   submit();
 }
 
@@ -947,7 +941,7 @@ void MainWindow::showBlock() {
       styles += (styles.isEmpty() ? "" : ", ") + QString::fromStdString(r.generated.blockStyles[k]);
     }
   }
-  const bool overridden = request_.overrides.count(block.id) > 0;
+  const bool overridden = request_.overrides.count(block.key) > 0 || request_.overridesById.count(block.id) > 0;
   setBlockInfo(
       QString("<b>Block %1</b> (%2 m&sup2;; subdivided with %3%4)<br>"
               "<table cellspacing=4><tr><th></th><th>observed</th><th>procedural</th></tr>"

@@ -146,29 +146,57 @@ const char* metricName(ComparedMetric m) {
   return "";
 }
 
-const char* metricUnit(ComparedMetric m) {
-  switch (m) {
-    case ComparedMetric::Area: return "m2";
-    case ComparedMetric::Width: return "m";
-    case ComparedMetric::AspectRatio: return "";
-  }
-  return "";
+const char* metricUnit(ComparedMetric m) { return parcelQuantity(metricName(m)).unit.c_str(); }
+
+const std::vector<ParcelQuantity>& parcelMetrics() {
+  using M = ParcelMetrics;
+  static const std::vector<ParcelQuantity> q = {
+      {"area", "area (m\xc2\xb2)", [](const M& m) { return m.area; }, false, "m2", false,
+       "|outer ring| - sum of |holes| (shoelace)", "> 0", "Vanegas et al. 2012, section 6 (A)"},
+      {"perimeter", "perimeter (m)", [](const M& m) { return m.perimeter; }, false, "m", false,
+       "length of the outer ring plus the holes", "> 0", ""},
+      {"width", "width, short side of the minimum bounding rectangle (m)", [](const M& m) { return m.width; }, false,
+       "m", false, "short side of the minimum-area bounding rectangle (MBR)", ">= 0",
+       "Vanegas et al. 2012, section 6 (minimum width W)"},
+      {"length", "length, long side of the minimum bounding rectangle (m)", [](const M& m) { return m.length; },
+       false, "m", false, "long side of the MBR", ">= width", ""},
+      {"aspect_ratio", "aspect ratio (length / width)", [](const M& m) { return m.aspectRatio; }, false, "", false,
+       "length / width", "[1, inf)", "Vanegas et al. 2012, Figure 1 (the colour maps)"},
+      {"elongation", "elongation (MBR width / length)", [](const M& m) { return m.elongation; }, false, "", false,
+       "width / length of the MBR; 1 is a square", "(0, 1]", "momepy.elongation (Gil et al. 2012)"},
+      {"rectangularity", "rectangularity (area / MBR area)", [](const M& m) { return m.rectangularity; }, false, "",
+       false, "area / MBR area; 1 is a rectangle", "(0, 1]", "momepy.rectangularity (Dibble et al. 2019)"},
+      {"p_angle", "p_angle, mean corner deviation from 90\xc2\xb0 (degrees)", [](const M& m) { return m.pAngle; },
+       false, "deg", false,
+       "mean over the outer ring's corners (turns above 10 degrees) of | |turn| - 90 |; 0 without corners",
+       "[0, 90)", "Yang et al. 2013, section 6"},
+      {"p_area", "p_area, bounding rectangle area / area", [](const M& m) { return m.pArea; }, false, "", false,
+       "MBR area / area", "[1, inf)", "Yang et al. 2013, section 6 (undesirable: p_angle > 15 or p_area > 1.2)"},
+      {"neighbours", "neighbours (parcels sharing at least 1 m of boundary)",
+       [](const M& m) { return static_cast<double>(m.neighbours); }, true, "", true,
+       "parcels of the same block sharing at least 1 m of boundary (edges parallel within 10 degrees and within "
+       "min(block tolerance, 1 m))",
+       ">= 0", ""},
+      {"frontage", "frontage, boundary on the block's outer contour (m)", [](const M& m) { return m.frontage; }, true,
+       "m", false, "boundary length on the block's outer outline (facing a street), edges within half the block tolerance "
+       "(5 cm to 0.5 m)",
+       ">= 0", "Vanegas et al. 2012, section 4 (street access)"},
+      {"street_access", "street access (1: at least min-frontage on the block contour)",
+       [](const M& m) { return m.streetAccess ? 1.0 : 0.0; }, true, "", true, "1 when frontage >= --min-frontage (default 1 m)",
+       "0 or 1", "Vanegas et al. 2012, section 4"},
+  };
+  return q;
 }
 
 const std::vector<ParcelQuantity>& parcelQuantities() {
-  static const std::vector<ParcelQuantity> q = {
-      {"aspect_ratio", "aspect ratio (length / width)", [](const ParcelMetrics& m) { return m.aspectRatio; }},
-      {"area", "area (m\xc2\xb2)", [](const ParcelMetrics& m) { return m.area; }},
-      {"width", "width, short side of the minimum bounding rectangle (m)",
-       [](const ParcelMetrics& m) { return m.width; }},
-      {"neighbours", "neighbours (parcels sharing at least 1 m of boundary)",
-       [](const ParcelMetrics& m) { return static_cast<double>(m.neighbours); }, true},
-      {"street_access", "street access (1: at least min-frontage on the block contour)",
-       [](const ParcelMetrics& m) { return m.streetAccess ? 1.0 : 0.0; }, true},
-      {"p_angle", "p_angle, mean corner deviation from 90\xc2\xb0 (degrees)",
-       [](const ParcelMetrics& m) { return m.pAngle; }},
-      {"p_area", "p_area, bounding rectangle area / area", [](const ParcelMetrics& m) { return m.pArea; }},
-  };
+  static const std::vector<ParcelQuantity> q = [] {
+    std::vector<ParcelQuantity> out;
+    for (const ParcelQuantity& m : parcelMetrics()) {
+      if (m.name == "aspect_ratio") out.insert(out.begin(), m);
+      else out.push_back(m);
+    }
+    return out;
+  }();
   return q;
 }
 
@@ -273,7 +301,7 @@ Comparison compareSets(const std::vector<ParcelMetrics>& observed, const std::ve
 Table blockComparisonTable(const std::vector<BlockComparison>& blocks) {
   using T = Column::Type;
   Table t;
-  t.columns = {{"block_id", T::Integer, ""}, {"block_area", T::Real, "m2"}};
+  t.columns = {{"block_id", T::Integer, ""}, {"block_key", T::String, ""}, {"block_area", T::Real, "m2"}};
   // Observed and generated side by side, in the order of the paper's table.
   const std::pair<const char*, const char*> pairs[] = {
       {"parcels", ""},          {"mean_area", "m2"},           {"sd_area", "m2"},
@@ -293,7 +321,7 @@ Table blockComparisonTable(const std::vector<BlockComparison>& blocks) {
   for (const BlockComparison& b : blocks) {
     const SetSummary& o = b.comparison.observed;
     const SetSummary& g = b.comparison.generated;
-    std::vector<Value> row = {b.blockId, b.blockArea, o.parcels, g.parcels};
+    std::vector<Value> row = {b.blockId, keyText(b.blockKey), b.blockArea, o.parcels, g.parcels};
     for (const auto& [ov, gv] : {std::pair{o.meanArea, g.meanArea}, {o.sdArea, g.sdArea},
                                  {o.meanWidth, g.meanWidth}, {o.sdWidth, g.sdWidth},
                                  {o.meanAspectRatio, g.meanAspectRatio},

@@ -6,26 +6,38 @@
 
 #include "BoxPairs.h"
 #include "Contacts.h"
+#include "parcelscope/analysis/Comparison.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
 #include "parcelscope/core/GeosOps.h"
 
 namespace parcelscope::analysis {
 
+const ParameterDescription& minFrontageParameter() {
+  static const ParameterDescription d = realParameter(
+      "min-frontage",
+      "Length of the block's outer contour a parcel must run along to count as having street access (observed "
+      "and generated parcels alike)",
+      "m", 0.0, 1000.0, 1.0, "Blocks");
+  return d;
+}
+
 const std::vector<ParameterDescription>& analysisParameters() {
+  // k first: its group, Bounds, then comes first in compare's --help and the GUI.
   static const std::vector<ParameterDescription> d = {
-      {"block-tolerance",
-       "Parcels whose boundaries come this close belong to one block; gaps narrower than this are "
-       "closed in the block outline",
-       "m", 0.0, 50.0, 1.0},
-      {"k", "Number of standard deviations in A_min/A_max = A-bar -/+ k s_A and W_min/W_max = W-bar -/+ k s_W",
-       "", 0.0, 10.0, 2.0},
-      {"min-frontage", "Boundary on the block's outer contour a parcel needs for street access", "m", 0.0,
-       1000.0, 1.0},
-      {"detect-right-of-way",
-       "1: detect parcels that are streets (holes holding parcels, or network shape) and keep them out "
-       "of blocks; 0: treat every parcel as a lot",
-       "", 0.0, 1.0, 1.0, true},
+      realParameter("k",
+                    "Number of standard deviations in A_min/A_max = A-bar -/+ k s_A and W_min/W_max = "
+                    "W-bar -/+ k s_W",
+                    "", 0.0, 10.0, 2.0, "Bounds"),
+      realParameter("block-tolerance",
+                    "Parcels whose boundaries come this close belong to one block; gaps narrower than this are "
+                    "closed in the block outline",
+                    "m", 0.0, 50.0, 1.0, "Blocks"),
+      minFrontageParameter(),
+      booleanParameter("detect-right-of-way",
+                       "Detect parcels that are streets (holes holding parcels, or network shape) and keep them "
+                       "out of blocks; no: treat every parcel as a lot",
+                       true, "Blocks"),
   };
   return d;
 }
@@ -238,6 +250,22 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
     out.blockOf[i] = rootBlock[r];
     out.blocks[rootBlock[r]].parcels.push_back(static_cast<int>(i));
   }
+  // Each block's key, and its members in the order of their keys: sums over
+  // them (the statistics, the outline's union) are then the same to the bit
+  // whatever the order of the input's features.
+  for (Block& block : out.blocks) {
+    std::vector<std::pair<Key, int>> members;
+    members.reserve(block.parcels.size());
+    for (int i : block.parcels) members.emplace_back(parcelKey(parcels[i]), i);
+    std::sort(members.begin(), members.end());
+    std::vector<Key> keys;
+    keys.reserve(members.size());
+    for (std::size_t m = 0; m < members.size(); ++m) {
+      keys.push_back(members[m].first);
+      block.parcels[m] = members[m].second;
+    }
+    block.key = setKey(std::move(keys));
+  }
 
   // 5. Block outlines, frontage and statistics.
   out.timings.start("block_outlines");
@@ -337,31 +365,43 @@ std::vector<ParcelMetrics> measureParcels(const std::vector<Polygon>& shapes, co
 }
 
 std::vector<Column> metricColumns() {
-  using T = Column::Type;
-  return {{"area", T::Real, "m2"},           {"perimeter", T::Real, "m"},     {"width", T::Real, "m"},
-          {"length", T::Real, "m"},          {"aspect_ratio", T::Real, ""},   {"elongation", T::Real, ""},
-          {"rectangularity", T::Real, ""},   {"p_angle", T::Real, "deg"},     {"p_area", T::Real, ""},
-          {"neighbours", T::Integer, ""},    {"frontage", T::Real, "m"},      {"street_access", T::Integer, ""}};
+  std::vector<Column> columns;
+  for (const ParcelQuantity& q : parcelMetrics()) {
+    columns.push_back({q.name, q.integer ? Column::Type::Integer : Column::Type::Real, q.unit});
+  }
+  return columns;
 }
 
 std::vector<Value> metricValues(const ParcelMetrics& m) {
-  return {m.area,         m.perimeter,    m.width, m.length, m.aspectRatio, m.elongation, m.rectangularity,
-          m.pAngle,       m.pArea,        std::int64_t(m.neighbours), m.frontage, std::int64_t(m.streetAccess)};
+  const auto& metrics = parcelMetrics();
+  std::vector<Value> values;
+  values.reserve(metrics.size());
+  for (const ParcelQuantity& q : metrics) {
+    if (q.integer) {
+      values.emplace_back(static_cast<std::int64_t>(q.value(m)));
+    } else {
+      values.emplace_back(q.value(m));
+    }
+  }
+  return values;
 }
 
 Table parcelTable(const std::vector<Parcel>& parcels, const ObservedAnalysis& a) {
   using T = Column::Type;
   Table t;
-  t.columns = {{"parcel_id", T::Integer, ""}, {"source_fid", T::Integer, ""}, {"part", T::Integer, ""},
-               {"block_id", T::Integer, ""},  {"role", T::String, ""},        {"stack_count", T::Integer, ""},
-               {"repaired", T::Integer, ""}};
+  t.columns = {{"parcel_id", T::Integer, ""},  {"parcel_key", T::String, ""}, {"source_fid", T::Integer, ""},
+               {"part", T::Integer, ""},       {"block_id", T::Integer, ""},   {"block_key", T::String, ""},
+               {"role", T::String, ""},        {"stack_count", T::Integer, ""}, {"repaired", T::Integer, ""}};
   for (Column& c : metricColumns()) t.columns.push_back(std::move(c));
   static const char* roles[] = {"lot", "right_of_way_holes", "right_of_way_network"};
   for (std::size_t i = 0; i < parcels.size(); ++i) {
+    const int block = a.blockOf[i];
     std::vector<Value> row = {std::int64_t(i),
+                              keyText(parcelKey(parcels[i])),
                               std::int64_t(parcels[i].sourceFid),
                               std::int64_t(parcels[i].part),
-                              std::int64_t(a.blockOf[i]),
+                              std::int64_t(block),
+                              block >= 0 ? keyText(a.blocks[static_cast<std::size_t>(block)].key) : std::string(),
                               std::string(roles[static_cast<int>(a.rightOfWay[i])]),
                               std::int64_t(parcels[i].stackCount),
                               std::int64_t(parcels[i].repaired)};
@@ -374,7 +414,8 @@ Table parcelTable(const std::vector<Parcel>& parcels, const ObservedAnalysis& a)
 Table blockTable(const ObservedAnalysis& a) {
   using T = Column::Type;
   Table t;
-  t.columns = {{"block_id", T::Integer, ""},       {"parcel_count", T::Integer, ""},
+  t.columns = {{"block_id", T::Integer, ""},       {"block_key", T::String, ""},
+               {"parcel_count", T::Integer, ""},
                {"block_area", T::Real, "m2"},      {"parts", T::Integer, ""},
                {"mean_area", T::Real, "m2"},       {"sd_area", T::Real, "m2"},
                {"mean_width", T::Real, "m"},       {"sd_width", T::Real, "m"},
@@ -384,7 +425,7 @@ Table blockTable(const ObservedAnalysis& a) {
                {"street_access_share", T::Real, ""}};
   for (std::size_t b = 0; b < a.blocks.size(); ++b) {
     const BlockStatistics& s = a.statistics[b];
-    t.rows.push_back({std::int64_t(s.blockId), std::int64_t(s.parcelCount), s.blockArea,
+    t.rows.push_back({std::int64_t(s.blockId), keyText(a.blocks[b].key), std::int64_t(s.parcelCount), s.blockArea,
                       std::int64_t(a.blocks[b].parts.size()), s.meanArea, s.sdArea, s.meanWidth, s.sdWidth,
                       s.aMin, s.aMax, s.wMin, s.wMax, std::int64_t(s.aMinClamped),
                       std::int64_t(s.wMinClamped), s.streetAccessShare});

@@ -9,6 +9,7 @@
 #include "PolygonSplit.h"
 #include "Random.h"
 #include "parcelscope/analysis/Metrics.h"
+#include "parcelscope/analysis/ObservedAnalysis.h"
 #include "parcelscope/core/GeosOps.h"
 #include "BlockFailure.h"
 
@@ -16,20 +17,23 @@ namespace parcelscope::generation {
 
 const std::vector<ParameterDescription>& obbParameterDescriptions() {
   static const std::vector<ParameterDescription> d = {
-      {"a-min", "Smallest parcel area a split may create", "m2", 0.0, 1e8, 200.0},
-      {"a-max", "Parcels larger than this are split", "m2", 1.0, 1e8, 800.0},
-      {"w-min", "Smallest parcel width (OBB short side) a split may create", "m", 0.0, 1e5, 8.0},
-      {"w-max", "Parcels wider than this are split", "m", 0.1, 1e5, 30.0},
-      {"omega", "Split irregularity: the split line moves up to omega x 1/4 of the parcel's length off centre",
-       "", 0.0, 1.0, 0.3},
-      {"xi", "Street-access preference: probability that a split leaving a parcel without street access is "
-             "replaced by one that does not",
-       "", 0.0, 1.0, 1.0},
-      {"snap", "Split lines passing this close to a block contour vertex are moved through it", "m", 0.0, 1000.0,
-       2.0},
-      {"min-frontage", "Block contour a parcel needs to count as having street access", "m", 0.0, 1000.0, 1.0},
-      {"seed", "Seed of the random choices; the same seed gives the same parcels", "", 0.0, 4294967295.0, 1.0,
-       true},
+      realParameter("a-min", "Smallest parcel area a split may create", "m2", 0.0, 1e8, 200.0, "Bounds"),
+      realParameter("a-max", "Parcels larger than this are split", "m2", 1.0, 1e8, 800.0, "Bounds"),
+      realParameter("w-min", "Smallest parcel width (OBB short side) a split may create", "m", 0.0, 1e5, 8.0,
+                    "Bounds"),
+      realParameter("w-max", "Parcels wider than this are split", "m", 0.1, 1e5, 30.0, "Bounds"),
+      realParameter("omega",
+                    "Split irregularity: the split line moves up to omega x 1/4 of the parcel's length off centre",
+                    "", 0.0, 1.0, 0.3, "Subdivision"),
+      realParameter("xi",
+                    "Street-access preference: probability that a split leaving a parcel without street access "
+                    "is replaced by one that does not",
+                    "", 0.0, 1.0, 1.0, "Subdivision"),
+      realParameter("snap", "Split lines passing this close to a block contour vertex are moved through it", "m",
+                    0.0, 1000.0, 2.0, "Subdivision"),
+      analysis::minFrontageParameter(),
+      integerParameter("seed", "Seed of the random choices; the same seed gives the same parcels", "", 0.0,
+                       4294967295.0, 1.0, "Subdivision"),
   };
   return d;
 }

@@ -26,18 +26,20 @@ namespace parcelscope::generation {
 
 const std::vector<ParameterDescription>& skeletonParameterDescriptions() {
   static const std::vector<ParameterDescription> d = {
-      {"offset",
-       "d_offset: depth of the parcel strips from the street; a patio fills what lies deeper. 0: no patio, "
-       "parcels reach the skeleton's centre line (style offset: 0 means 30 m)",
-       "m", 0.0, 1e5, 0.0},
-      {"street-angle", "Contour corners turning by less than this continue the same logical street", "deg", 0.0,
-       180.0, 30.0},
-      {"corner-rule",
-       "Which street a corner parcel faces: 0 StreetWidth (the wider street; the longer one when widths are "
-       "equal or unknown), 1 StreetLength (the longer street)",
-       "", 0.0, 1.0, 0.0, true},
-      {"patio-obb", "1: subdivide patios with the OBB style; 0: each patio is one parcel (style offset: always 1)",
-       "", 0.0, 1.0, 0.0, true},
+      realParameter("offset",
+                    "d_offset: depth of the parcel strips from the street; a patio fills what lies deeper. 0: no "
+                    "patio, parcels reach the skeleton's centre line (style offset: 0 means 30 m)",
+                    "m", 0.0, 1e5, 0.0, "Skeleton"),
+      realParameter("street-angle", "Contour corners turning by less than this continue the same logical street",
+                    "deg", 0.0, 180.0, 30.0, "Skeleton"),
+      enumParameter("corner-rule",
+                    "Which street a corner parcel faces: street-width, the wider one (the longer one when "
+                    "widths are equal or unknown); street-length, the longer one",
+                    {"street-width", "street-length"}, "street-width", "Skeleton"),
+      booleanParameter("patio-obb",
+                       "Subdivide patios with the OBB style; no: each patio is one parcel (style offset: always "
+                       "yes)",
+                       false, "Skeleton"),
   };
   return d;
 }

@@ -17,15 +17,8 @@ const std::vector<std::pair<std::string, std::string>>& generationStyles() {
 
 std::vector<ParameterDescription> generationParameterDescriptions() {
   std::vector<ParameterDescription> params = obbParameterDescriptions();
-  auto add = [&](const std::vector<ParameterDescription>& more) {
-    for (const auto& d : more) {
-      bool seen = false;
-      for (const auto& p : params) seen = seen || p.name == d.name;
-      if (!seen) params.push_back(d);
-    }
-  };
-  add(skeletonParameterDescriptions());
-  add(analysis::analysisParameters());
+  appendParameters(params, skeletonParameterDescriptions());
+  appendParameters(params, analysis::analysisParameters());
   return params;
 }
 

@@ -58,6 +58,7 @@ struct Feature {
   std::unique_ptr<OGRGeometry> geometry;
   int stackCount = 1;
   std::vector<double> values;  // ReadOptions::numericFields
+  Key key = 0;                 // Parcel::featureKey
 };
 
 struct Envelope {
@@ -290,6 +291,23 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
   for (const auto& name : options.numericFields) {
     fieldIndex.push_back(layer->GetLayerDefn()->GetFieldIndex(name.c_str()));
   }
+  const int keyIndex = options.keyField.empty() ? -1 : layer->GetLayerDefn()->GetFieldIndex(options.keyField.c_str());
+  if (!options.keyField.empty() && keyIndex < 0 && !options.keyFieldOptional) {
+    throw inputError(path + ": layer " + result.layerName + " has no field '" + options.keyField + "' (--key-field)");
+  }
+  // A feature's key: its key field's value, else its geometry (see Parcel::featureKey).
+  auto featureKey = [&](const OGRFeature& feature, const std::string& geometryWkb) -> Key {
+    if (keyIndex >= 0 && feature.IsFieldSetAndNotNull(keyIndex)) {
+      const char* value = feature.GetFieldAsString(keyIndex);
+      if (const auto parsed = parseKey(value)) return *parsed;
+      return hashBytes(value);
+    }
+    if (keyIndex >= 0 && !options.keyFieldOptional) {
+      throw inputError(path + ": feature " + std::to_string(feature.GetFID()) + " has no value in key field '" +
+                       options.keyField + "'");
+    }
+    return hashBytes(geometryWkb);
+  };
 
   // Pass 1: read features, collapse exact duplicate geometries, find the extent.
   const GIntBig total = layer->GetFeatureCount(FALSE);
@@ -327,6 +345,8 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
       if (original->stackCount == 1) ++report.duplicateStacks;
       ++original->stackCount;
       ++report.duplicatesCollapsed;
+      // The stack's key is the least of its features' keys, whatever their order.
+      original->key = std::min(original->key, featureKey(*feature, wkb));
       continue;
     }
     OGREnvelope e;
@@ -344,8 +364,9 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
                                                                     : std::numeric_limits<double>::quiet_NaN());
     }
     byHash.emplace(hash, features.size());
-    features.push_back(
-        {feature->GetFID(), std::unique_ptr<OGRGeometry>(feature->StealGeometry()), 1, std::move(values)});
+    const Key key = featureKey(*feature, wkb);
+    features.push_back({feature->GetFID(), std::unique_ptr<OGRGeometry>(feature->StealGeometry()), 1,
+                        std::move(values), key});
   }
   if (CPLGetLastErrorType() == CE_Failure && report.features == 0) {
     throw inputError(path + ": reading layer " + result.layerName + " failed (" + lastGdalMessage() + ")");
@@ -389,6 +410,7 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
       report.partsFromMultipart += static_cast<std::int64_t>(c.parcels.size());
     }
     for (Parcel& p : c.parcels) {
+      p.featureKey = features[k].key;
       if (!p.shape.holes.empty()) ++report.withHoles;
       result.parcels.push_back(std::move(p));
     }

@@ -26,20 +26,22 @@ using analysis::ParcelMetrics;
 
 const std::vector<ParameterDescription>& comparisonParameters() {
   static const std::vector<ParameterDescription> d = {
-      {"bins", "Shared bins of the histograms, in the figures and in the histogram intersection", "", 2, 500, 30,
-       true},
-      {"histogram-quantile",
-       "The bins run from the smallest value to this quantile of both sets pooled; larger values count in the "
-       "last bin",
-       "", 0.5, 1.0, 0.99},
-      {"map-aspect-ratio-max", "Aspect ratio drawn fully green in map_aspect_ratio (1:1 is red)", "", 1.5, 100, 5},
-      {"figures", "1: render the figures (needs an X server); 0: tables and layers only", "", 0, 1, 1, true},
-      {"spatial-index",
-       "1: the GeoPackage layers get an R-tree spatial index (GIS tools draw large layers faster); 0: written "
-       "faster without one",
-       "", 0, 1, 1, true},
-      {"figure-width", "Width of every figure", "px", 200, 10000, 1800, true},
-      {"figure-height", "Height of every figure", "px", 150, 10000, 900, true},
+      integerParameter("bins", "Shared bins of the histograms, in the figures and in the histogram intersection",
+                       "", 2, 500, 30, "Comparison"),
+      realParameter("histogram-quantile",
+                    "The bins run from the smallest value to this quantile of both sets pooled; larger values "
+                    "count in the last bin",
+                    "", 0.5, 1.0, 0.99, "Comparison"),
+      realParameter("map-aspect-ratio-max", "Aspect ratio drawn fully green in map_aspect_ratio (1:1 is red)", "",
+                    1.5, 100, 5, "Figures"),
+      outputOnly(booleanParameter("figures", "Render the figures (needs an X server); no: tables and layers only",
+                                  true, "Figures")),
+      outputOnly(booleanParameter("spatial-index",
+                                  "Give the GeoPackage layers an R-tree spatial index (GIS tools draw large layers "
+                                  "faster); no: written faster without one",
+                                  true, "Output")),
+      outputOnly(integerParameter("figure-width", "Width of every figure", "px", 200, 10000, 1800, "Figures")),
+      outputOnly(integerParameter("figure-height", "Height of every figure", "px", 150, 10000, 900, "Figures")),
   };
   return d;
 }
@@ -92,6 +94,7 @@ pipeline::GenerateRequest generateRequest(const CompareRequest& request, const p
   g.explicitParameters = request.explicitParameters;
   g.observed = observed;
   g.overrides = request.overrides;
+  g.overridesById = request.overridesById;
   return g;
 }
 
@@ -165,6 +168,7 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
     const std::size_t b = todo[t - 1];
     analysis::BlockComparison& c = r.blocks[b];
     c.blockId = a.blocks[b].id;
+    c.blockKey = a.blocks[b].key;
     c.blockArea = a.statistics[b].blockArea;
     const analysis::PreparedSet generated = analysis::prepareSet(pick(r.generated.metrics, generatedIn[b]));
     c.comparison = analysis::compareSets(observedSides[b], generated, bins, quantile);

@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <functional>
+#include <map>
+#include <optional>
 #include <set>
 
 #include "CompareStages.h"
@@ -24,7 +27,8 @@ std::uint64_t runSeedOf(const CompareRequest& request) {
 }
 
 bool sameInput(const io::ReadOptions& a, const io::ReadOptions& b) {
-  return a.path == b.path && a.layer == b.layer && a.where == b.where && a.crsOverride == b.crsOverride;
+  return a.path == b.path && a.layer == b.layer && a.where == b.where && a.crsOverride == b.crsOverride &&
+         a.keyField == b.keyField;
 }
 
 // Analysis parameters that shape the blocks (all but k, which only moves the bounds).
@@ -58,6 +62,8 @@ void measureDeferred(const pipeline::BlockInputs& inputs,
                      const std::vector<std::size_t>& entries, double minFrontage, const ProgressFn& progress,
                      std::set<std::int64_t>& stale) {
   for (std::size_t k : entries) stale.insert(inputs.entries[k].blockId);
+  // Asked once before any work: the loop's own ticks may all come after its last block.
+  reportProgress(progress, 0.0, "measuring context");
   parallelFor(
       entries.size(),
       [&](std::size_t t) { pipeline::measureOutcomeContext(inputs, entries[t], *outcomes[entries[t]], minFrontage); },
@@ -65,6 +71,50 @@ void measureDeferred(const pipeline::BlockInputs& inputs,
         reportProgress(progress, static_cast<double>(n) / static_cast<double>(entries.size()), "measuring context");
       })
                : std::function<void(std::size_t)>());
+}
+
+bool sameRing(const Ring& a, const Ring& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                    [](const Point& p, const Point& q) { return p.x == q.x && p.y == q.y; });
+}
+
+bool sameShape(const Polygon& a, const Polygon& b) {
+  return sameRing(a.outer, b.outer) &&
+         std::equal(a.holes.begin(), a.holes.end(), b.holes.begin(), b.holes.end(), sameRing);
+}
+
+// Street widths equal value for value, unknown (NaN) ones included.
+bool sameWidths(const generation::StreetWidths& a, const generation::StreetWidths& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const auto& x, const auto& y) {
+    return std::equal(x.begin(), x.end(), y.begin(), y.end(),
+                      [](double u, double v) { return u == v || (std::isnan(u) && std::isnan(v)); });
+  });
+}
+
+// Fills `outcomes` and `done` of the new entries from the old ones that hold
+// the same block part (key and part), shape and plan.
+void carryOver(const pipeline::BlockInputs& oldInputs, const std::vector<pipeline::BlockPlan>& oldPlans,
+               const std::vector<std::shared_ptr<pipeline::BlockOutcome>>& oldOutcomes,
+               const pipeline::BlockInputs& inputs, const std::vector<pipeline::BlockPlan>& plans,
+               std::vector<std::shared_ptr<pipeline::BlockOutcome>>& outcomes, std::vector<pipeline::BlockPlan>& done) {
+  std::map<std::pair<Key, int>, std::size_t> old;
+  for (std::size_t k = 0; k < oldInputs.entries.size() && k < oldOutcomes.size(); ++k) {
+    old.emplace(std::make_pair(oldInputs.entries[k].blockKey, oldInputs.entries[k].part), k);
+  }
+  for (std::size_t k = 0; k < inputs.entries.size(); ++k) {
+    const auto& e = inputs.entries[k];
+    const auto it = old.find({e.blockKey, e.part});
+    if (it == old.end()) continue;
+    const std::size_t j = it->second;
+    if (!oldOutcomes[j] || oldPlans[j] != plans[k] || !sameShape(oldInputs.entries[j].shape, e.shape)) continue;
+    if (plans[k].style != "obb") {
+      const bool widths = inputs.widths.size() == inputs.entries.size() &&
+                          oldInputs.widths.size() == oldInputs.entries.size() && sameWidths(inputs.widths[k], oldInputs.widths[j]);
+      if (!widths) continue;
+    }
+    outcomes[k] = oldOutcomes[j];
+    done[k] = oldPlans[j];
+  }
 }
 
 }  // namespace
@@ -133,6 +183,11 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   std::vector<std::shared_ptr<pipeline::BlockOutcome>> outcomes =
       reload ? std::vector<std::shared_ptr<pipeline::BlockOutcome>>(plans.size()) : s.outcomes;
   std::vector<pipeline::BlockPlan> done = reload ? std::vector<pipeline::BlockPlan>(plans.size()) : s.plans;
+  // A reload (another input, or blocks built anew) keeps the outcomes of the
+  // blocks that are the same block by key, the same shape to the bit, with the
+  // same plan (and street widths, for the skeleton styles): an edit of the
+  // input, or its features in another order, regenerates only what changed.
+  if (reload && s.outcomesMatchCurrent) carryOver(s.inputs, s.plans, s.outcomes, inputs, plans, outcomes, done);
   std::vector<std::size_t> todo;
   for (std::size_t k2 = 0; k2 < plans.size(); ++k2) {
     if (!outcomes[k2] || done[k2] != plans[k2]) todo.push_back(k2);
@@ -337,19 +392,21 @@ Json sessionJson(const CompareRequest& request) {
     if (it != request.parameters.end()) parameters.set(name, it->second);
   }
   Json overrides = Json::array();
-  for (const auto& [id, o] : request.overrides) {
+  auto add = [&](Json block, const BlockOverride& o) {
     Json values = Json::object();
     for (const auto& [name, v] : o.parameters) values.set(name, v);
-    overrides.push(Json::object().set("block_id", static_cast<std::int64_t>(id)).set("style", o.style).set(
-        "parameters", values));
-  }
+    overrides.push(block.set("style", o.style).set("parameters", values));
+  };
+  for (const auto& [key, o] : request.overrides) add(Json::object().set("block_key", keyText(key)), o);
+  for (const auto& [id, o] : request.overridesById) add(Json::object().set("block_id", id), o);
   return Json::object()
-      .set("parcelscope_session", 1)
+      .set("parcelscope_session", 2)
       .set("input", Json::object()
                         .set("path", request.input.path)
                         .set("layer", request.input.layer)
                         .set("where", request.input.where)
-                        .set("crs", request.input.crsOverride))
+                        .set("crs", request.input.crsOverride)
+                        .set("key_field", request.input.keyField))
       .set("style", request.style)
       .set("metric", request.metric)
       .set("parameters", parameters)
@@ -386,6 +443,7 @@ CompareRequest readSession(const std::string& path) {
   request.input.layer = text(*input, "layer", "input.");
   request.input.where = text(*input, "where", "input.");
   request.input.crsOverride = text(*input, "crs", "input.");
+  request.input.keyField = text(*input, "key_field", "input.");
   if (const std::string style = text(root, "style", ""); !style.empty()) request.style = style;
   if (const std::string metric = text(root, "metric", ""); !metric.empty()) {
     try {
@@ -418,15 +476,27 @@ CompareRequest readSession(const std::string& path) {
     std::size_t index = 0;
     for (const Json& item : o->elements()) {
       const std::string where = "overrides[" + std::to_string(index++) + "].";
+      if (!item.isObject()) throw bad("member " + where.substr(0, where.size() - 1) + " is not an object");
       const Json* id = item.find("block_id");
-      if (!id || !id->isNumber()) throw bad("member " + where + "block_id is missing or not a number");
+      const Json* key = item.find("block_key");
+      std::optional<Key> parsedKey;
+      if (key) {
+        if (key->isString()) parsedKey = parseKey(key->string());
+        if (!parsedKey) throw bad("member " + where + "block_key is not 16 hexadecimal digits");
+      } else if (!id || !id->isNumber()) {
+        throw bad("member " + where + "block_key (or block_id) is missing or not a number");
+      }
       pipeline::BlockOverride override;
       override.style = text(item, "style", where);
       if (const Json* p = item.find("parameters")) {
         if (!p->isObject()) throw bad("member " + where + "parameters is not an object");
         readValues(*p, where + "parameters.", override.parameters, nullptr);
       }
-      request.overrides[static_cast<std::int64_t>(id->number())] = std::move(override);
+      if (parsedKey) {
+        request.overrides[*parsedKey] = std::move(override);
+      } else {
+        request.overridesById[static_cast<std::int64_t>(id->number())] = std::move(override);
+      }
     }
   }
   return request;

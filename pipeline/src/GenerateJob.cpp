@@ -1,5 +1,7 @@
 #include "parcelscope/pipeline/GenerateJob.h"
 
+#include "parcelscope/pipeline/BlockSource.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -18,15 +20,6 @@ namespace {
 // m: edges of generated parcels this close count as shared (they share them exactly).
 constexpr double kContactTolerance = 0.05;
 
-// A block's seed key: its centroid in the input CRS, rounded to about 0.1 m, so
-// that adding, removing or renumbering other blocks does not reseed it.
-std::int64_t positionKey(const Polygon& shape, const io::LocalFrame& frame) {
-  const Point c = frame.toSource(centroid(shape));
-  const double q = frame.isGeographic() ? 1e-6 : 0.1;
-  const auto qx = static_cast<std::uint64_t>(std::llround(c.x / q));
-  const auto qy = static_cast<std::uint64_t>(std::llround(c.y / q));
-  return static_cast<std::int64_t>(qx * 0x9E3779B97F4A7C15ull ^ qy);
-}
 }  // namespace
 
 namespace {
@@ -64,35 +57,7 @@ bool BlockPlan::operator==(const BlockPlan& o) const {
 }
 
 BlockInputs prepareBlocks(const GenerateRequest& request, const ProgressFn& progress) {
-  BlockInputs in;
-  if (request.fromParcels) {
-    pipeline::ObservedData loaded;
-    if (!request.observed) loaded = pipeline::loadObserved(request.input, request.parameters, progress);
-    const pipeline::ObservedData& observed = request.observed ? *request.observed : loaded;
-    for (std::size_t b = 0; b < observed.analysis.blocks.size(); ++b) {
-      const auto& s = observed.analysis.statistics[b];
-      for (const Polygon& shape : observed.analysis.blocks[b].parts) {
-        in.entries.push_back({observed.analysis.blocks[b].id, shape, s.aMin, s.aMax, s.wMin, s.wMax,
-                              s.streetAccessShare});
-      }
-    }
-    if (request.observed) {
-      in.source = std::make_shared<const io::ParcelLayer>(request.observed->layer);
-    } else {
-      in.source = std::make_shared<const io::ParcelLayer>(std::move(loaded.layer));
-    }
-  } else {
-    io::ReadOptions options = request.input;
-    options.numericFields = {"block_id", "a_min", "a_max", "w_min", "w_max", "street_access_share"};
-    auto layer = std::make_shared<io::ParcelLayer>(io::readParcels(options, progress));
-    for (std::size_t i = 0; i < layer->parcels.size(); ++i) {
-      const auto& f = layer->fields[i];
-      const std::int64_t id = std::isfinite(f[0]) ? static_cast<std::int64_t>(f[0]) : layer->parcels[i].sourceFid;
-      in.entries.push_back({id, layer->parcels[i].shape, f[1], f[2], f[3], f[4], f[5]});
-    }
-    in.source = std::move(layer);
-  }
-  return in;
+  return blockSourceOf(request)->blocks(progress);
 }
 
 const std::vector<StreetWidths>& streetWidthsOf(BlockInputs& inputs) {
@@ -126,10 +91,24 @@ std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInp
   };
   check(request.parameters, "", false);
   std::set<std::int64_t> ids;
-  for (const auto& e : inputs.entries) ids.insert(e.blockId);
-  for (const auto& [id, o] : request.overrides) {
+  std::set<Key> keys;
+  for (const auto& e : inputs.entries) {
+    ids.insert(e.blockId);
+    keys.insert(e.blockKey);
+  }
+  std::vector<std::pair<std::string, const BlockOverride*>> overrides;
+  for (const auto& [key, o] : request.overrides) {
+    const std::string where = "block " + keyText(key);
+    if (!keys.count(key)) throw usageError(where + ": no such block (override)");
+    overrides.emplace_back(where, &o);
+  }
+  for (const auto& [id, o] : request.overridesById) {
     const std::string where = "block " + std::to_string(id);
     if (!ids.count(id)) throw usageError(where + ": no such block (override)");
+    overrides.emplace_back(where, &o);
+  }
+  for (const auto& [where, override] : overrides) {
+    const BlockOverride& o = *override;
     if (!o.style.empty()) checkStyle(o.style, true, where);
     ParameterValues merged = request.parameters;
     for (const auto& [name, v] : o.parameters) merged[name] = v;
@@ -153,14 +132,19 @@ std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInp
   std::vector<BlockPlan> plans(inputs.entries.size());
   for (std::size_t k = 0; k < inputs.entries.size(); ++k) {
     const BlockInputs::Entry& e = inputs.entries[k];
-    const auto ov = request.overrides.find(e.blockId);
-    const bool overridden = ov != request.overrides.end();
+    const BlockOverride* override = nullptr;
+    if (const auto byKey = request.overrides.find(e.blockKey); byKey != request.overrides.end()) {
+      override = &byKey->second;
+    } else if (const auto byId = request.overridesById.find(e.blockId); byId != request.overridesById.end()) {
+      override = &byId->second;
+    }
+    const bool overridden = override != nullptr;
     ParameterValues values;
     std::set<std::string> given;
     if (overridden) {
       values = request.parameters;
       given = request.explicitParameters;
-      for (const auto& [name, v] : ov->second.parameters) {
+      for (const auto& [name, v] : override->parameters) {
         values[name] = v;
         given.insert(name);
       }
@@ -192,13 +176,13 @@ std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInp
     }
 
     BlockPlan& plan = plans[k];
-    plan.style = overridden && !ov->second.style.empty() ? ov->second.style : request.style;
+    plan.style = overridden && !override->style.empty() ? override->style : request.style;
     if (plan.style == "auto") {
       plan.style = std::isfinite(e.accessShare) && e.accessShare < kAutoSkeletonAccessShare ? "obb" : "skeleton";
     }
     if (plan.style != "obb") plan.parameters = skeletonParametersFrom(v);
     plan.parameters.bounds = p;
-    plan.seed = blockSeed(runSeed(v), positionKey(e.shape, inputs.source->frame));
+    plan.seed = blockSeed(runSeed(v), static_cast<std::int64_t>(partKey(e.blockKey, e.part)));
   }
   if (clampedBounds) *clampedBounds = clamped;
   return plans;
@@ -316,11 +300,13 @@ GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<Bl
     std::copy(o.metrics.begin(), o.metrics.end(), out.metrics.begin() + static_cast<std::ptrdiff_t>(first[k]));
   });
   out.blockIds.reserve(n);
+  out.blockKeys.reserve(n);
   out.blockStyles.reserve(n);
   for (std::size_t k = 0; k < n; ++k) {
     const Subdivision& s = outcomes[k]->subdivision;
     const std::int64_t id = inputs.entries[k].blockId;
     out.blockIds.push_back(id);
+    out.blockKeys.push_back(inputs.entries[k].blockKey);
     out.blockStyles.push_back(s.fallback ? "obb" : plans[k].style);
     out.oversize += s.oversize;
     out.withoutAccess += s.withoutAccess;
@@ -375,11 +361,17 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
 
 Table generatedParcelTable(const GeneratedParcels& g, std::vector<std::vector<Polygon>>* geometries) {
   Table table;
-  table.columns = {{"parcel_id", Column::Type::Integer, ""}, {"block_id", Column::Type::Integer, ""}};
+  table.columns = {{"parcel_id", Column::Type::Integer, ""},
+                   {"parcel_key", Column::Type::String, ""},
+                   {"block_id", Column::Type::Integer, ""},
+                   {"block_key", Column::Type::String, ""}};
   for (Column& c : analysis::metricColumns()) table.columns.push_back(std::move(c));
+  std::map<Key, int> inBlock;  // parcels numbered so far per block (multipart blocks span entries)
   for (std::size_t b = 0; b < g.blocks.size(); ++b) {
+    const std::string blockKey = keyText(g.blockKeys[b]);
+    int& index = inBlock[g.blockKeys[b]];
     for (int i : g.blocks[b].parcels) {
-      std::vector<Value> row = {std::int64_t(i), g.blockIds[b]};
+      std::vector<Value> row = {std::int64_t(i), blockKey + "-" + std::to_string(index++), g.blockIds[b], blockKey};
       for (Value& v : analysis::metricValues(g.metrics[i])) row.push_back(std::move(v));
       table.rows.push_back(std::move(row));
       if (geometries) geometries->push_back({g.parcels[i]});
@@ -410,6 +402,7 @@ pipeline::JobOutcome runGenerate(const GenerateRequest& request, const std::stri
   Json run = pipeline::runRecord("generate", request.parameters)
                  .set("style", request.style)
                  .set("from_parcels", request.fromParcels)
+                 .set("block_source", blockSourceOf(request)->kind())
                  .set("seed", static_cast<std::int64_t>(g.seed))
                  .set("per_block_parameters_where_available", perBlock);
   run.set("input", Json::object()

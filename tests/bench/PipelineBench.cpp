@@ -299,7 +299,7 @@ void SessionUpdate(benchmark::State& state) {
       request.parameters["omega"] = ++i % 2 ? 0.25 : 0.35;
       request.explicitParameters.insert("omega");
     } else {
-      request.overrides[100].parameters["a-max"] = ++i % 2 ? 400.0 : 600.0;
+      request.overridesById[100].parameters["a-max"] = ++i % 2 ? 400.0 : 600.0;
     }
     const auto update = session.update(request, {}, {}, 0.5, defer);
     regenerated = update.blocksRegenerated;

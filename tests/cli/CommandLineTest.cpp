@@ -34,7 +34,7 @@ TEST(StatsCommand, WritesAllOutputsForTheBundledSample) {
   std::ifstream blocks(out + "/blocks.csv");
   std::string header, line;
   std::getline(blocks, header);
-  EXPECT_EQ(header.rfind("block_id,parcel_count,block_area", 0), 0u) << header;
+  EXPECT_EQ(header.rfind("block_id,block_key,parcel_count,block_area", 0), 0u) << header;
   int rows = 0;
   while (std::getline(blocks, line)) ++rows;
   EXPECT_EQ(rows, 10);  // the sample town has ten blocks (datasets/README.md)
@@ -98,7 +98,7 @@ TEST(GenerateCommand, FromParcelsWritesParcelsAndIsReproducibleFromTheSeed) {
     EXPECT_TRUE(fs::exists(dir.file("a") + "/" + f)) << f;
   }
   const std::string csv = slurp(dir.file("a") + "/parcels.csv");
-  EXPECT_EQ(csv.rfind("parcel_id,block_id,area,perimeter,width", 0), 0u) << csv.substr(0, 80);
+  EXPECT_EQ(csv.rfind("parcel_id,parcel_key,block_id,block_key,area,perimeter,width", 0), 0u) << csv.substr(0, 80);
   EXPECT_GT(std::count(csv.begin(), csv.end(), '\n'), 100);
   const std::string json = slurp(dir.file("a") + "/run.json");
   EXPECT_NE(json.find("\"blocks_failed\": 0"), std::string::npos) << json;
@@ -149,6 +149,102 @@ TEST(GenerateCommand, BadStyleAndConflictingBoundsAreUsageErrors) {
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_EQ(run("generate '" + kSample + "' --a-max 0 --out '" + dir.file("x") + "' --quiet").code, 2);
   EXPECT_FALSE(fs::exists(dir.file("x")));
+}
+
+TEST(GenerateCommand, EnumAndBooleanParametersTakeTheirLabelsAndRecordNumbers) {
+  TempDir dir;
+  const std::string base = "generate '" + kSample + "' --where \"use <> 'ROW'\" --from-parcels --quiet --seed 3" +
+                           " --style skeleton --offset 20";
+  const CliRun numbers = run(base + " --corner-rule 1 --patio-obb 1 --detect-right-of-way 0 --out '" +
+                             dir.file("numbers") + "'");
+  ASSERT_EQ(numbers.code, 0) << numbers.output;
+  const CliRun labels = run(base + " --corner-rule street-length --patio-obb yes --detect-right-of-way=false --out '" +
+                            dir.file("labels") + "'");
+  ASSERT_EQ(labels.code, 0) << labels.output;
+  EXPECT_EQ(slurp(dir.file("labels") + "/parcels.csv"), slurp(dir.file("numbers") + "/parcels.csv"));
+  const std::string json = slurp(dir.file("labels") + "/run.json");
+  for (const char* value : {"\"corner-rule\": 1", "\"patio-obb\": 1", "\"detect-right-of-way\": 0"}) {
+    EXPECT_NE(json.find(value), std::string::npos) << value << " in " << json;
+  }
+  // The defaults by label: the same parcels as without the flags.
+  ASSERT_EQ(run(base + " --corner-rule street-width --patio-obb no --out '" + dir.file("defaults") + "'").code, 0);
+  ASSERT_EQ(run(base + " --out '" + dir.file("plain") + "'").code, 0);
+  EXPECT_EQ(slurp(dir.file("defaults") + "/parcels.csv"), slurp(dir.file("plain") + "/parcels.csv"));
+}
+
+TEST(GenerateCommand, AnUnknownLabelIsAUsageErrorNamingTheLabels) {
+  TempDir dir;
+  const CliRun r = run("generate '" + kSample + "' --corner-rule widest --out '" + dir.file("x") + "' --quiet");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("--corner-rule widest"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("street-width, street-length"), std::string::npos) << r.output;
+  const CliRun b = run("generate '" + kSample + "' --patio-obb maybe --out '" + dir.file("x") + "' --quiet");
+  EXPECT_EQ(b.code, 2) << b.output;
+  EXPECT_NE(b.output.find("true, false, yes, no"), std::string::npos) << b.output;
+  EXPECT_EQ(run("generate '" + kSample + "' --corner-rule 2 --out '" + dir.file("x") + "' --quiet").code, 2);
+  EXPECT_EQ(run("generate '" + kSample + "' --seed yes --out '" + dir.file("x") + "' --quiet").code, 2);
+  EXPECT_FALSE(fs::exists(dir.file("x")));
+}
+
+TEST(CommandHelp, ListsTheParametersByGroupWithRangesDefaultsAndLabels) {
+  const CliRun g = run("generate --help");
+  ASSERT_EQ(g.code, 0) << g.output;
+  for (const char* line :
+       {"\n  Skeleton\n", "\n    --corner-rule LABEL  0 street-width, 1 street-length; default street-width\n",
+        "\n    --patio-obb yes|no  (or 1|0, true|false), default no\n",
+        "\n    --a-min X  [0, 100000000] m2, default 200\n", "\n    --seed N  [0, 4294967295], default 1\n"}) {
+    EXPECT_NE(g.output.find(line), std::string::npos) << line << " in\n" << g.output;
+  }
+  const CliRun c = run("compare --help");
+  ASSERT_EQ(c.code, 0) << c.output;
+  std::size_t at = 0;
+  for (const char* group : {"Bounds", "Blocks", "Subdivision", "Skeleton", "Comparison", "Figures", "Output"}) {
+    const std::size_t next = c.output.find("\n  " + std::string(group) + "\n", at);
+    ASSERT_NE(next, std::string::npos) << group << " (in this order) in\n" << c.output;
+    at = next;
+  }
+  EXPECT_NE(c.output.find("\n    --figures yes|no  (or 1|0, true|false), default yes\n"), std::string::npos)
+      << c.output;
+  // min-frontage is described once, with one help text.
+  const std::string flag = "--min-frontage ";
+  const std::size_t first = c.output.find(flag);
+  ASSERT_NE(first, std::string::npos) << c.output;
+  EXPECT_EQ(c.output.find(flag, first + 1), std::string::npos) << c.output;
+  // The flag's two lines (values, help) read the same in stats and generate.
+  auto described = [](const std::string& help) {
+    const std::size_t start = help.find("\n    --min-frontage ");
+    if (start == std::string::npos) return std::string();
+    return help.substr(start, help.find('\n', help.find('\n', start + 1) + 1) - start);
+  };
+  const std::string stats = described(run("stats --help").output);
+  EXPECT_NE(stats.find("street access"), std::string::npos) << stats;
+  EXPECT_EQ(stats, described(g.output));
+}
+
+// The metric registry is the one description of the parcel metrics: every
+// parcel table has its columns in its order, and docs/user/metrics.md holds
+// the table `parcelscope metrics` prints from it.
+TEST(MetricsCommand, PrintsTheRegistryAsTheDocumentedTableAndTheTablesFollowIt) {
+  const CliRun m = test::runCli("metrics");
+  ASSERT_EQ(m.code, 0) << m.output;
+  EXPECT_NE(m.output.find("| `aspect_ratio` |"), std::string::npos) << m.output;
+  const std::string doc = slurp(std::string(PARCELSCOPE_SOURCE_DIR) + "/docs/user/metrics.md");
+  EXPECT_NE(doc.find(m.output), std::string::npos)
+      << "docs/user/metrics.md does not hold the table `parcelscope metrics` prints; paste it in:\n" << m.output;
+  // The metric columns of a parcel table, in the registry's order.
+  TempDir dir;
+  const CliRun r = test::runCli("stats '" + std::string(PARCELSCOPE_SOURCE_DIR) +
+                                "/datasets/sample/sample_town.geojson' --quiet --out '" + dir.file("out") + "'");
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::string header = slurp(dir.file("out") + "/parcels.csv");
+  header = header.substr(0, header.find('\n'));
+  std::string names;
+  std::istringstream lines(m.output);
+  for (std::string line; std::getline(lines, line);) {
+    const auto a = line.find("| `"), b = line.find("` |");
+    if (a == 0 && b != std::string::npos) names += "," + line.substr(3, b - 3);
+  }
+  EXPECT_EQ(header.substr(header.size() - std::min(header.size(), names.size() - 1)), names.substr(1)) << header;
 }
 
 }  // namespace

@@ -1,9 +1,13 @@
 // parcelscope-gui driven as a user drives it, headless under Xvfb (QTest):
 // load the sample, move a slider, change the colouring, click a block,
-// override it, export every figure and table, survive a bad file, and match a
-// screenshot baseline. Run through scripts/with-xvfb.sh.
+// override it, export every figure and table, survive a bad file, match a
+// screenshot baseline, and offer each parameter in its group with a control of
+// its kind. Run through scripts/with-xvfb.sh.
 #include <QApplication>
+#include <QCheckBox>
+#include <QComboBox>
 #include <QDoubleSpinBox>
+#include <QGroupBox>
 #include <QDir>
 #include <QLabel>
 #include <QMimeData>
@@ -283,6 +287,57 @@ private slots:
     QVERIFY(window_->result()->generated.contextPending.empty());
     QVERIFY2(window_->histogramTitle().contains("street_access"), qPrintable(window_->histogramTitle()));
     window_->setColourBy("aspect_ratio");
+  }
+
+  // The panel is built from the descriptions' groups and kinds: a box per
+  // group, combo boxes of labels for enums, check boxes for booleans, and no
+  // control for the settings of written files.
+  void parametersComeInTheirGroupsWithCombosAndCheckBoxes() {
+    parcelscope::gui::ParameterPanel* panel = window_->parameterPanel();
+    for (const char* group : {"Bounds", "Blocks", "Subdivision", "Skeleton", "Comparison", "Figures"}) {
+      QVERIFY2(panel->groupBox(group), group);
+    }
+    QVERIFY(!panel->groupBox("Output"));  // spatial-index only: no box
+    QVERIFY(panel->groupBox("Bounds")->findChild<QSlider*>("slider-a-min"));
+    QVERIFY(panel->groupBox("Skeleton")->findChild<QDoubleSpinBox*>("spin-street-angle"));
+    QVERIFY(!window_->findChild<QCheckBox*>("check-figures"));
+    QVERIFY(!window_->findChild<QDoubleSpinBox*>("spin-figure-width"));
+
+    QComboBox* corner = window_->findChild<QComboBox*>("combo-corner-rule");
+    QVERIFY(corner);
+    QCOMPARE(corner, panel->comboBox("corner-rule"));
+    QVERIFY(!panel->slider("corner-rule"));
+    QCOMPARE(corner->count(), 2);
+    QCOMPARE(corner->itemText(0), QString("street-width"));
+    QCOMPARE(corner->itemText(1), QString("street-length"));
+    QCOMPARE(corner->currentIndex(), 0);
+    QCheckBox* rightOfWay = window_->findChild<QCheckBox*>("check-detect-right-of-way");
+    QVERIFY(rightOfWay);
+    QVERIFY(rightOfWay->isChecked());
+    QCheckBox* patios = panel->checkBox("patio-obb");
+    QVERIFY(patios);
+    QVERIFY(!patios->isChecked());
+
+    // A choice reaches the request as the number the run records hold.
+    corner->setCurrentIndex(1);
+    QCOMPARE(window_->request().parameters.at("corner-rule"), 1.0);
+    QVERIFY(window_->request().explicitParameters.count("corner-rule"));
+    QCOMPARE(panel->value("corner-rule"), 1.0);
+    patios->setChecked(true);
+    QCOMPARE(window_->request().parameters.at("patio-obb"), 1.0);
+    QVERIFY(settle());
+    QVERIFY2(window_->lastError().isEmpty(), qPrintable(window_->lastError()));
+    corner->setCurrentIndex(0);
+    patios->setChecked(false);
+    QCOMPARE(window_->request().parameters.at("corner-rule"), 0.0);
+    QCOMPARE(window_->request().parameters.at("patio-obb"), 0.0);
+    // Values set from outside (a session) show in the controls.
+    panel->setValues({{"corner-rule", 1.0}, {"detect-right-of-way", 0.0}});
+    QCOMPARE(corner->currentIndex(), 1);
+    QVERIFY(!rightOfWay->isChecked());
+    QCOMPARE(window_->request().parameters.at("corner-rule"), 0.0);  // setValues emits nothing
+    panel->setValues(window_->request().parameters);
+    QVERIFY(settle());
   }
 };
 

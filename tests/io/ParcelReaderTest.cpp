@@ -4,6 +4,8 @@
 #include <gdal_utils.h>
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <GeographicLib/Geodesic.hpp>
 #include <GeographicLib/PolygonArea.hpp>
 #include <cmath>
@@ -202,6 +204,60 @@ TEST(ParcelReader, RefusesProjectedCoordinatesWithoutCrs) {
   const auto shp = convert(geojson, dir.file("feet.shp"), "ESRI Shapefile");
   std::filesystem::remove(dir.file("feet.prj"));
   expectError(options(shp, "", "", ""), Error::Kind::Input, {"feet.shp", "declares no CRS", "--crs"});
+}
+
+}  // namespace
+}  // namespace parcelscope::io
+
+namespace parcelscope::io {
+namespace {
+
+// Keys come from the geometry as read, or from a key field: a value of 16
+// hexadecimal digits is the key itself, any other value is hashed; parts of a
+// multipart feature get distinct keys; a missing key field is named.
+TEST(ParcelReaderKeys, KeysComeFromGeometriesOrFromTheKeyField) {
+  test::TempDir dir;
+  const double lon = 2.35, lat = 48.85, d = 0.0001;
+  auto square = [&](double x) {
+    return std::string(R"({"type":"Polygon","coordinates":[)") + test::squareRing(lon + x * d, lat, d) + "]}";
+  };
+  const std::string two = R"({"type":"MultiPolygon","coordinates":[[)" + test::squareRing(lon + 4 * d, lat, d) +
+                          "],[" + test::squareRing(lon + 6 * d, lat, d) + "]]}";
+  const auto path = dir.write("keys.geojson", test::collection(test::feature(square(0), 1) + "," +
+                                                               test::feature(square(2), 2) + "," +
+                                                               test::feature(two, 3)));
+  ReadOptions o;
+  o.path = path;
+  const ParcelLayer byGeometry = readParcels(o);
+  ASSERT_EQ(byGeometry.parcels.size(), 4u);
+  std::set<Key> keys;
+  for (const Parcel& p : byGeometry.parcels) keys.insert(parcelKey(p));
+  EXPECT_EQ(keys.size(), 4u);
+  EXPECT_EQ(byGeometry.parcels[2].featureKey, byGeometry.parcels[3].featureKey);  // one feature, two parts
+  EXPECT_EQ(readParcels(o).parcels[1].featureKey, byGeometry.parcels[1].featureKey);  // reproducible
+
+  o.keyField = "pid";
+  const ParcelLayer byField = readParcels(o);
+  EXPECT_EQ(byField.parcels[0].featureKey, hashBytes("1"));
+  EXPECT_EQ(byField.parcels[1].featureKey, hashBytes("2"));
+
+  const auto hex = dir.write("hex.geojson", R"({"type":"FeatureCollection","features":[{"type":"Feature",)"
+                                            R"("properties":{"block_key":"00000000000000ff"},"geometry":)" +
+                                                square(0) + "}]}");
+  o.path = hex;
+  o.keyField = "block_key";
+  EXPECT_EQ(readParcels(o).parcels[0].featureKey, Key{255});
+
+  o.path = path;
+  o.keyField = "nothing";
+  try {
+    readParcels(o);
+    FAIL() << "a missing key field is an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'nothing'"), std::string::npos) << e.what();
+  }
+  o.keyFieldOptional = true;
+  EXPECT_EQ(readParcels(o).parcels[1].featureKey, byGeometry.parcels[1].featureKey);
 }
 
 }  // namespace

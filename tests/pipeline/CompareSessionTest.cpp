@@ -1,6 +1,7 @@
 // CompareSession: the incremental compare behind the GUI gives what compare()
 // gives for the same request, regenerating only the blocks whose plan changed;
-// session files round-trip.
+// session files round-trip. The parameter descriptions of compare: each name
+// described once, whatever list holds it.
 #include "parcelscope/pipeline/CompareSession.h"
 #include "parcelscope/viz/CompareFigures.h"
 
@@ -10,10 +11,14 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <random>
+#include <set>
 
 #include "TestUtil.h"
+#include "parcelscope/analysis/ObservedAnalysis.h"
 #include "parcelscope/core/Error.h"
+#include "parcelscope/generation/Styles.h"
 #include "parcelscope/io/Writers.h"
 
 namespace parcelscope::pipeline {
@@ -98,7 +103,7 @@ TEST(CompareSession, RegeneratesOnlyTheBlocksAnEditTouches) {
   EXPECT_EQ(observedSides->size(), same.result->blocks.size() + 1);  // every block, then the city
 
   // One block's own bounds: that block alone.
-  request.overrides[3].parameters = {{"a-max", 300.0}, {"a-min", 100.0}};
+  request.overridesById[3].parameters = {{"a-max", 300.0}, {"a-min", 100.0}};
   const auto one = session.update(request);
   EXPECT_FALSE(one.reloaded);
   EXPECT_EQ(one.blocksRegenerated, 1u);
@@ -143,12 +148,12 @@ TEST(CompareSession, RandomEditSequencesMatchAFreshCompare) {
     SCOPED_TRACE("seed " + std::to_string(seed) + ", step " + std::to_string(step));
     switch (rng() % 5) {
       case 0: request.style = styles[rng() % 4]; break;
-      case 1: request.overrides[static_cast<std::int64_t>(rng() % 10)].style = styles[rng() % 3]; break;
+      case 1: request.overridesById[static_cast<std::int64_t>(rng() % 10)].style = styles[rng() % 3]; break;
       case 2:
-        request.overrides[static_cast<std::int64_t>(rng() % 10)].parameters["w-max"] =
+        request.overridesById[static_cast<std::int64_t>(rng() % 10)].parameters["w-max"] =
             12.0 + static_cast<double>(rng() % 20);
         break;
-      case 3: request.overrides.erase(static_cast<std::int64_t>(rng() % 10)); break;
+      case 3: request.overridesById.erase(static_cast<std::int64_t>(rng() % 10)); break;
       case 4:
         request.parameters["seed"] = static_cast<double>(rng() % 5);
         request.explicitParameters.insert("seed");
@@ -227,7 +232,7 @@ TEST(CompareSession, BlocksFinishedBeforeACancelAreComparedAgain) {
   request.style = "skeleton";
   const ProgressFn stopHalfway = [](double fraction, const std::string&) { return fraction < 0.4; };
   EXPECT_THROW(session.update(request, stopHalfway), Error);
-  request.overrides[0].parameters["w-max"] = 15;
+  request.overridesById[0].parameters["w-max"] = 15;
   const auto u = session.update(request);
   EXPECT_LT(u.blocksRegenerated, 48u) << "the blocks finished before the cancel are kept";
   expectSameResult(*u.result, compare(request));
@@ -311,7 +316,7 @@ TEST(CompareSession, DeferredContextIsMeasuredLaterWithTheSameResult) {
   request.parameters["omega"] = 0.7;
   request.explicitParameters.insert("omega");
   EXPECT_EQ(session.update(request, {}, {}, 0.5, true).result->generated.contextPending.size(), 10u);
-  request.overrides[2].parameters = {{"w-max", 14.0}};
+  request.overridesById[2].parameters = {{"w-max", 14.0}};
   const auto one = session.update(request);
   EXPECT_EQ(one.blocksRegenerated, 1u);
   EXPECT_TRUE(one.result->generated.contextPending.empty());
@@ -358,7 +363,7 @@ TEST(CompareSession, CancelledContextCompletionLeavesTheResultAndLosesNothing) {
   EXPECT_EQ(session.completeContext().result, shapes.result);
   EXPECT_FALSE(session.current()->generated.contextPending.empty());
   // A deferred one-block edit after the stopped completions, then the completion.
-  request.overrides[5].parameters = {{"w-max", 15.0}};
+  request.overridesById[5].parameters = {{"w-max", 15.0}};
   const auto edit = session.update(request, {}, {}, 0.5, true);
   // (with the blocks the cancelled update had made skeleton blocks)
   EXPECT_GE(edit.blocksRegenerated, 1u);
@@ -373,7 +378,7 @@ TEST(CompareSession, CancelledContextCompletionLeavesTheResultAndLosesNothing) {
 TEST(CompareSession, OverrideOfAMissingBlockIsAUsageError) {
   CompareSession session;
   CompareRequest request = sampleRequest();
-  request.overrides[99].style = "skeleton";
+  request.overridesById[99].style = "skeleton";
   try {
     session.update(request);
     FAIL() << "expected Error(Usage)";
@@ -381,9 +386,9 @@ TEST(CompareSession, OverrideOfAMissingBlockIsAUsageError) {
     EXPECT_EQ(e.kind(), Error::Kind::Usage);
     EXPECT_NE(std::string(e.what()).find("block 99"), std::string::npos) << e.what();
   }
-  request.overrides.clear();
-  request.overrides[2].parameters["a-min"] = 900;
-  request.overrides[2].parameters["a-max"] = 100;
+  request.overridesById.clear();
+  request.overridesById[2].parameters["a-min"] = 900;
+  request.overridesById[2].parameters["a-max"] = 100;
   EXPECT_THROW(session.update(request), Error);
 }
 
@@ -453,7 +458,7 @@ TEST(SessionFile, RoundTripsInputParametersOverridesAndSeed) {
   request.parameters["seed"] = 7;
   request.parameters["w-max"] = 21.5;
   request.explicitParameters = {"seed", "w-max"};
-  request.overrides[4] = {"obb", {{"a-max", 420.0}}};
+  request.overridesById[4] = {"obb", {{"a-max", 420.0}}};
   exportSession(request, dir.file("s.json"));
   const CompareRequest back = readSession(dir.file("s.json"));
   EXPECT_EQ(back.input.path, request.input.path);
@@ -464,9 +469,9 @@ TEST(SessionFile, RoundTripsInputParametersOverridesAndSeed) {
   EXPECT_EQ(back.parameters.at("seed"), 7);
   EXPECT_EQ(back.parameters.at("w-max"), 21.5);
   EXPECT_EQ(back.parameters.at("omega"), 0.3);  // defaults for the rest
-  ASSERT_EQ(back.overrides.count(4), 1u);
-  EXPECT_EQ(back.overrides.at(4).style, "obb");
-  EXPECT_EQ(back.overrides.at(4).parameters.at("a-max"), 420.0);
+  ASSERT_EQ(back.overridesById.count(4), 1u);
+  EXPECT_EQ(back.overridesById.at(4).style, "obb");
+  EXPECT_EQ(back.overridesById.at(4).parameters.at("a-max"), 420.0);
   CompareRequest ours = back;
   ours.parameters["figures"] = 0;
   expectSameResult(compare(ours), compare(request));
@@ -498,8 +503,88 @@ TEST(SessionFile, BadMembersAreNamed) {
                 .find("parameters.omgea"),
             std::string::npos);
   EXPECT_NE(message(R"({"parcelscope_session": 1, "input": {"path": "x"}, "overrides": [{"style": "obb"}]})")
-                .find("overrides[0].block_id"),
+                .find("overrides[0].block_key"),
             std::string::npos);
+}
+
+// Every list of parameter descriptions, by the function that returns it.
+std::vector<std::pair<std::string, std::vector<ParameterDescription>>> parameterLists() {
+  return {{"analysis::analysisParameters", analysis::analysisParameters()},
+          {"generation::obbParameterDescriptions", generation::obbParameterDescriptions()},
+          {"generation::skeletonParameterDescriptions", generation::skeletonParameterDescriptions()},
+          {"generation::generationParameterDescriptions", generation::generationParameterDescriptions()},
+          {"pipeline::comparisonParameters", comparisonParameters()},
+          {"pipeline::compareParameters", compareParameters()}};
+}
+
+TEST(ParameterDescriptions, ANameHasTheSameDescriptionInEveryListAndCompareListsThemAll) {
+  std::map<std::string, std::pair<std::string, ParameterDescription>> first;  // name: list, description
+  for (const auto& [list, descriptions] : parameterLists()) {
+    std::set<std::string> names;
+    for (const auto& d : descriptions) {
+      EXPECT_TRUE(names.insert(d.name).second) << d.name << " is listed twice by " << list;
+      const auto [seen, isNew] = first.emplace(d.name, std::make_pair(list, d));
+      EXPECT_TRUE(isNew || seen->second.second == d)
+          << d.name << " is described differently by " << seen->second.first << " and " << list;
+    }
+  }
+  // min-frontage is shared: the analysis and the OBB style list one description.
+  EXPECT_EQ(first.at("min-frontage").first, "analysis::analysisParameters");
+  const auto& obb = generation::obbParameterDescriptions();
+  EXPECT_TRUE(std::any_of(obb.begin(), obb.end(), [](const auto& d) { return d.name == "min-frontage"; }));
+  // compareParameters() is the union of them all.
+  const auto all = compareParameters();
+  EXPECT_EQ(all.size(), first.size());
+  for (const auto& [name, where] : first) {
+    EXPECT_TRUE(std::any_of(all.begin(), all.end(), [&](const auto& d) { return d.name == name; }))
+        << name << " of " << where.first << " is not in compareParameters()";
+  }
+}
+
+TEST(ParameterDescriptions, EveryEnumValueHasALabelAndEveryDescriptionIsComplete) {
+  for (const auto& d : compareParameters()) {
+    SCOPED_TRACE(d.name);
+    EXPECT_FALSE(d.help.empty());
+    EXPECT_FALSE(d.group.empty());
+    EXPECT_NO_THROW(checkValue(d, d.defaultValue));
+    if (d.kind == ParameterKind::Enum) {
+      ASSERT_EQ(std::floor(d.minimum), d.minimum);
+      ASSERT_EQ(std::floor(d.maximum), d.maximum);
+      ASSERT_EQ(d.labels.size(), static_cast<std::size_t>(d.maximum - d.minimum + 1));
+      for (std::size_t i = 0; i < d.labels.size(); ++i) {
+        const double v = d.minimum + static_cast<double>(i);
+        EXPECT_FALSE(d.labels[i].empty()) << v;
+        EXPECT_EQ(parseValue(d, d.labels[i]), v) << d.labels[i];  // labels are distinct and not numbers
+        EXPECT_EQ(formatValue(d, v), d.labels[i]);
+      }
+    } else {
+      EXPECT_TRUE(d.labels.empty());
+    }
+    if (d.kind == ParameterKind::Boolean) {
+      EXPECT_EQ(d.minimum, 0.0);
+      EXPECT_EQ(d.maximum, 1.0);
+    }
+  }
+}
+
+TEST(ParameterDescriptions, EnumsAndBooleansAreNoLongerPlainNumbers) {
+  std::map<std::string, ParameterDescription> byName;
+  for (const auto& d : compareParameters()) byName[d.name] = d;
+  EXPECT_EQ(byName.at("corner-rule").kind, ParameterKind::Enum);
+  EXPECT_EQ(byName.at("corner-rule").labels, (std::vector<std::string>{"street-width", "street-length"}));
+  EXPECT_EQ(byName.at("corner-rule").defaultValue, 0.0);
+  for (const char* b : {"patio-obb", "detect-right-of-way", "figures", "spatial-index"}) {
+    EXPECT_EQ(byName.at(b).kind, ParameterKind::Boolean) << b;
+  }
+  for (const char* i : {"seed", "bins", "figure-width", "figure-height"}) {
+    EXPECT_EQ(byName.at(i).kind, ParameterKind::Integer) << i;
+  }
+  // The settings of written files only, which the GUI leaves out.
+  std::set<std::string> outputOnly;
+  for (const auto& [name, d] : byName) {
+    if (d.outputOnly) outputOnly.insert(name);
+  }
+  EXPECT_EQ(outputOnly, (std::set<std::string>{"figure-height", "figure-width", "figures", "spatial-index"}));
 }
 
 }  // namespace

@@ -87,17 +87,28 @@ const char* metricUnit(ComparedMetric m);
 /// The finite values of metric `m` over `metrics`.
 std::vector<double> metricSample(const std::vector<ParcelMetrics>& metrics, ComparedMetric m);
 
-/// A per-parcel quantity a map can be coloured by and a histogram drawn of (the
-/// GUI's colour choices, compare's --metric).
+/// One per-parcel metric, described once: its column in every parcel table,
+/// its colour scale and histogram (the GUI's "colour by", compare's --metric),
+/// and its row in docs/user/metrics.md (`parcelscope metrics` prints that table).
 struct ParcelQuantity {
-  std::string name;   ///< aspect_ratio, area, width, neighbours, street_access, p_angle, p_area
+  std::string name;   ///< column and JSON name, e.g. "aspect_ratio"
   std::string title;  ///< for people, with the unit, e.g. "area (m²)"
   double (*value)(const ParcelMetrics&);
   /// Measured from the parcel's surroundings (neighbours, block outline) rather
   /// than its own shape: see measureContext.
   bool context = false;
+  std::string unit;        ///< "m", "m2", "deg" or "" (dimensionless)
+  bool integer = false;    ///< a count or a flag, written as an integer
+  std::string formula;     ///< how it is computed
+  std::string range;       ///< values it takes, e.g. "[1, inf)"
+  std::string source;      ///< the paper or tool it follows
 };
-/// Every ParcelQuantity, aspect_ratio (the paper's colour map) first.
+/// Every parcel metric in the order of the parcel tables' columns: area,
+/// perimeter, width, length, aspect_ratio, elongation, rectangularity,
+/// p_angle, p_area, neighbours, frontage, street_access.
+const std::vector<ParcelQuantity>& parcelMetrics();
+/// The same metrics in the order offered to people: aspect_ratio (the paper's
+/// colour map) first, then as parcelMetrics().
 const std::vector<ParcelQuantity>& parcelQuantities();
 /// The quantity called `name`; throws Error(Usage) listing the names otherwise.
 const ParcelQuantity& parcelQuantity(const std::string& name);
@@ -131,6 +142,7 @@ Comparison compareSets(const PreparedSet& observed, const PreparedSet& generated
 
 struct BlockComparison {
   std::int64_t blockId = -1;
+  Key blockKey = 0;  ///< the observed block's stable key
   double blockArea = 0;  ///< m²
   Comparison comparison;
 };

@@ -27,6 +27,10 @@ struct AnalysisOptions {
 
 /// The descriptions of AnalysisOptions (CLI flags, GUI controls, run record).
 const std::vector<ParameterDescription>& analysisParameters();
+/// min-frontage, the street-access threshold of observed parcels (AnalysisOptions)
+/// and of generated ones (generation::ObbParameters): described once, here, and
+/// listed by analysisParameters() and generation::obbParameterDescriptions().
+const ParameterDescription& minFrontageParameter();
 /// Options from parameter values (names as in analysisParameters()).
 AnalysisOptions analysisOptionsFrom(const ParameterValues& values);
 

@@ -34,8 +34,9 @@ struct ObbParameters {
   double minFrontage = 1.0;  ///< m of block contour a parcel needs to count as having street access
 };
 
-/// The descriptions of every OBB parameter (CLI flags, GUI sliders, run record),
-/// including "seed".
+/// The descriptions of every OBB parameter (CLI flags, GUI controls, run record),
+/// including "seed" and min-frontage (analysis::minFrontageParameter(), shared
+/// with the analysis of observed parcels).
 const std::vector<ParameterDescription>& obbParameterDescriptions();
 /// Parameters from values named as in obbParameterDescriptions(); missing names keep defaults.
 ObbParameters obbParametersFrom(const ParameterValues& values);

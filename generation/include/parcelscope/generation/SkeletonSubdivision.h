@@ -65,7 +65,8 @@ struct SkeletonParameters {
 };
 
 /// Descriptions of the skeleton-only parameters (offset, street-angle,
-/// corner-rule, patio-obb); the bounds are obbParameterDescriptions()'.
+/// corner-rule: an enum, 0 street-width / 1 street-length, as CornerRule;
+/// patio-obb: a boolean); the bounds are obbParameterDescriptions()'.
 const std::vector<ParameterDescription>& skeletonParameterDescriptions();
 /// Parameters from values named as in both description lists.
 SkeletonParameters skeletonParametersFrom(const ParameterValues& values);

@@ -22,6 +22,13 @@ struct ReadOptions {
   /// Numeric attributes to carry per parcel (ParcelLayer::fields); absent or
   /// null values read as NaN.
   std::vector<std::string> numericFields;
+  /// Field whose value is each feature's stable key (Parcel::featureKey): a
+  /// value of 16 hexadecimal digits is the key itself (as `stats` writes
+  /// block_key), any other value is hashed. Empty: keys come from geometries.
+  /// A value missing on a feature, or the field missing from the layer, is
+  /// Error(Input) unless `keyFieldOptional` (then that feature's geometry is used).
+  std::string keyField;
+  bool keyFieldOptional = false;
 };
 
 struct CleaningReport {

@@ -28,6 +28,8 @@ struct CompareRequest {
   std::set<std::string> explicitParameters;
   /// Per-block style and parameters over the run's (see pipeline::BlockOverride).
   pipeline::BlockOverrides overrides;
+  /// Overrides by block id, from version 1 session files (see BlockOverridesById).
+  pipeline::BlockOverridesById overridesById;
   /// A parcel quantity (analysis::parcelQuantities()) drawn as the extra figures
   /// map_<metric> and hist_<metric> when it is not one drawn anyway.
   std::string metric = "aspect_ratio";

@@ -74,12 +74,15 @@ private:
   std::unique_ptr<State> state_;
 };
 
-/// The request as a session file holds it: {"parcelscope_session": 1, "input":
+/// The request as a session file holds it: {"parcelscope_session": 2, "input":
 /// {path, layer, where, crs}, "style", "metric", "parameters": {the explicit
-/// ones}, "overrides": [{"block_id", "style", "parameters"}]}.
+/// ones}, "overrides": [{"block_key", "style", "parameters"}]} (an override
+/// read by block id from a version 1 file is written back by block_id).
 Json sessionJson(const CompareRequest& request);
 
-/// Reads a session file (or the "session" member of a compare run.json).
+/// Reads a session file (or the "session" member of a compare run.json), of
+/// version 2 (overrides by block_key) or 1 (overrides by block_id, which
+/// follow the order of the input's features: see BlockOverridesById).
 /// Relative input paths are taken relative to the file's folder. Throws
 /// Error(Input) naming the file and the member that is wrong.
 CompareRequest readSession(const std::string& path);

@@ -34,9 +34,13 @@ struct BlockOverride {
   /// included). They win over the block's derived bounds and the run's values.
   ParameterValues parameters;
 };
-/// Overrides by block id (the ids of `stats` and `compare`: ObservedAnalysis block
-/// ids, or the block_id field of a block layer).
-using BlockOverrides = std::map<std::int64_t, BlockOverride>;
+/// Overrides by block key (`block_key` of `stats` and `compare`; see Keys.h):
+/// they stay on their block whatever the order of the input's features.
+using BlockOverrides = std::map<Key, BlockOverride>;
+/// Overrides by block id (ObservedAnalysis block ids, or the block_id field of
+/// a block layer), as version 1 session files hold them: ids follow the order
+/// of the input's features, so these are resolved against the blocks as read.
+using BlockOverridesById = std::map<std::int64_t, BlockOverride>;
 
 struct GenerateRequest {
   io::ReadOptions input;
@@ -53,8 +57,10 @@ struct GenerateRequest {
   /// With fromParcels: the input already read and analysed with `parameters`
   /// (as `compare` does before generating); used instead of reading it again.
   const pipeline::ObservedData* observed = nullptr;
-  /// Per-block style and parameters; a block id no block has is Error(Usage).
+  /// Per-block style and parameters; a block key or id no block has is
+  /// Error(Usage). A block named both ways takes the override by key.
   BlockOverrides overrides;
+  BlockOverridesById overridesById;
 };
 
 struct GeneratedParcels {
@@ -62,6 +68,7 @@ struct GeneratedParcels {
   std::shared_ptr<const io::ParcelLayer> source;
   std::vector<Block> blocks;              ///< block outlines; `parcels` index `parcels` below
   std::vector<std::int64_t> blockIds;     ///< id of each entry of `blocks` (ids repeat for multipart blocks)
+  std::vector<Key> blockKeys;             ///< stable key of each entry of `blocks` (repeats as ids do)
   std::vector<Polygon> parcels;           ///< generated parcels, local metres
   std::vector<analysis::ParcelMetrics> metrics;
   /// Entries of `blocks` whose outcome was measured by shape only (see
@@ -88,6 +95,10 @@ struct BlockInputs {
     Polygon shape;
     double aMin = NAN, aMax = NAN, wMin = NAN, wMax = NAN;
     double accessShare = NAN;
+    /// The block's stable key (observed blocks: Block::key; a block layer: its
+    /// block_key field, else the feature's geometry).
+    Key blockKey = 0;
+    int part = 0;  ///< which part of a multipart block
   };
   std::shared_ptr<const io::ParcelLayer> source;  ///< the input as read (frame, CRS, cleaning report)
   std::vector<Entry> entries;
@@ -106,7 +117,7 @@ const std::vector<StreetWidths>& streetWidthsOf(BlockInputs& inputs);
 struct BlockPlan {
   std::string style;  ///< obb, skeleton or offset
   SkeletonParameters parameters;  ///< bounds included; skeleton-only fields at their defaults for obb
-  std::uint64_t seed = 0;         ///< the block's seed (blockSeed of the run seed and the block's position)
+  std::uint64_t seed = 0;         ///< the block's seed (blockSeed of the run seed and the key of the block's part)
   bool operator==(const BlockPlan& other) const;
   bool operator!=(const BlockPlan& other) const { return !(*this == other); }
 };
@@ -164,7 +175,9 @@ GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<Bl
 GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& progress = {});
 
 /// The generated parcels as parcels.gpkg and parcels.csv hold them: one row per
-/// parcel in block order (parcel_id, block_id and every metric) and, when
+/// parcel in block order (parcel_id, parcel_key, block_id, block_key and every
+/// metric; parcel_key is the block's key and the parcel's index in its block,
+/// "<block_key>-<index>") and, when
 /// `geometries` is given, each row's geometry.
 Table generatedParcelTable(const GeneratedParcels& g, std::vector<std::vector<Polygon>>* geometries = nullptr);
 

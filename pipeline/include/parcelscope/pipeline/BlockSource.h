@@ -1,0 +1,45 @@
+#pragma once
+// Where a run's blocks come from. `generate`, `compare` and the session ask a
+// BlockSource for their blocks (BlockInputs: each block part with its key, its
+// own bounds and street-access share); each kind of input is one
+// implementation. Today: blocks grouped from observed parcels, and a layer of
+// block polygons; a street network (blocks as the faces of a road graph) is the
+// next.
+#include <memory>
+#include <string>
+
+#include "parcelscope/core/Parameter.h"
+#include "parcelscope/core/Progress.h"
+#include "parcelscope/io/ParcelReader.h"
+#include "parcelscope/pipeline/GenerateJob.h"
+
+namespace parcelscope::pipeline {
+
+class BlockSource {
+public:
+  virtual ~BlockSource() = default;
+  /// Names the kind of source in run records: "observed-parcels" or "block-layer".
+  virtual std::string kind() const = 0;
+  /// The blocks, each multipart block as one entry per part. Throws Error(Input)
+  /// on unreadable input, Error(Cancelled) when `progress` asks to stop.
+  virtual BlockInputs blocks(const ProgressFn& progress = {}) const = 0;
+};
+
+/// Blocks grouped from observed parcels exactly as `stats` groups them, with
+/// bounds derived from their parcels (Vanegas et al. 2012, section 6); the
+/// analysis parameters come from `parameters`. With `observed`, that data (read
+/// and analysed with the same parameters) is used instead of reading `input`.
+std::unique_ptr<BlockSource> observedParcelBlocks(const io::ReadOptions& input, const ParameterValues& parameters,
+                                                  const ObservedData* observed = nullptr);
+
+/// A layer of block polygons, as `stats` writes blocks.gpkg: numeric fields
+/// block_id, a_min, a_max, w_min, w_max and street_access_share are used when
+/// present (NaN otherwise), and block_key when present (the feature's geometry
+/// gives the key otherwise).
+std::unique_ptr<BlockSource> blockLayer(const io::ReadOptions& input);
+
+/// The source a generate request names: observedParcelBlocks with fromParcels,
+/// else blockLayer.
+std::unique_ptr<BlockSource> blockSourceOf(const GenerateRequest& request);
+
+}  // namespace parcelscope::pipeline

@@ -1,0 +1,87 @@
+#include "parcelscope/pipeline/BlockSource.h"
+
+#include <cmath>
+#include <utility>
+
+namespace parcelscope::pipeline {
+
+namespace {
+
+class ObservedParcelBlocks : public BlockSource {
+public:
+  ObservedParcelBlocks(io::ReadOptions input, ParameterValues parameters, const ObservedData* observed)
+      : input_(std::move(input)), parameters_(std::move(parameters)), observed_(observed) {}
+
+  std::string kind() const override { return "observed-parcels"; }
+
+  BlockInputs blocks(const ProgressFn& progress) const override {
+    BlockInputs in;
+    ObservedData loaded;
+    if (!observed_) loaded = loadObserved(input_, parameters_, progress);
+    const ObservedData& observed = observed_ ? *observed_ : loaded;
+    for (std::size_t b = 0; b < observed.analysis.blocks.size(); ++b) {
+      const auto& s = observed.analysis.statistics[b];
+      const Block& block = observed.analysis.blocks[b];
+      for (std::size_t part = 0; part < block.parts.size(); ++part) {
+        in.entries.push_back({block.id, block.parts[part], s.aMin, s.aMax, s.wMin, s.wMax, s.streetAccessShare,
+                              block.key, static_cast<int>(part)});
+      }
+    }
+    if (observed_) {
+      in.source = std::make_shared<const io::ParcelLayer>(observed_->layer);
+    } else {
+      in.source = std::make_shared<const io::ParcelLayer>(std::move(loaded.layer));
+    }
+    return in;
+  }
+
+private:
+  io::ReadOptions input_;
+  ParameterValues parameters_;
+  const ObservedData* observed_;
+};
+
+class BlockLayer : public BlockSource {
+public:
+  explicit BlockLayer(io::ReadOptions input) : input_(std::move(input)) {}
+
+  std::string kind() const override { return "block-layer"; }
+
+  BlockInputs blocks(const ProgressFn& progress) const override {
+    io::ReadOptions options = input_;
+    options.numericFields = {"block_id", "a_min", "a_max", "w_min", "w_max", "street_access_share"};
+    if (options.keyField.empty()) {
+      options.keyField = "block_key";  // as `stats` writes it; absent: keys from the geometries
+      options.keyFieldOptional = true;
+    }
+    auto layer = std::make_shared<io::ParcelLayer>(io::readParcels(options, progress));
+    BlockInputs in;
+    for (std::size_t i = 0; i < layer->parcels.size(); ++i) {
+      const auto& f = layer->fields[i];
+      const Parcel& p = layer->parcels[i];
+      const std::int64_t id = std::isfinite(f[0]) ? static_cast<std::int64_t>(f[0]) : p.sourceFid;
+      in.entries.push_back({id, p.shape, f[1], f[2], f[3], f[4], f[5], p.featureKey, p.part});
+    }
+    in.source = std::move(layer);
+    return in;
+  }
+
+private:
+  io::ReadOptions input_;
+};
+
+}  // namespace
+
+std::unique_ptr<BlockSource> observedParcelBlocks(const io::ReadOptions& input, const ParameterValues& parameters,
+                                                  const ObservedData* observed) {
+  return std::make_unique<ObservedParcelBlocks>(input, parameters, observed);
+}
+
+std::unique_ptr<BlockSource> blockLayer(const io::ReadOptions& input) { return std::make_unique<BlockLayer>(input); }
+
+std::unique_ptr<BlockSource> blockSourceOf(const GenerateRequest& request) {
+  if (request.fromParcels) return observedParcelBlocks(request.input, request.parameters, request.observed);
+  return blockLayer(request.input);
+}
+
+}  // namespace parcelscope::pipeline
