@@ -87,8 +87,7 @@ private:
   double last_ = 0;
 };
 
-// The per-block bounds, and the parameters a block override offers.
-const char* kBounds[] = {"a-min", "a-max", "w-min", "w-max"};
+// The parameters a block override offers.
 const char* kBlockParameters[] = {"a-min", "a-max", "w-min", "w-max", "omega", "offset", "seed"};
 
 // Every parameter of compare, in its groups, but the settings of written files
@@ -110,13 +109,6 @@ const ParameterDescription& describe(const std::string& name) {
   throw std::logic_error("no parameter " + name);
 }
 
-bool isBound(const std::string& name) {
-  for (const char* b : kBounds) {
-    if (name == b) return true;
-  }
-  return false;
-}
-
 QString number(double v) {
   if (std::isnan(v)) return QStringLiteral("-");
   return QString::number(v, 'g', 5);
@@ -129,27 +121,25 @@ QString sampleDirectory() { return QStringLiteral(PARCELSCOPE_SAMPLE_DIR); }
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new SessionWorker) {
   setWindowTitle("ParcelScope");
   setAcceptDrops(true);
-  request_.parameters = defaultValues(pipeline::compareParameters());
-  request_.parameters["figures"] = 0;
-  request_.explicitParameters = {"seed"};
 
   worker_->moveToThread(&thread_);
   connect(&thread_, &QThread::finished, worker_, &QObject::deleteLater);
   connect(worker_, &SessionWorker::updated, this, &MainWindow::showReport);
   connect(worker_, &SessionWorker::failed, this, [this](const QString& message, qint64 serial) {
-    if (serial == pendingSerial_) failedOrCancelled_ = true;
+    // The newest request failed: the controls show the last good one, which later edits build on.
+    const bool newest = controller_.failed(serial);
+    if (newest) showRequest();
     progress_->setVisible(false);
     cancel_->setVisible(false);
     // A CRS the reader cannot use: say so, and offer to give one.
     const bool crsProblem = message.contains("CRS");
     showError(crsProblem ? message + "  (File > Set input CRS gives the input another CRS)" : message);
-    if (crsProblem && serial == pendingSerial_ && !QStandardPaths::isTestModeEnabled()) {
-      QTimer::singleShot(0, this, [this] { askForCrs(); });
+    if (crsProblem && newest && !QStandardPaths::isTestModeEnabled()) {
+      QTimer::singleShot(0, this, [this, input = controller_.failedRequest()->input] { askForCrs(input); });
     }
   });
   connect(worker_, &SessionWorker::cancelled, this, [this](qint64 serial) {
-    if (serial == pendingSerial_) {
-      failedOrCancelled_ = true;
+    if (controller_.cancelled(serial)) {
       progress_->setVisible(false);
       cancel_->setVisible(false);
       status_->setText("cancelled");
@@ -158,7 +148,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
   connect(worker_, &SessionWorker::progress, this, [this](double fraction, const QString& stage) {
     // Only long updates show progress: showing the bar relays the window out
     // and redraws every view, which would slow the short ones down.
-    const auto it = started_.find(pendingSerial_);
+    const auto it = started_.find(controller_.pendingSerial());
     if (it != started_.end() && it->second.elapsed() < 250 && !progress_->isVisible()) return;
     progress_->setVisible(true);
     cancel_->setVisible(true);
@@ -176,7 +166,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
   maps->addWidget(proceduralView_);
   for (MapView* v : {observedView_, proceduralView_}) {
     connect(v, &MapView::clicked, this, [this](double x, double y) {
-      if (result_) selectBlock(pipeline::blockAt(*result_, {x, y}));
+      if (controller_.shownResult()) selectBlock(pipeline::blockAt(*controller_.shownResult(), {x, y}));
     });
   }
 
@@ -281,20 +271,14 @@ QWidget* MainWindow::buildControls() {
   perBlockBounds_->setToolTip("Each block's A_min, A_max, W_min, W_max come from its observed parcels; "
                               "moving one of those sliders sets it for every block instead");
   connect(perBlockBounds_, &QCheckBox::toggled, this, [this](bool on) {
-    for (const char* b : kBounds) {
-      if (on) {
-        request_.explicitParameters.erase(b);
-      } else {
-        request_.explicitParameters.insert(b);
-      }
-    }
+    controller_.setPerBlockBounds(on);
     submit();
   });
   form->addRow(perBlockBounds_);
   v->addWidget(run);
 
   panel_ = new ParameterPanel(panelParameters());
-  panel_->setValues(request_.parameters);
+  panel_->setValues(controller_.request().parameters);
   connect(panel_, &ParameterPanel::changed, this,
           [this](const QString& name, double value) { setParameter(name.toStdString(), value); });
   auto* scroll = new QScrollArea;
@@ -400,29 +384,31 @@ void MainWindow::buildMenus() {
 }
 
 void MainWindow::askForCrs() {
-  if (!loaded_) return showError("open a dataset first");
+  if (const pipeline::CompareRequest* failed = controller_.failedRequest()) return askForCrs(failed->input);
+  if (!controller_.loaded()) return showError("open a dataset first");
+  askForCrs(controller_.request().input);
+}
+
+void MainWindow::askForCrs(const io::ReadOptions& input) {
   bool ok = false;
   const QString crs =
       QInputDialog::getText(this, "Input CRS", "CRS of the input (e.g. EPSG:2249); empty: as the file declares it",
-                            QLineEdit::Normal, QString::fromStdString(request_.input.crsOverride), &ok);
+                            QLineEdit::Normal, QString::fromStdString(input.crsOverride), &ok);
   if (ok) {
-    openFile(QString::fromStdString(request_.input.path), QString::fromStdString(request_.input.layer),
-             QString::fromStdString(request_.input.where), crs.trimmed());
+    openFile(QString::fromStdString(input.path), QString::fromStdString(input.layer),
+             QString::fromStdString(input.where), crs.trimmed());
   }
 }
 
 void MainWindow::openFile(const QString& path, const QString& layer, const QString& where, const QString& crs) {
-  pipeline::CompareRequest next = request_;
-  next.input = {};
-  next.input.path = path.toStdString();
-  next.input.where = where.toStdString();
-  next.input.crsOverride = crs.toStdString();
-  next.input.layer = layer.toStdString();
-  next.overrides.clear();
-  next.overridesById.clear();
+  io::ReadOptions input;
+  input.path = path.toStdString();
+  input.where = where.toStdString();
+  input.crsOverride = crs.toStdString();
+  input.layer = layer.toStdString();
   if (layer.isEmpty()) {
     try {
-      const auto names = io::layerNames(next.input.path);
+      const auto names = io::layerNames(input.path);
       if (names.size() > 1) {
         QStringList items;
         for (const auto& n : names) items << QString::fromStdString(n);
@@ -430,16 +416,15 @@ void MainWindow::openFile(const QString& path, const QString& layer, const QStri
         const QString chosen = QInputDialog::getItem(this, "Layer", QFileInfo(path).fileName() + " holds several layers:",
                                                      items, 0, false, &ok);
         if (!ok) return;
-        next.input.layer = chosen.toStdString();
+        input.layer = chosen.toStdString();
       }
     } catch (const std::exception& e) {
       showError(e.what());
       return;
     }
   }
-  request_ = next;
+  controller_.openInput(input);
   selected_ = -1;
-  loaded_ = true;
   rememberRecent(path);
   setWindowTitle("ParcelScope - " + QFileInfo(path).fileName());
   submit();
@@ -451,31 +436,33 @@ void MainWindow::openSample() {
 
 void MainWindow::openSession(const QString& path) {
   try {
-    pipeline::CompareRequest next = pipeline::readSession(path.toStdString());
-    next.parameters["figures"] = 0;
-    request_ = next;
+    controller_.openSession(path.toStdString());
   } catch (const std::exception& e) {
     showError(e.what());
     return;
   }
-  loaded_ = true;
   selected_ = -1;
+  showRequest();
+  submit();
+}
+
+void MainWindow::showRequest() {
+  const pipeline::CompareRequest& request = controller_.request();
   {
     const QSignalBlocker a(style_), b(colourBy_), c(perBlockBounds_);
-    style_->setCurrentText(QString::fromStdString(request_.style));
-    colourBy_->setCurrentText(QString::fromStdString(request_.metric));
-    bool perBlock = true;
-    for (const char* bound : kBounds) perBlock = perBlock && !request_.explicitParameters.count(bound);
-    perBlockBounds_->setChecked(perBlock);
+    style_->setCurrentText(QString::fromStdString(request.style));
+    colourBy_->setCurrentText(QString::fromStdString(request.metric));
+    perBlockBounds_->setChecked(controller_.perBlockBounds());
   }
-  panel_->setValues(request_.parameters);
-  setWindowTitle("ParcelScope - " + QFileInfo(QString::fromStdString(request_.input.path)).fileName());
-  submit();
+  panel_->setValues(request.parameters);
+  setWindowTitle(controller_.loaded()
+                     ? "ParcelScope - " + QFileInfo(QString::fromStdString(request.input.path)).fileName()
+                     : QString("ParcelScope"));
 }
 
 void MainWindow::saveSession(const QString& path) {
   try {
-    pipeline::exportSession(request_, path.toStdString());
+    controller_.saveSession(path.toStdString());
     status_->setText("session saved to " + path);
   } catch (const std::exception& e) {
     showError(e.what());
@@ -489,22 +476,25 @@ void MainWindow::exportFigure(const QString& name, const QString& path, int widt
     ~RestoreCursor() { QApplication::restoreOverrideCursor(); }
   } restore;
   exportWith(name + " exported to " + path, [&] {
-    viz::exportFigure(*finalResult_, finalRequest_, name.toStdString(), path.toStdString(), width, height);
+    viz::exportFigure(*controller_.finalResult(), controller_.finalRequest(), name.toStdString(), path.toStdString(),
+                      width, height);
   });
 }
 
 void MainWindow::exportTables(const QString& folder) {
-  exportWith("tables exported to " + folder,
-             [&] { pipeline::exportTables(*finalResult_, folder.toStdString(), {finalRequest_.input.path}); });
+  exportWith("tables exported to " + folder, [&] {
+    pipeline::exportTables(*controller_.finalResult(), folder.toStdString(), {controller_.finalRequest().input.path});
+  });
 }
 
 void MainWindow::exportParcels(const QString& path) {
-  exportWith("generated parcels exported to " + path,
-             [&] { pipeline::exportParcels(*finalResult_, path.toStdString(), {finalRequest_.input.path}); });
+  exportWith("generated parcels exported to " + path, [&] {
+    pipeline::exportParcels(*controller_.finalResult(), path.toStdString(), {controller_.finalRequest().input.path});
+  });
 }
 
 void MainWindow::exportWith(const QString& done, const std::function<void()>& write) {
-  if (!finalResult_) return showError("nothing to export yet: open a dataset first");
+  if (!controller_.finalResult()) return showError("nothing to export yet: open a dataset first");
   try {
     write();
     status_->setText(done);
@@ -514,7 +504,7 @@ void MainWindow::exportWith(const QString& done, const std::function<void()>& wr
 }
 
 void MainWindow::exportFigureDialog() {
-  const QString metric = QString::fromStdString(request_.metric);
+  const QString metric = QString::fromStdString(controller_.request().metric);
   const QStringList items = {"map_" + metric, "hist_" + metric, "map_blocks"};
   bool ok = false;
   const QString name = QInputDialog::getItem(this, "Export figure", "Figure:", items, 0, false, &ok);
@@ -525,12 +515,10 @@ void MainWindow::exportFigureDialog() {
 }
 
 void MainWindow::setParameter(const std::string& name, double value) {
-  request_.parameters[name] = value;
-  request_.explicitParameters.insert(name);
-  if (isBound(name) && perBlockBounds_->isChecked()) {
+  controller_.setParameter(name, value);
+  if (perBlockBounds_->isChecked() != controller_.perBlockBounds()) {
     const QSignalBlocker block(perBlockBounds_);
-    perBlockBounds_->setChecked(false);
-    for (const char* b : kBounds) request_.explicitParameters.insert(b);
+    perBlockBounds_->setChecked(controller_.perBlockBounds());
   }
   {
     ParameterValues shown;
@@ -541,7 +529,7 @@ void MainWindow::setParameter(const std::string& name, double value) {
 }
 
 void MainWindow::setStyle(const QString& style) {
-  request_.style = style.toStdString();
+  controller_.setStyle(style.toStdString());
   if (style_->currentText() != style) {
     const QSignalBlocker block(style_);
     style_->setCurrentText(style);
@@ -550,14 +538,16 @@ void MainWindow::setStyle(const QString& style) {
 }
 
 void MainWindow::setColourBy(const QString& quantity) {
-  request_.metric = quantity.toStdString();
+  controller_.setMetric(quantity.toStdString());
   if (colourBy_->currentText() != quantity) {
     const QSignalBlocker block(colourBy_);
     colourBy_->setCurrentText(quantity);
   }
-  if (!result_) return;
+  const auto& shown = controller_.shownResult();
+  if (!shown) return;
   // Not measured yet: the views are coloured when the completed result arrives.
-  if (analysis::parcelQuantity(request_.metric).context && !result_->generated.contextPending.empty()) return;
+  const bool context = analysis::parcelQuantity(controller_.request().metric).context;
+  if (context && !shown->generated.contextPending.empty()) return;
   Laps lap;
   UpdateTimings timings;
   recolour(false);
@@ -570,7 +560,7 @@ void MainWindow::setColourBy(const QString& quantity) {
   lastTimings_ = timings;
   lastLatencyMs_ = lap.total();
   lastFirstViewMs_ = lastLatencyMs_;
-  emit viewsUpdated(shownSerial_);
+  emit viewsUpdated(controller_.completeSerial());
 }
 
 void MainWindow::setOutlinesVisible(bool visible) {
@@ -589,40 +579,33 @@ void MainWindow::selectBlock(int block) {
 }
 
 void MainWindow::overrideSelectedBlock(const QString& style, const ParameterValues& parameters) {
-  if (!result_ || selected_ < 0) return showError("select a block first (click it in either view)");
+  if (!controller_.shownResult() || selected_ < 0) return showError("select a block first (click it in either view)");
   pipeline::BlockOverride o;
   o.style = style.toStdString();
   o.parameters = parameters;
-  const Block& block = result_->observed->analysis.blocks[selected_];
-  request_.overridesById.erase(block.id);  // a version 1 session's override of the same block
-  request_.overrides[block.key] = o;
+  controller_.overrideBlock(controller_.shownResult()->observed->analysis.blocks[selected_], o);
   submit();
 }
 
 void MainWindow::clearSelectedOverride() {
-  if (!result_ || selected_ < 0) return;
-  const Block& block = result_->observed->analysis.blocks[selected_];
-  request_.overrides.erase(block.key);
-  request_.overridesById.erase(block.id);
+  if (!controller_.shownResult() || selected_ < 0) return;
+  controller_.clearOverride(controller_.shownResult()->observed->analysis.blocks[selected_]);
   submit();
 }
 
 void MainWindow::submit() {
-  if (!loaded_) return;
+  if (!controller_.loaded()) return;
   errorBar_->setVisible(false);
-  failedOrCancelled_ = false;
-  pendingSerial_ = worker_->submit(request_);
-  started_[pendingSerial_].start();
+  const qint64 serial = worker_->submit(controller_.request());
+  controller_.submitted(serial);
+  started_[serial].start();
   firstViewMs_ = -1;
   // Said only when the update takes a while: any change of a label makes Qt
   // compose the whole window again (it holds OpenGL widgets), which would
   // delay drawing a quick result.
-  QTimer::singleShot(250, this, [this, serial = pendingSerial_] {
+  QTimer::singleShot(250, this, [this, serial] {
     // A result in between already says how far the update is.
-    if (serial == pendingSerial_ && serial != shownSerial_ && serial != drawnSerial_ && !failedOrCancelled_ &&
-        firstViewMs_ < 0) {
-      status_->setText("updating...");
-    }
+    if (controller_.awaitingViews(serial)) status_->setText("updating...");
   });
 }
 
@@ -636,25 +619,16 @@ void MainWindow::showReport(const UpdateReport& report) {
 }
 
 void MainWindow::drawReport(const UpdateReport& report) {
-  if (report.partial && report.serial != pendingSerial_) return;  // superseded already
-  const bool contextPending = !report.result->generated.contextPending.empty();
-  const bool colouredByContext = analysis::parcelQuantity(request_.metric).context;
-  // Coloured by a quantity not measured yet: the completed result follows.
-  if (contextPending && colouredByContext) return;
-  if (report.completesContext && report.serial == drawnSerial_ && result_ && !colouredByContext) {
-    // Views and histogram show this result's shapes already: only the numbers change.
-    releaseInBackground(std::exchange(result_, report.result));
-    releaseInBackground(std::exchange(finalResult_, report.result));
-    shownRequest_ = finalRequest_ = report.request;
-    shownSerial_ = report.serial;
+  const pipeline::Controller::Decision decision = controller_.receive(report);
+  if (decision.action == pipeline::Controller::Action::Ignore) return;
+  if (decision.action == pipeline::Controller::Action::Numbers) {
     fillNumbers();
     showBlock();
     noteContextCompleted(report.serial);
     return;
   }
-  // (A completion drawn in full, as the colouring changed to what it brings,
-  // is not a new input when its first report was drawn.)
-  const bool first = !result_ || (report.reloaded && report.serial != drawnSerial_);
+  const bool first = decision.newInput;
+  const bool contextPending = !report.result->generated.contextPending.empty();
   Laps lap;
   UpdateTimings timings;
   if (const auto it = started_.find(report.serial); it != started_.end()) {
@@ -665,24 +639,16 @@ void MainWindow::drawReport(const UpdateReport& report) {
     if (stage == "generate") timings.generate = 1e3 * seconds;
     if (stage == "metrics") timings.metrics = 1e3 * seconds;
   }
-  // The result replaced is freed in the background, not before drawing.
-  releaseInBackground(std::exchange(result_, report.result));
-  shownRequest_ = report.request;
   if (!report.partial) {
-    if (!contextPending) {
-      releaseInBackground(std::exchange(finalResult_, report.result));
-      finalRequest_ = report.request;
-      shownSerial_ = report.serial;
-    }
     progress_->setVisible(false);
     cancel_->setVisible(false);
   }
-  const pipeline::CompareResult& r = *result_;
+  const pipeline::CompareResult& r = *controller_.shownResult();
   if (first) selected_ = -1;
 
   // Geometry: the observed parcels only when the input was read again.
   const analysis::ObservedAnalysis& a = r.observed->analysis;
-  const analysis::ParcelQuantity& q = analysis::parcelQuantity(request_.metric);
+  const analysis::ParcelQuantity& q = analysis::parcelQuantity(controller_.request().metric);
   if (first) {
     std::vector<const Polygon*> shapes;
     std::vector<double> values;
@@ -709,7 +675,7 @@ void MainWindow::drawReport(const UpdateReport& report) {
     }
     proceduralView_->layer().setShapes(shapes, values, blocks);
     // The layer reads these shapes again when the zoom changes.
-    releaseInBackground(std::exchange(layerResult_, result_));
+    releaseInBackground(std::exchange(layerResult_, controller_.shownResult()));
   }
   const bool observedChanged = recolour(first || selectionChanged_);
   selectionChanged_ = false;
@@ -754,7 +720,6 @@ void MainWindow::drawReport(const UpdateReport& report) {
     }
     started_.erase(started_.begin(), std::next(it));
   }
-  drawnSerial_ = report.serial;
   if (report.completesContext) noteContextCompleted(report.serial);
   firstViewMs_ = -1;
   status_->setText(QString("%1 blocks, %2 observed and %3 procedural parcels; %4 of %5 block parts regenerated; %6 ms")
@@ -779,16 +744,11 @@ void MainWindow::noteContextCompleted(qint64 serial) {
   emit contextCompleted(serial);
 }
 
-pipeline::CompareRequest MainWindow::shown() const {
-  pipeline::CompareRequest r = shownRequest_;
-  r.metric = request_.metric;
-  return r;
-}
-
 bool MainWindow::recolour(bool observedChanged) {
-  if (!result_) return false;
-  const pipeline::CompareResult& r = *result_;
-  const analysis::ParcelQuantity& q = analysis::parcelQuantity(request_.metric);
+  if (!controller_.shownResult()) return false;
+  const pipeline::CompareResult& r = *controller_.shownResult();
+  const std::string& metric = controller_.request().metric;
+  const analysis::ParcelQuantity& q = analysis::parcelQuantity(metric);
   // The observed view changes only with its data, the quantity or the scale.
   observedChanged = observedChanged || q.name != shownQuantity_;
   if (observedChanged) {
@@ -803,7 +763,8 @@ bool MainWindow::recolour(bool observedChanged) {
   generated.reserve(r.generated.metrics.size());
   for (const auto& m : r.generated.metrics) generated.push_back(q.value(m));
   proceduralView_->layer().setValues(generated);
-  const viz::ColourScale scale = viz::quantityScale(r, shown(), request_.metric);
+  const pipeline::CompareRequest shown = controller_.shownRequest();
+  const viz::ColourScale scale = viz::quantityScale(r, shown, metric);
   if (observedChanged || scale.minimum != shownScale_.minimum || scale.maximum != shownScale_.maximum ||
       scale.kind != shownScale_.kind || scale.title != shownScale_.title) {
     observedView_->layer().setScale(scale);
@@ -813,7 +774,7 @@ bool MainWindow::recolour(bool observedChanged) {
   }
   observedView_->setTitle(QString("Observed: %1 parcels").arg(r.observedLots.size()));
   proceduralView_->setTitle(QString("Procedural (%1, seed %2): %3 parcels")
-                                .arg(QString::fromStdString(shown().style))
+                                .arg(QString::fromStdString(shown.style))
                                 .arg(r.generated.seed)
                                 .arg(generated.size()));
   return observedChanged;
@@ -821,8 +782,8 @@ bool MainWindow::recolour(bool observedChanged) {
 
 void MainWindow::drawHistogram() {
   // Texts without this result's numbers (the numbers table has the counts).
-  const viz::QuantityHistogram h =
-      viz::quantityHistogram(*result_, shown(), request_.metric, viz::HistogramTexts::Steady);
+  const viz::QuantityHistogram h = viz::quantityHistogram(*controller_.shownResult(), controller_.shownRequest(),
+                                                          controller_.request().metric, viz::HistogramTexts::Steady);
   histogramCounts_.clear();
   if (h.edges.empty()) {
     chart_->ClearPlots();
@@ -859,8 +820,9 @@ QStringList MainWindow::histogramTexts() const {
 }
 
 void MainWindow::fillNumbers() {
-  const Table summary = analysis::summaryTable(result_->city);
-  const Table distances = analysis::distanceTable(result_->city);
+  const pipeline::CompareResult& shown = *controller_.shownResult();
+  const Table summary = analysis::summaryTable(shown.city);
+  const Table distances = analysis::distanceTable(shown.city);
   const auto text = [](const Value& v) -> QString {
     if (const auto* d = std::get_if<double>(&v)) return number(*d);
     if (const auto* i = std::get_if<std::int64_t>(&v)) return QString::number(*i);
@@ -899,7 +861,7 @@ void MainWindow::fillNumbers() {
   while (header.size() < columns) header << QString();
   if (resized) numbers_->setHorizontalHeaderLabels(header);
   // Street access of parcels whose context is still being measured.
-  const bool pending = !result_->generated.contextPending.empty();
+  const bool pending = !shown.generated.contextPending.empty();
   int row = 0;
   for (const auto& r : summary.rows) {
     const bool measuring = pending && std::get<std::string>(r.front()) == "street_access_share";
@@ -922,13 +884,13 @@ void MainWindow::fillNumbers() {
 
 void MainWindow::showBlock() {
   std::vector<const Polygon*> outline;
-  if (!result_ || selected_ < 0) {
+  if (!controller_.shownResult() || selected_ < 0) {
     observedView_->outline().setShapes(outline);
     proceduralView_->outline().setShapes(outline);
     setBlockInfo("Click a block in either view.");
     return;
   }
-  const pipeline::CompareResult& r = *result_;
+  const pipeline::CompareResult& r = *controller_.shownResult();
   const Block& block = r.observed->analysis.blocks[selected_];
   for (const Polygon& part : block.parts) outline.push_back(&part);
   observedView_->outline().setShapes(outline);
@@ -941,7 +903,7 @@ void MainWindow::showBlock() {
       styles += (styles.isEmpty() ? "" : ", ") + QString::fromStdString(r.generated.blockStyles[k]);
     }
   }
-  const bool overridden = request_.overrides.count(block.key) > 0 || request_.overridesById.count(block.id) > 0;
+  const bool overridden = controller_.overridden(block);
   setBlockInfo(
       QString("<b>Block %1</b> (%2 m&sup2;; subdivided with %3%4)<br>"
               "<table cellspacing=4><tr><th></th><th>observed</th><th>procedural</th></tr>"

@@ -1,9 +1,10 @@
 #pragma once
 // The ParcelScope window: observed and procedural parcels side by side with
 // linked cameras, overlaid histograms and the comparison numbers, a parameter
-// panel and a block panel. Every change builds a pipeline::CompareRequest and hands
-// it to a SessionWorker, which calls the same library code as `parcelscope
-// compare`; this class only gathers input and shows results.
+// panel and a block panel. Every change is an edit of the request a
+// pipeline::Controller holds, which says what to hand to a SessionWorker (the
+// same library code as `parcelscope compare`) and what to do with each of its
+// reports; this class only gathers input and shows results.
 #include <QElapsedTimer>
 #include <QImage>
 #include <QMainWindow>
@@ -20,6 +21,7 @@
 
 #include "SessionWorker.h"
 #include "parcelscope/pipeline/CompareSession.h"
+#include "parcelscope/pipeline/Controller.h"
 #include "parcelscope/viz/Figures.h"
 
 class QCheckBox;
@@ -77,8 +79,10 @@ public:
   /// (which QWidget::grab leaves out, as each view is a native window).
   QImage screenshot();
 
-  const pipeline::CompareRequest& request() const { return request_; }
-  std::shared_ptr<const pipeline::CompareResult> result() const { return result_; }
+  const pipeline::CompareRequest& request() const { return controller_.request(); }
+  std::shared_ptr<const pipeline::CompareResult> result() const { return controller_.shownResult(); }
+  /// The request being edited and the bookkeeping of its updates.
+  const pipeline::Controller& controller() const { return controller_; }
   ParameterPanel* parameterPanel() const { return panel_; }
   MapView* observedView() const { return observedView_; }
   MapView* proceduralView() const { return proceduralView_; }
@@ -111,7 +115,7 @@ public:
   };
   UpdateTimings lastTimings() const { return lastTimings_; }
   /// True while an update is queued or under way.
-  bool busy() const { return pendingSerial_ != shownSerial_ && !failedOrCancelled_; }
+  bool busy() const { return controller_.busy(); }
 
 signals:
   /// Views, histograms and numbers show the result of request serial `serial`.
@@ -135,8 +139,9 @@ private:
   void drawReport(const UpdateReport& report);
   /// The numbers of request `serial` are complete: timing and contextCompleted.
   void noteContextCompleted(qint64 serial);
-  /// The request of the result shown, with the colouring chosen now.
-  pipeline::CompareRequest shown() const;
+  /// The controls show the request being edited (after a session was read,
+  /// or a failure brought back the last good request).
+  void showRequest();
   void showError(const QString& message);
   void setBlockInfo(const QString& html);
   /// Recolours the views; returns whether the observed view changed (it is
@@ -150,21 +155,16 @@ private:
   void exportFigureDialog();
   /// Runs `write` on the last complete result; says `done` or shows the error.
   void exportWith(const QString& done, const std::function<void()>& write);
+  /// File > Set input CRS: for the input whose open failed last, else the one open.
   void askForCrs();
+  /// Asks for a CRS and opens `input` again with it.
+  void askForCrs(const io::ReadOptions& input);
 
   QThread thread_;
   SessionWorker* worker_;
-  pipeline::CompareRequest request_;
-  std::shared_ptr<const pipeline::CompareResult> result_;  ///< shown (possibly a result in between)
-  pipeline::CompareRequest shownRequest_;                    ///< the request of result_
-  std::shared_ptr<const pipeline::CompareResult> finalResult_;  ///< the last complete result (exports)
-  pipeline::CompareRequest finalRequest_;                       ///< its request
-  bool loaded_ = false;
-  qint64 pendingSerial_ = 0, shownSerial_ = 0;
-  bool failedOrCancelled_ = false;
+  pipeline::Controller controller_;
   std::map<qint64, QElapsedTimer> started_;
   std::map<qint64, QElapsedTimer> completeStarted_;  ///< views drawn, numbers not complete yet
-  qint64 drawnSerial_ = 0;  ///< request whose (final) views were drawn last
   /// The result whose parcels the procedural layer draws (it reads them again on zoom).
   std::shared_ptr<const pipeline::CompareResult> layerResult_;
   double lastLatencyMs_ = 0, lastCompleteMs_ = 0;

@@ -9,7 +9,7 @@
 
 namespace parcelscope::gui {
 
-SessionWorker::SessionWorker() { qRegisterMetaType<parcelscope::gui::UpdateReport>(); }
+SessionWorker::SessionWorker() { qRegisterMetaType<parcelscope::pipeline::UpdateReport>(); }
 SessionWorker::~SessionWorker() = default;
 
 qint64 SessionWorker::submit(const pipeline::CompareRequest& request) {

@@ -14,30 +14,13 @@
 #include <optional>
 
 #include "parcelscope/pipeline/CompareSession.h"
+#include "parcelscope/pipeline/Controller.h"
 
 namespace parcelscope::gui {
 
-/// What one finished update brings to the window.
-struct UpdateReport {
-  std::shared_ptr<const pipeline::CompareResult> result;
-  pipeline::CompareRequest request;
-  qint64 serial = 0;
-  bool reloaded = false;
-  int blocksRegenerated = 0;
-  int blocksTotal = 0;
-  double seconds = 0;
-  /// A result in between: `blocksRegenerated` of `blocksTotal` block parts are
-  /// new, the others as before; the final report follows.
-  bool partial = false;
-  /// The regenerated blocks' neighbours, frontage and street access are still
-  /// being measured (pipeline::CompareSession::update with deferContext): views
-  /// and histograms of shape quantities are final, and a report with
-  /// `completesContext` and the same serial follows unless a newer request
-  /// supersedes this one.
-  bool contextPending = false;
-  /// The same result as the last report of this serial, with its context measured.
-  bool completesContext = false;
-};
+/// What one finished update brings to the window (Qt-free, so that
+/// pipeline::Controller decides what the window does with it).
+using UpdateReport = pipeline::UpdateReport;
 
 class SessionWorker : public QObject {
   Q_OBJECT
@@ -50,7 +33,7 @@ public:
   void cancel();
 
 signals:
-  void updated(const parcelscope::gui::UpdateReport& report);
+  void updated(const parcelscope::pipeline::UpdateReport& report);
   void failed(const QString& message, qint64 serial);
   void cancelled(qint64 serial);
   void progress(double fraction, const QString& stage);
@@ -74,4 +57,4 @@ private:
 
 }  // namespace parcelscope::gui
 
-Q_DECLARE_METATYPE(parcelscope::gui::UpdateReport)
+Q_DECLARE_METATYPE(parcelscope::pipeline::UpdateReport)

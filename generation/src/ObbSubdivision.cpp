@@ -1,4 +1,5 @@
 #include "parcelscope/generation/ObbSubdivision.h"
+#include "parcelscope/generation/Styles.h"
 
 #include <algorithm>
 #include <cmath>
@@ -525,6 +526,39 @@ Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, 
     for (Polygon& parcel : out.parcels) detail::translate(parcel, o.x, o.y);
   }
   return out;
+}
+
+}  // namespace parcelscope::generation
+
+namespace parcelscope::generation {
+
+namespace {
+
+// obb: OBB recursive subdivision (Vanegas et al. 2012, section 4.3).
+class ObbStyle : public Style {
+public:
+  std::string name() const override { return "obb"; }
+  std::string description() const override { return "OBB recursive subdivision (Vanegas et al. 2012, 4.3)"; }
+  std::vector<ParameterDescription> parameters() const override { return obbParameterDescriptions(); }
+  Subdivision run(const StyleRun& r) const override {
+    const ObbParameters p = obbParametersFrom(r.values);
+    const bool afterObb = r.previous && r.previousStyle && *r.previousStyle == "obb" && r.previousValues;
+    // Splits recorded under other A_max or W_max serve a run of the same seed.
+    const bool reusable = afterObb && r.previous->obbSplits && r.previousSeed == r.seed &&
+                          obbSplitsReusable(obbParametersFrom(*r.previousValues), p);
+    // A block an earlier OBB run subdivided passed the validity check then.
+    const bool checked = afterObb && !r.previous->failed && !r.previous->fallback;
+    return subdivideObb(r.block, p, r.seed,
+                        {reusable ? r.previous->obbSplits.get() : nullptr, r.record, checked,
+                         checked ? r.previous->blockSimple : static_cast<signed char>(-1)});
+  }
+};
+
+}  // namespace
+
+const Style& obbStyle() {
+  static const ObbStyle s;
+  return s;
 }
 
 }  // namespace parcelscope::generation

@@ -1,4 +1,5 @@
 #include "parcelscope/generation/SkeletonSubdivision.h"
+#include "parcelscope/generation/Styles.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Straight_skeleton_builder_2.h>
@@ -21,6 +22,7 @@
 #include "parcelscope/analysis/Metrics.h"
 #include "parcelscope/core/GeosOps.h"
 #include "BlockFailure.h"
+#include "PostProcess.h"
 
 namespace parcelscope::generation {
 
@@ -105,10 +107,8 @@ using SkeletonTraits = CGAL::Straight_skeleton_builder_traits_2<Kc>;
 using SkeletonMaker = CGAL::Straight_skeleton_builder_2<SkeletonTraits, Skeleton, GuardVisitor>;
 
 // Thrown inside the builder when the skeleton route cannot handle a block; the
-// block then goes to the OBB style.
-struct Fallback : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+// block then goes to the OBB style (the shared post-processing, PostProcess.h).
+using Fallback = detail::StyleFailure;
 struct SkeletonFolds : Fallback {
   SkeletonFolds() : Fallback("a skeleton face is not simple once rounded") {}
 };
@@ -1114,15 +1114,6 @@ void finish(const Polygon& block, const Point& o, Subdivision& out, double minFr
 }
 
 // The parcels tile the block: valid, and their areas sum to the block's.
-void checkTiling(const Polygon& block, const Subdivision& out) {
-  double sum = 0;
-  for (const Polygon& parcel : out.parcels) {
-    if (!geos::isValid(parcel)) throw Fallback("a parcel is not a valid polygon once rounded");
-    sum += area(parcel);
-  }
-  const double a = area(block);
-  if (std::fabs(sum - a) > 1e-9 * a) throw Fallback("the parcels do not sum to the block's area");
-}
 
 }  // namespace
 
@@ -1204,18 +1195,65 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
     // Back to the block's coordinates, where rounding can close what were
     // separate points locally: clean and check there.
     finish(block, o, out, p.bounds.minFrontage);
-    checkTiling(block, out);
+    detail::checkTiling(block, out);
   } catch (const std::exception& e) {
     detail::rethrowUnlessBlockFailure();
     reason = e.what();
   }
-  if (!reason.empty()) {
-    out = subdivideObb(block, p.bounds, seed);
-    out.fallback = true;
-    out.fallbackReason = reason;
-  }
+  if (!reason.empty()) out = detail::fallBackToObb(block, p.bounds, seed, reason);
   if (reuse.record) out.skeletonLayout = std::move(layout);
   return out;
+}
+
+}  // namespace parcelscope::generation
+
+namespace parcelscope::generation {
+
+namespace {
+
+// skeleton: straight-skeleton strips along the streets (Vanegas et al. 2012,
+// section 4.2); offset: the same with a finite d_offset (30 m unless given)
+// and the patios subdivided with obb.
+class SkeletonStyle : public Style {
+public:
+  explicit SkeletonStyle(bool offset) : offset_(offset) {}
+  std::string name() const override { return offset_ ? "offset" : "skeleton"; }
+  std::string description() const override {
+    return offset_ ? "skeleton with a finite offset (30 m unless --offset) and patios subdivided by OBB"
+                   : "straight-skeleton strips along the streets (4.2); --offset M leaves patios";
+  }
+  std::vector<ParameterDescription> parameters() const override {
+    std::vector<ParameterDescription> p = obbParameterDescriptions();
+    appendParameters(p, skeletonParameterDescriptions());
+    return p;
+  }
+  bool usesStreetWidths() const override { return true; }
+  Subdivision run(const StyleRun& r) const override {
+    SkeletonParameters p = skeletonParametersFrom(r.values);
+    if (offset_) {
+      if (p.offset <= 0) p.offset = kDefaultOffsetStyleDepth;
+      p.subdividePatios = true;
+    }
+    // The layout checks for itself that it was made for this block and these parameters.
+    const SkeletonLayout* layout = r.previous ? r.previous->skeletonLayout.get() : nullptr;
+    return subdivideSkeleton(r.block, p, r.seed, r.streetWidths, {layout, r.record});
+  }
+
+private:
+  static constexpr double kDefaultOffsetStyleDepth = 30.0;  // m, style offset without --offset
+  bool offset_;
+};
+
+}  // namespace
+
+const Style& skeletonStyle() {
+  static const SkeletonStyle s(false);
+  return s;
+}
+
+const Style& offsetStyle() {
+  static const SkeletonStyle s(true);
+  return s;
 }
 
 }  // namespace parcelscope::generation

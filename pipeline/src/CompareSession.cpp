@@ -107,7 +107,7 @@ void carryOver(const pipeline::BlockInputs& oldInputs, const std::vector<pipelin
     if (it == old.end()) continue;
     const std::size_t j = it->second;
     if (!oldOutcomes[j] || oldPlans[j] != plans[k] || !sameShape(oldInputs.entries[j].shape, e.shape)) continue;
-    if (plans[k].style != "obb") {
+    if (generation::style(plans[k].style).usesStreetWidths()) {
       const bool widths = inputs.widths.size() == inputs.entries.size() &&
                           oldInputs.widths.size() == oldInputs.entries.size() && sameWidths(inputs.widths[k], oldInputs.widths[j]);
       if (!widths) continue;
@@ -177,7 +177,8 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   const pipeline::GenerateRequest g = detail::generateRequest(request, observed.get());
   std::int64_t clamped = 0;
   const std::vector<pipeline::BlockPlan> plans = pipeline::planBlocks(g, inputs, &clamped);
-  if (std::any_of(plans.begin(), plans.end(), [](const auto& p) { return p.style != "obb"; })) {
+  if (std::any_of(plans.begin(), plans.end(),
+                  [](const auto& p) { return generation::style(p.style).usesStreetWidths(); })) {
     pipeline::streetWidthsOf(inputs);
   }
   std::vector<std::shared_ptr<pipeline::BlockOutcome>> outcomes =

@@ -43,17 +43,10 @@ std::uint64_t runSeed(const ParameterValues& values) {
   return it == values.end() ? 1 : static_cast<std::uint64_t>(it->second);
 }
 
-bool sameBounds(const ObbParameters& a, const ObbParameters& b) {
-  return a.aMin == b.aMin && a.aMax == b.aMax && a.wMin == b.wMin && a.wMax == b.wMax && a.omega == b.omega &&
-         a.xi == b.xi && a.snapDistance == b.snapDistance && a.minFrontage == b.minFrontage;
-}
-
 }  // namespace
 
 bool BlockPlan::operator==(const BlockPlan& o) const {
-  return style == o.style && seed == o.seed && sameBounds(parameters.bounds, o.parameters.bounds) &&
-         parameters.offset == o.parameters.offset && parameters.streetAngle == o.parameters.streetAngle &&
-         parameters.corner == o.parameters.corner && parameters.subdividePatios == o.parameters.subdividePatios;
+  return style == o.style && seed == o.seed && values == o.values;
 }
 
 BlockInputs prepareBlocks(const GenerateRequest& request, const ProgressFn& progress) {
@@ -176,12 +169,15 @@ std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInp
     }
 
     BlockPlan& plan = plans[k];
-    plan.style = overridden && !override->style.empty() ? override->style : request.style;
-    if (plan.style == "auto") {
-      plan.style = std::isfinite(e.accessShare) && e.accessShare < kAutoSkeletonAccessShare ? "obb" : "skeleton";
-    }
-    if (plan.style != "obb") plan.parameters = skeletonParametersFrom(v);
-    plan.parameters.bounds = p;
+    const Style& chosen = style(overridden && !override->style.empty() ? override->style : request.style);
+    const Style& concrete = chosen.resolve({e.accessShare});
+    plan.style = concrete.name();
+    ParameterValues planned = v;
+    planned["a-min"] = p.aMin;
+    planned["a-max"] = p.aMax;
+    planned["w-min"] = p.wMin;
+    planned["w-max"] = p.wMax;
+    plan.values = styleValues(concrete, planned);
     plan.seed = blockSeed(runSeed(v), static_cast<std::int64_t>(partKey(e.blockKey, e.part)));
   }
   if (clampedBounds) *clampedBounds = clamped;
@@ -190,11 +186,23 @@ std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInp
 
 namespace {
 
+// Runs the plan's style on the entry, with what `previous` (made under
+// `previousPlan`) left to reuse.
 Subdivision subdivideEntry(const BlockInputs& inputs, std::size_t entry, const BlockPlan& plan,
-                           const SkeletonReuse& reuse = {}) {
-  const bool widths = plan.style != "obb" && inputs.widths.size() == inputs.entries.size();
-  return subdivideBlock(inputs.entries[entry].shape, plan.style, plan.parameters, plan.seed,
-                        widths ? inputs.widths[entry] : StreetWidths{}, reuse);
+                           const Subdivision* previous = nullptr, const BlockPlan* previousPlan = nullptr,
+                           bool record = false) {
+  const Style& s = style(plan.style);
+  static const StreetWidths kNone;
+  const bool widths = s.usesStreetWidths() && inputs.widths.size() == inputs.entries.size();
+  StyleRun run{inputs.entries[entry].shape, plan.values, plan.seed, widths ? inputs.widths[entry] : kNone};
+  if (previous && previousPlan) {
+    run.previous = previous;
+    run.previousStyle = &previousPlan->style;
+    run.previousValues = &previousPlan->values;
+    run.previousSeed = previousPlan->seed;
+  }
+  run.record = record;
+  return s.run(run);
 }
 
 Block entryBlock(const BlockInputs& inputs, std::size_t entry, std::size_t parcels) {
@@ -230,21 +238,8 @@ BlockOutcome runBlock(const BlockInputs& inputs, std::size_t entry, const BlockP
                       const BlockReuse& reuse) {
   BlockOutcome o;
   const BlockOutcome* previous = reuse.previous && reuse.previousPlan ? reuse.previous : nullptr;
-  if (plan.style == "obb") {
-    const bool reusable = previous && previous->subdivision.obbSplits && reuse.previousPlan->style == "obb" &&
-                          reuse.previousPlan->seed == plan.seed &&
-                          obbSplitsReusable(reuse.previousPlan->parameters.bounds, plan.parameters.bounds);
-    // A block an earlier OBB run subdivided passed the validity check then.
-    const bool checked = previous && reuse.previousPlan->style == "obb" && !previous->subdivision.failed &&
-                         !previous->subdivision.fallback;
-    o.subdivision = subdivideObb(inputs.entries[entry].shape, plan.parameters.bounds, plan.seed,
-                                 {reusable ? previous->subdivision.obbSplits.get() : nullptr, reuse.record, checked,
-                                  checked ? previous->subdivision.blockSimple : static_cast<signed char>(-1)});
-  } else {
-    // The layout checks for itself that it was made for this block and these parameters.
-    const SkeletonLayout* layout = previous ? previous->subdivision.skeletonLayout.get() : nullptr;
-    o.subdivision = subdivideEntry(inputs, entry, plan, {layout, reuse.record});
-  }
+  o.subdivision = subdivideEntry(inputs, entry, plan, previous ? &previous->subdivision : nullptr,
+                                 previous ? reuse.previousPlan : nullptr, reuse.record);
   if (previous && sameParcels(o.subdivision.parcels, previous->subdivision.parcels)) {
     o.metrics = previous->metrics;  // the same parcels in the same block: the same measurements
     o.contextMeasured = previous->contextMeasured;
@@ -331,7 +326,7 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
   const std::vector<BlockPlan> plans = planBlocks(request, inputs, &clamped);
   Timings timings;
   timings.start("subdivide");
-  if (std::any_of(plans.begin(), plans.end(), [](const BlockPlan& p) { return p.style != "obb"; })) {
+  if (std::any_of(plans.begin(), plans.end(), [](const BlockPlan& p) { return style(p.style).usesStreetWidths(); })) {
     streetWidthsOf(inputs);
   }
   // Every block in parallel; each block's seed depends only on its position.

@@ -107,7 +107,7 @@ void ObbSubdivisionPerBlock(benchmark::State& state) {
   for (auto _ : state) {
     blocks = parcels = 0;
     for (std::size_t k = 0; k < inputs.entries.size(); ++k) {
-      parcels += parcelscope::generation::subdivideObb(inputs.entries[k].shape, plans[k].parameters.bounds, plans[k].seed)
+      parcels += parcelscope::generation::subdivideObb(inputs.entries[k].shape, plans[k].bounds(), plans[k].seed)
                      .parcels.size();
       ++blocks;
     }
@@ -242,7 +242,8 @@ void SkeletonSubdivisionPerBlock(benchmark::State& state) {
     for (std::size_t k = 0; k < inputs.entries.size(); ++k) {
       const auto t0 = std::chrono::steady_clock::now();
       const auto sub =
-          gen::subdivideSkeleton(inputs.entries[k].shape, plans[k].parameters, plans[k].seed, inputs.widths[k]);
+          gen::subdivideSkeleton(inputs.entries[k].shape, gen::skeletonParametersFrom(plans[k].values), plans[k].seed,
+                                 inputs.widths[k]);
       ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
       parcels += sub.parcels.size();
       fallbacks += sub.fallback;

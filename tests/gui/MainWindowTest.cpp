@@ -225,6 +225,27 @@ private slots:
     window_->openSample();
     QVERIFY(settle());
     QVERIFY(window_->lastError().isEmpty());
+    // A file that opens but cannot be read as asked fails in the update; the
+    // request is then the last good one again, so a later edit builds on it
+    // instead of reading the file as asked again (and failing again).
+    const auto good = window_->result();
+    const QString sample = QString(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_town.geojson";
+    window_->openFile(sample, {}, "no_such_field = 1");
+    QVERIFY(settle());
+    QTRY_VERIFY_WITH_TIMEOUT(!window_->lastError().isEmpty(), 10000);
+    QVERIFY2(window_->lastError().contains("no_such_field"), qPrintable(window_->lastError()));
+    QCOMPARE(window_->result(), good);
+    QVERIFY(window_->controller().failedRequest());
+    QCOMPARE(window_->controller().failedRequest()->input.where, std::string("no_such_field = 1"));
+    QCOMPARE(window_->request().input.where, std::string("use <> 'ROW'"));
+    const double seed = window_->request().parameters.at("seed");
+    window_->setParameter("seed", seed + 1);
+    QVERIFY(settle());
+    QVERIFY2(window_->lastError().isEmpty(), qPrintable(window_->lastError()));
+    QVERIFY(window_->result() != good);
+    QCOMPARE(window_->result()->observed, good->observed);  // the same input, not read again
+    window_->setParameter("seed", seed);
+    QVERIFY(settle());
   }
 
   // The main window with the sample at seed 1 against a baseline screenshot;

@@ -113,10 +113,10 @@ TEST_P(RealBlocks, RunsReusingTheLastRunGiveWhatFreshRunsGive) {
   const std::size_t n = inputs.entries.size();
   std::vector<BlockPlan> moved = planned->plans;
   for (BlockPlan& p : moved) {
-    p.parameters.bounds.aMax *= 1.3;
-    p.parameters.bounds.wMax *= 0.8;
+    p.values.at("a-max") *= 1.3;
+    p.values.at("w-max") *= 0.8;
     if (style != "obb") {
-      p.parameters.bounds.omega = std::min(1.0, p.parameters.bounds.omega + 0.2);
+      p.values.at("omega") = std::min(1.0, p.values.at("omega") + 0.2);
       p.seed += 1;
     }
   }
@@ -134,7 +134,7 @@ TEST_P(RealBlocks, RunsReusingTheLastRunGiveWhatFreshRunsGive) {
     differing[k] = !same(reused.subdivision, runBlock(inputs, k, moved[k], minFrontage).subdivision);
     if (style != "obb") {
       BlockPlan angled = moved[k];
-      angled.parameters.streetAngle += 10;
+      angled.values.at("street-angle") += 10;
       const BlockOutcome again = runBlock(inputs, k, angled, minFrontage, {&reused, &moved[k], false});
       differing[k] += !same(again.subdivision, runBlock(inputs, k, angled, minFrontage).subdivision);
     }
@@ -186,7 +186,7 @@ TEST(PlanBlocks, UserValuesOverridePerBlockValuesWhichOverrideDefaults) {
   BlockInputs inputs;
   inputs.source = std::make_shared<const io::ParcelLayer>();
   inputs.entries.push_back({7, test::rect(0, 0, 100, 50), 100, 900, 4, std::nan(""), 1.0});
-  const ObbParameters p = planBlocks(r, inputs).at(0).parameters.bounds;
+  const ObbParameters p = planBlocks(r, inputs).at(0).bounds();
   EXPECT_DOUBLE_EQ(p.aMin, 100);   // per block
   EXPECT_DOUBLE_EQ(p.aMax, 555);   // given by the user
   EXPECT_DOUBLE_EQ(p.wMin, 4);     // per block

@@ -1,6 +1,9 @@
 #pragma once
-// The subdivision styles: their names, descriptions and parameters, and one
-// block subdivided with a concrete style.
+// The subdivision styles, each registered once: its name, description,
+// parameters and run function. The command line (--style, --help), the GUI's
+// style lists, the run record and the pipeline read this registry; adding a
+// style is one source file defining a Style and one line in the registry's
+// list (generation/src/Styles.cpp).
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -12,31 +15,79 @@
 
 namespace parcelscope::generation {
 
-/// The subdivision styles `generate` offers, each with a one-line description:
-///  - obb: OBB recursive subdivision (Vanegas et al. 2012, 4.3);
-///  - skeleton: straight-skeleton strips (4.2), d_offset from --offset (0: none);
-///  - offset: skeleton with a finite offset (30 m unless --offset is given) and
-///    the patios subdivided with the OBB style;
-///  - auto: per block, skeleton where at least 90 % of its observed parcels have
-///    street access (the paper's first variety: every parcel on a street, rears
-///    abutting), obb otherwise; blocks without observed parcels (a block layer
-///    without a street_access_share field) use skeleton.
+/// One block's run of a style.
+struct StyleRun {
+  const Polygon& block;           ///< normalised, local metres
+  const ParameterValues& values;  ///< the block's values (see Style::parameterNames); missing names: defaults
+  std::uint64_t seed = 0;
+  /// Street widths per contour edge (see StreetWidths); empty when unknown or
+  /// when the style does not use them.
+  const StreetWidths& streetWidths;
+  /// The block's last outcome, when the caller kept it, made by style
+  /// `previousStyle` with `previousValues` and `previousSeed`: a style may reuse
+  /// what it recorded there; the parcels are those of a fresh run.
+  const Subdivision* previous = nullptr;
+  const std::string* previousStyle = nullptr;
+  const ParameterValues* previousValues = nullptr;
+  std::uint64_t previousSeed = 0;
+  /// Keep what a later run may reuse in the outcome (Subdivision::obbSplits, ::skeletonLayout).
+  bool record = false;
+};
+
+/// What a style knows of a block before choosing (for styles that choose
+/// another per block, like auto).
+struct BlockFacts {
+  double accessShare = 0;  ///< share of its observed parcels with street access; NaN when unknown
+};
+
+class Style {
+public:
+  virtual ~Style() = default;
+  /// Flag value and name in run records, e.g. "obb".
+  virtual std::string name() const = 0;
+  /// One line for --help and the GUI.
+  virtual std::string description() const = 0;
+  /// The parameters this style reads (bounds and its own), each described once.
+  virtual std::vector<ParameterDescription> parameters() const = 0;
+  /// Whether run() reads street widths (they are measured only when some block needs them).
+  virtual bool usesStreetWidths() const { return false; }
+  /// The concrete style a block is subdivided with: this one, or for a style
+  /// that chooses per block (auto), the one it picks.
+  virtual const Style& resolve(const BlockFacts&) const { return *this; }
+  /// Subdivides one block. Deterministic: the same block, values and seed give
+  /// the same parcels. Geometric failures come back in the Subdivision (failed,
+  /// or fallback to obb with the reason); memory, a stop or a usage error throw.
+  virtual Subdivision run(const StyleRun& run) const = 0;
+};
+
+/// Every registered style, in the order of --help and the GUI: obb, skeleton, offset, auto.
+const std::vector<const Style*>& styles();
+/// The style called `name`; throws Error(Usage) naming the styles otherwise.
+const Style& style(const std::string& name);
+
+/// (name, description) of every style (compatibility view of styles()).
 const std::vector<std::pair<std::string, std::string>>& generationStyles();
 
-/// Every parameter `generate` takes: OBB, skeleton and block-building ones, each
-/// name once (CLI flags, GUI sliders, run record).
+/// Every parameter `generate` takes: every style's and the block-building ones,
+/// each name once (CLI flags, GUI sliders, run record).
 std::vector<ParameterDescription> generationParameterDescriptions();
 
-/// Subdivides one block with a concrete style (obb, skeleton or offset; not
-/// auto): `parameters.bounds` for obb, all of `parameters` for the skeleton
-/// styles (offset: d_offset 30 m when 0, patios always subdivided).
-/// `streetWidths` (per contour edge, see StreetWidths) feed the StreetWidth rule;
-/// `reuse` serves the skeleton styles.
-Subdivision subdivideBlock(const Polygon& block, const std::string& style, const SkeletonParameters& parameters,
-                           std::uint64_t seed, const StreetWidths& streetWidths = {},
-                           const SkeletonReuse& reuse = {});
+/// The values of `values` that style `s` reads (its parameters()): what a
+/// block's plan holds, so that two plans are equal exactly when the style would
+/// make the same parcels.
+ParameterValues styleValues(const Style& s, const ParameterValues& values);
+
+/// Subdivides one block with a concrete style by name (not auto).
+Subdivision subdivideBlock(const Polygon& block, const std::string& style, const ParameterValues& values,
+                           std::uint64_t seed, const StreetWidths& streetWidths = {});
 
 /// Share of observed parcels with street access at or above which `auto` picks skeleton.
 constexpr double kAutoSkeletonAccessShare = 0.9;
+
+/// The registered styles (defined beside their algorithms).
+const Style& obbStyle();
+const Style& skeletonStyle();
+const Style& offsetStyle();
+const Style& autoStyle();
 
 }  // namespace parcelscope::generation

@@ -115,9 +115,12 @@ const std::vector<StreetWidths>& streetWidthsOf(BlockInputs& inputs);
 /// How one block is subdivided: a concrete style, every parameter, its own seed.
 /// Two equal plans give the same parcels.
 struct BlockPlan {
-  std::string style;  ///< obb, skeleton or offset
-  SkeletonParameters parameters;  ///< bounds included; skeleton-only fields at their defaults for obb
-  std::uint64_t seed = 0;         ///< the block's seed (blockSeed of the run seed and the key of the block's part)
+  std::string style;  ///< a concrete style of the registry (generation::styles()), auto resolved
+  /// The values the style reads (generation::styleValues), per-block bounds included.
+  ParameterValues values;
+  std::uint64_t seed = 0;  ///< the block's seed (blockSeed of the run seed and the key of the block's part)
+  /// The OBB bounds of `values`.
+  ObbParameters bounds() const { return generation::obbParametersFrom(values); }
   bool operator==(const BlockPlan& other) const;
   bool operator!=(const BlockPlan& other) const { return !(*this == other); }
 };

@@ -1,0 +1,78 @@
+// The style registry: one description per style, read by everything that
+// lists styles; plans hold only the values their style reads.
+#include "parcelscope/generation/Styles.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "TestUtil.h"
+#include "parcelscope/core/Error.h"
+
+namespace parcelscope::generation {
+namespace {
+
+TEST(Styles, EachStyleIsRegisteredOnceWithItsParametersAndTheListsFollowTheRegistry) {
+  std::set<std::string> names;
+  for (const Style* s : styles()) {
+    EXPECT_TRUE(names.insert(s->name()).second) << s->name();
+    EXPECT_FALSE(s->description().empty()) << s->name();
+    std::set<std::string> parameters;
+    for (const auto& d : s->parameters()) parameters.insert(d.name);
+    for (const char* bound : {"a-min", "a-max", "w-min", "w-max", "omega", "seed"}) {
+      EXPECT_EQ(parameters.count(bound), 1u) << s->name() << " lacks " << bound;
+    }
+    EXPECT_EQ(&style(s->name()), s);
+  }
+  EXPECT_EQ(names, (std::set<std::string>{"obb", "skeleton", "offset", "auto"}));
+  ASSERT_EQ(generationStyles().size(), styles().size());
+  for (std::size_t i = 0; i < styles().size(); ++i) EXPECT_EQ(generationStyles()[i].first, styles()[i]->name());
+  try {
+    style("voronoi");
+    FAIL() << "an unknown style is a usage error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::Usage);
+    EXPECT_NE(std::string(e.what()).find("obb, skeleton, offset, auto"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Styles, StyleValuesHoldWhatTheStyleReadsAndNothingElse) {
+  ParameterValues values = defaultValues(generationParameterDescriptions());
+  values["street-angle"] = 45;
+  values["block-tolerance"] = 2;
+  const ParameterValues obb = styleValues(obbStyle(), values);
+  EXPECT_EQ(obb.count("street-angle"), 0u);  // a skeleton parameter
+  EXPECT_EQ(obb.count("block-tolerance"), 0u);  // builds blocks, not parcels
+  EXPECT_EQ(obb.at("a-max"), values.at("a-max"));
+  const ParameterValues skeleton = styleValues(skeletonStyle(), values);
+  EXPECT_EQ(skeleton.at("street-angle"), 45);
+  EXPECT_EQ(skeleton.at("a-max"), values.at("a-max"));
+}
+
+TEST(Styles, AutoChoosesPerBlockAndDoesNotSubdivideItself) {
+  EXPECT_EQ(&autoStyle().resolve({0.5}), &obbStyle());
+  EXPECT_EQ(&autoStyle().resolve({0.95}), &skeletonStyle());
+  EXPECT_EQ(&autoStyle().resolve({std::nan("")}), &skeletonStyle());
+  EXPECT_EQ(&obbStyle().resolve({0.5}), &obbStyle());
+  EXPECT_THROW(subdivideBlock(test::rect(0, 0, 60, 40), "auto", {}, 1), Error);
+}
+
+TEST(Styles, ConcreteStylesTileARectangleReproducibly) {
+  const Polygon block = test::rect(0, 0, 120, 60);
+  for (const char* name : {"obb", "skeleton", "offset"}) {
+    const Subdivision a = subdivideBlock(block, name, {}, 7), b = subdivideBlock(block, name, {}, 7);
+    ASSERT_GT(a.parcels.size(), 1u) << name;
+    ASSERT_EQ(a.parcels.size(), b.parcels.size()) << name;
+    double sum = 0;
+    for (std::size_t i = 0; i < a.parcels.size(); ++i) {
+      EXPECT_TRUE(test::sameBits(a.parcels[i], b.parcels[i])) << name << " parcel " << i;
+      sum += area(a.parcels[i]);
+    }
+    EXPECT_NEAR(sum, area(block), 1e-9 * area(block)) << name;
+    EXPECT_FALSE(a.failed) << name;
+  }
+}
+
+}  // namespace
+}  // namespace parcelscope::generation
