@@ -539,7 +539,7 @@ class ObbStyle : public Style {
 public:
   std::string name() const override { return "obb"; }
   std::string description() const override { return "OBB recursive subdivision (Vanegas et al. 2012, 4.3)"; }
-  std::vector<ParameterDescription> parameters() const override { return obbParameterDescriptions(); }
+  const std::vector<ParameterDescription>& parameters() const override { return obbParameterDescriptions(); }
   Subdivision run(const StyleRun& r) const override {
     const ObbParameters p = obbParametersFrom(r.values);
     const bool afterObb = r.previous && r.previousStyle && *r.previousStyle == "obb" && r.previousValues;

@@ -1222,9 +1222,12 @@ public:
     return offset_ ? "skeleton with a finite offset (30 m unless --offset) and patios subdivided by OBB"
                    : "straight-skeleton strips along the streets (4.2); --offset M leaves patios";
   }
-  std::vector<ParameterDescription> parameters() const override {
-    std::vector<ParameterDescription> p = obbParameterDescriptions();
-    appendParameters(p, skeletonParameterDescriptions());
+  const std::vector<ParameterDescription>& parameters() const override {
+    static const std::vector<ParameterDescription> p = [] {
+      std::vector<ParameterDescription> all = obbParameterDescriptions();
+      appendParameters(all, skeletonParameterDescriptions());
+      return all;
+    }();
     return p;
   }
   bool usesStreetWidths() const override { return true; }

@@ -65,9 +65,12 @@ public:
   std::string description() const override {
     return "per block: skeleton where >= 90 % of observed parcels have street access, else obb";
   }
-  std::vector<ParameterDescription> parameters() const override {
-    std::vector<ParameterDescription> p = obbStyle().parameters();
-    appendParameters(p, skeletonStyle().parameters());
+  const std::vector<ParameterDescription>& parameters() const override {
+    static const std::vector<ParameterDescription> p = [] {
+      std::vector<ParameterDescription> all = obbStyle().parameters();
+      appendParameters(all, skeletonStyle().parameters());
+      return all;
+    }();
     return p;
   }
   bool usesStreetWidths() const override { return true; }

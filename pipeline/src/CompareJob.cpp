@@ -8,6 +8,7 @@
 #include <future>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <optional>
 
@@ -130,13 +131,41 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
     }
     r.observedLots = pick(a.metrics, lots);
   }
+  // Generated entries go to the observed block of their key; a block of the
+  // source that no observed block matches (no observed parcels) is compared
+  // as such, after the observed ones, with an empty observed side.
+  std::map<Key, std::size_t> observedBlock;
+  for (std::size_t b = 0; b < a.blocks.size(); ++b) observedBlock.emplace(a.blocks[b].key, b);
   std::vector<std::vector<int>> generatedIn(a.blocks.size());
+  std::vector<std::size_t> blockOfEntry(r.generated.blocks.size());
+  struct Unmatched {
+    std::int64_t id;
+    Key key;
+    double area = 0;
+    std::vector<int> parcels;
+  };
+  std::vector<Unmatched> unmatched;
+  std::map<Key, std::size_t> unmatchedOf;
   for (std::size_t k = 0; k < r.generated.blocks.size(); ++k) {
+    const Key key = k < r.generated.blockKeys.size() ? r.generated.blockKeys[k] : 0;
     const std::int64_t id = r.generated.blockIds[k];
-    if (id < 0 || id >= static_cast<std::int64_t>(a.blocks.size())) {
-      throw std::logic_error("compare: generated block id " + std::to_string(id) + " is not an observed block");
+    std::size_t b = a.blocks.size();
+    if (id >= 0 && id < static_cast<std::int64_t>(a.blocks.size()) && a.blocks[id].key == key) {
+      b = static_cast<std::size_t>(id);  // blocks made from the observed parcels themselves
+    } else if (const auto found = observedBlock.find(key); found != observedBlock.end()) {
+      b = found->second;
     }
-    for (int i : r.generated.blocks[k].parcels) generatedIn[id].push_back(i);
+    if (b < a.blocks.size()) {
+      blockOfEntry[k] = b;
+      for (int i : r.generated.blocks[k].parcels) generatedIn[b].push_back(i);
+      continue;
+    }
+    const auto [it, added] = unmatchedOf.emplace(key, unmatched.size());
+    if (added) unmatched.push_back({id, key, 0.0, {}});
+    Unmatched& u = unmatched[it->second];
+    for (const Polygon& part : r.generated.blocks[k].parts) u.area += area(part);
+    u.parcels.insert(u.parcels.end(), r.generated.blocks[k].parcels.begin(), r.generated.blocks[k].parcels.end());
+    blockOfEntry[k] = a.blocks.size() + it->second;
   }
   if (!r.observedSides) {
     auto sides = std::make_shared<std::vector<analysis::PreparedSet>>(a.blocks.size() + 1);
@@ -148,9 +177,9 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
   const std::vector<analysis::PreparedSet>& observedSides = *r.observedSides;
   // Street access of parcels not measured yet is not known: NaN, not the 0 they hold.
   constexpr double kNotMeasured = std::numeric_limits<double>::quiet_NaN();
-  std::vector<char> pending(a.blocks.size(), 0);
-  for (std::size_t k : r.generated.contextPending) pending[static_cast<std::size_t>(r.generated.blockIds[k])] = 1;
-  const bool reuse = keep && keep->size() == a.blocks.size() && r.blocks.size() == a.blocks.size();
+  std::vector<char> pending(a.blocks.size() + unmatched.size(), 0);
+  for (std::size_t k : r.generated.contextPending) pending[blockOfEntry[k]] = 1;
+  const bool reuse = keep && unmatched.empty() && keep->size() == a.blocks.size() && r.blocks.size() == a.blocks.size();
   if (!reuse) r.blocks.assign(a.blocks.size(), {});
   std::vector<std::size_t> todo;
   for (std::size_t b = 0; b < a.blocks.size(); ++b) {
@@ -174,6 +203,19 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
     c.comparison = analysis::compareSets(observedSides[b], generated, bins, quantile);
     if (pending[b]) c.comparison.generated.streetAccessShare = kNotMeasured;
   });
+  if (!unmatched.empty()) {
+    const analysis::PreparedSet none = analysis::prepareSet({});
+    r.blocks.resize(a.blocks.size() + unmatched.size());
+    parallelFor(unmatched.size(), [&](std::size_t u) {
+      analysis::BlockComparison& c = r.blocks[a.blocks.size() + u];
+      c.blockId = unmatched[u].id;
+      c.blockKey = unmatched[u].key;
+      c.blockArea = unmatched[u].area;
+      c.comparison = analysis::compareSets(none, analysis::prepareSet(pick(r.generated.metrics, unmatched[u].parcels)),
+                                           bins, quantile);
+      if (pending[a.blocks.size() + u]) c.comparison.generated.streetAccessShare = kNotMeasured;
+    });
+  }
   if (!r.generated.contextPending.empty()) r.city.generated.streetAccessShare = kNotMeasured;
 }
 

@@ -172,12 +172,11 @@ std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInp
     const Style& chosen = style(overridden && !override->style.empty() ? override->style : request.style);
     const Style& concrete = chosen.resolve({e.accessShare});
     plan.style = concrete.name();
-    ParameterValues planned = v;
-    planned["a-min"] = p.aMin;
-    planned["a-max"] = p.aMax;
-    planned["w-min"] = p.wMin;
-    planned["w-max"] = p.wMax;
-    plan.values = styleValues(concrete, planned);
+    plan.values = styleValues(concrete, v);
+    plan.values["a-min"] = p.aMin;
+    plan.values["a-max"] = p.aMax;
+    plan.values["w-min"] = p.wMin;
+    plan.values["w-max"] = p.wMax;
     plan.seed = blockSeed(runSeed(v), static_cast<std::int64_t>(partKey(e.blockKey, e.part)));
   }
   if (clampedBounds) *clampedBounds = clamped;

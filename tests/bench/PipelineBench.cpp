@@ -119,6 +119,27 @@ void ObbSubdivisionPerBlock(benchmark::State& state) {
 }
 BENCHMARK(ObbSubdivisionPerBlock)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
+// Planning every cambridge_ma block (auto style: per-block bounds, overrides,
+// the style's values, the seed from the block key), as each session update
+// does before it knows which blocks changed.
+void PlanBlocks(benchmark::State& state) {
+  if (!haveData(state)) return;
+  parcelscope::io::ReadOptions in;
+  in.path = kCambridge;
+  const auto d = parcelscope::pipeline::loadObserved(
+      in, parcelscope::defaultValues(parcelscope::analysis::analysisParameters()));
+  parcelscope::pipeline::GenerateRequest request;
+  request.fromParcels = true;
+  request.observed = &d;
+  request.style = "auto";
+  request.parameters = parcelscope::defaultValues(parcelscope::generation::generationParameterDescriptions());
+  const auto inputs = parcelscope::pipeline::prepareBlocks(request);
+  std::size_t plans = 0;
+  for (auto _ : state) plans = parcelscope::pipeline::planBlocks(request, inputs).size();
+  state.counters["blocks"] = static_cast<double>(plans);
+}
+BENCHMARK(PlanBlocks)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+
 // Runs `compare` into `out` and adds the seconds of each stage (summary.json)
 // to `seconds`; returns the summary.
 CPLJSONObject runTimed(const parcelscope::pipeline::CompareRequest& request, const std::filesystem::path& out,

@@ -17,6 +17,7 @@
 #include "parcelscope/io/Writers.h"
 #include "parcelscope/pipeline/CompareJob.h"
 #include "parcelscope/pipeline/CompareSession.h"
+#include "CompareStages.h"
 
 namespace parcelscope::pipeline {
 namespace {
@@ -222,6 +223,39 @@ TEST(StableKeys, ABlockLayerFromStatsKeepsTheKeysAndSeedsOfItsParcels) {
     ASSERT_NE(it, seeds.end()) << "block layer entry " << k << " has a key no observed block has";
     EXPECT_EQ(it->second, pb[k].seed);
   }
+}
+
+}  // namespace
+}  // namespace parcelscope::pipeline
+
+namespace parcelscope::pipeline {
+namespace {
+
+// A block of the generation that no observed block matches (as a block source
+// other than the observed parcels can give) is compared with an empty
+// observed side, after the observed blocks; nothing throws.
+TEST(CompareStage, ABlockWithoutObservedParcelsIsComparedAsSuch) {
+  CompareRequest r = request(kSample);
+  CompareResult result = compare(r);
+  const std::size_t observedBlocks = result.observed->analysis.blocks.size();
+  ASSERT_EQ(result.blocks.size(), observedBlocks);
+  const std::size_t moved = result.generated.blocks[0].parcels.size();
+  const std::int64_t formerBlock = result.generated.blockIds[0];
+  const std::int64_t formerCount = result.blocks[formerBlock].comparison.generated.parcels;
+  result.generated.blockIds[0] = 9999;
+  result.generated.blockKeys[0] = 0x0123456789abcdefull;
+  result.blocks.clear();
+  detail::compareStage(result, r);
+  ASSERT_EQ(result.blocks.size(), observedBlocks + 1);
+  const analysis::BlockComparison& extra = result.blocks.back();
+  EXPECT_EQ(extra.blockId, 9999);
+  EXPECT_EQ(extra.blockKey, 0x0123456789abcdefull);
+  EXPECT_EQ(extra.comparison.observed.parcels, 0);
+  EXPECT_EQ(extra.comparison.generated.parcels, static_cast<std::int64_t>(moved));
+  EXPECT_NEAR(extra.blockArea, area(result.generated.blocks[0].parts[0]), 1e-9);
+  EXPECT_EQ(result.blocks[formerBlock].comparison.generated.parcels, formerCount - static_cast<std::int64_t>(moved));
+  // The tables hold it too.
+  EXPECT_EQ(analysis::blockComparisonTable(result.blocks).rows.size(), observedBlocks + 1);
 }
 
 }  // namespace

@@ -48,7 +48,7 @@ public:
   /// One line for --help and the GUI.
   virtual std::string description() const = 0;
   /// The parameters this style reads (bounds and its own), each described once.
-  virtual std::vector<ParameterDescription> parameters() const = 0;
+  virtual const std::vector<ParameterDescription>& parameters() const = 0;
   /// Whether run() reads street widths (they are measured only when some block needs them).
   virtual bool usesStreetWidths() const { return false; }
   /// The concrete style a block is subdivided with: this one, or for a style

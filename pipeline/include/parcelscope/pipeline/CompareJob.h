@@ -62,7 +62,9 @@ struct CompareResult {
   /// of the blocks holding pending entries is NaN.
   analysis::Comparison city;
   /// One per observed block, in block order; generated parcels are matched to
-  /// blocks by block id (a multipart block's parts are one block).
+  /// blocks by block key (a multipart block's parts are one block). Blocks of
+  /// the generation that no observed block matches (a block source without
+  /// observed parcels there) follow, each compared with an empty observed side.
   std::vector<analysis::BlockComparison> blocks;
   /// The observed side of every comparison, prepared once per observed data
   /// and shared between successive results of a CompareSession: one per
