@@ -1,14 +1,49 @@
 #include "Args.h"
 
+#include <cctype>
+#include <cstdlib>
+#include <set>
 #include <sstream>
 
 #include "parcelscope/core/Error.h"
 
 namespace parcelscope::cli {
 
+namespace {
+
+// Whether strtod would read all of `text` as a number that is not written in
+// decimal: hexadecimal ("0x2", "0x1p3"), "inf", "infinity" or "nan". Leading
+// blanks, which strtod skips, are allowed as before.
+bool readsAsNonDecimalNumber(const std::string& text) {
+  char* end = nullptr;
+  std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0') return false;  // not a number at all: parseValue says so
+  std::size_t i = 0;
+  while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+  if (i < text.size() && (text[i] == '+' || text[i] == '-')) ++i;
+  std::size_t digits = 0;
+  while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i, ++digits;
+  if (i < text.size() && text[i] == '.') {
+    ++i;
+    while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i, ++digits;
+  }
+  if (digits == 0) return true;
+  if (i < text.size() && (text[i] == 'e' || text[i] == 'E')) {
+    ++i;
+    if (i < text.size() && (text[i] == '+' || text[i] == '-')) ++i;
+    std::size_t exponent = 0;
+    while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i, ++exponent;
+    if (exponent == 0) return true;
+  }
+  return i != text.size();
+}
+
+}  // namespace
+
 Args::Args(const std::vector<std::string>& args, const std::vector<FlagSpec>& flags,
            const std::vector<ParameterDescription>& parameters)
     : parameters_(defaultValues(parameters)) {
+  std::set<std::string> seen;  // flag names given so far
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a.size() < 3 || a.compare(0, 2, "--") != 0) {
@@ -31,12 +66,16 @@ Args::Args(const std::vector<std::string>& args, const std::vector<FlagSpec>& fl
       if (f.name == name) flag = &f;
     }
     if (!param && !flag) throw usageError("unknown option --" + name);
+    if (!seen.insert(name).second) throw usageError("--" + name + " is given more than once; give it once");
     const bool takesValue = param || flag->takesValue;
     if (takesValue && !hasInline) {
       if (i + 1 >= args.size()) throw usageError("--" + name + " needs a value");
       val = args[++i];
     }
     if (param) {
+      if (readsAsNonDecimalNumber(val)) {
+        throw usageError("--" + name + " " + val + " is not a decimal number (e.g. 2, -0.5, 1e3)");
+      }
       parameters_[name] = parseValue(*param, val);
       given_.insert(name);
     } else {

@@ -20,9 +20,10 @@ struct FlagSpec {
 class Args {
 public:
   /// Parses `args` (after the subcommand). Throws Error(Usage) on an unknown
-  /// flag, a missing value, a parameter value that is not valid (parseValue():
-  /// numbers for every parameter, an enum's labels, true/false/yes/no for a
-  /// boolean) or is out of range.
+  /// flag, a flag given more than once, a missing value, a parameter value that
+  /// is not valid (parseValue(): decimal numbers for every parameter, an enum's
+  /// labels, true/false/yes/no for a boolean; hexadecimal, inf and nan are
+  /// refused) or is out of range.
   Args(const std::vector<std::string>& args, const std::vector<FlagSpec>& flags,
        const std::vector<ParameterDescription>& parameters);
 

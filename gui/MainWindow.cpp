@@ -20,6 +20,7 @@
 #include <QPainter>
 #include <QProgressBar>
 #include <QPushButton>
+#include <QRegularExpression>
 #include <QScrollArea>
 #include <QSettings>
 #include <QSplitter>
@@ -43,7 +44,9 @@
 #include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
 
+#include <algorithm>
 #include <cmath>
+#include <set>
 #include <utility>
 
 #include "MapView.h"
@@ -65,6 +68,9 @@ public:
   static ChartStyle* New();
   vtkTypeMacro(ChartStyle, vtkContextInteractorStyle)
   void drawNow() { RenderNow(); }
+  // VTK's own keys ('3' stereo, 'r' reset the camera, 'e'/'q' quit, ...) do
+  // nothing; the chart still receives key presses (OnKeyPress).
+  void OnChar() override {}
 };
 vtkStandardNewMacro(ChartStyle);
 
@@ -116,6 +122,79 @@ QString number(double v) {
 
 QString sampleDirectory() { return QStringLiteral(PARCELSCOPE_SAMPLE_DIR); }
 
+// A message of the libraries, worded for the command line ("--crs", "--w-min"),
+// in the window's words: its menus and the names of its controls. The
+// libraries' messages stay as they are (the command line shows them).
+QString windowWording(QString message) {
+  // Before a flag: the start, a space or punctuation, not a letter (file names keep their dashes).
+  const QString before = QStringLiteral(R"((^|[\s(\[;:,"'=]))");
+  message.replace(QRegularExpression(R"(give the (real )?CRS with --crs EPSG:N)"),
+                  QStringLiteral("set the input CRS (File > Set input CRS...)"));
+  message.replace(QRegularExpression(before + R"(--crs\b)"), QStringLiteral("\\1the input CRS"));
+  message.replace(QRegularExpression(before + R"(--where\b)"), QStringLiteral("\\1the filter"));
+  // A parameter as the parameter panel and the block override name it.
+  static const std::set<QString> names = [] {
+    std::set<QString> out{QStringLiteral("style"), QStringLiteral("subdivision-style"), QStringLiteral("key-field")};
+    for (const auto& d : pipeline::compareParameters()) out.insert(QString::fromStdString(d.name));
+    return out;
+  }();
+  static const QRegularExpression flag(before + R"(--([a-z][a-z0-9]*(?:-[a-z0-9]+)*))");
+  QString out;
+  int last = 0;
+  for (auto it = flag.globalMatch(message); it.hasNext();) {
+    const QRegularExpressionMatch m = it.next();
+    if (!names.count(m.captured(2))) continue;
+    out += message.mid(last, m.capturedStart(2) - 2 - last) + m.captured(2);
+    last = m.capturedEnd(2);
+  }
+  return out + message.mid(last);
+}
+
+// File > Open recent: each file with the layer, filter and CRS it opened with.
+struct RecentFile {
+  QString path, layer, where, crs;
+};
+
+const char* kSettingsOrganisation = "ParcelScope";
+const char* kSettingsApplication = "parcelscope-gui";
+
+std::vector<RecentFile> readRecentFiles() {
+  QSettings settings(kSettingsOrganisation, kSettingsApplication);
+  std::vector<RecentFile> files;
+  const int n = settings.beginReadArray("recentFiles");
+  for (int i = 0; i < n; ++i) {
+    settings.setArrayIndex(i);
+    files.push_back({settings.value("path").toString(), settings.value("layer").toString(),
+                     settings.value("where").toString(), settings.value("crs").toString()});
+  }
+  settings.endArray();
+  // Written by an earlier version: paths only.
+  if (n == 0) {
+    for (const QString& path : settings.value("recent").toStringList()) files.push_back({path, {}, {}, {}});
+  }
+  return files;
+}
+
+void writeRecentFiles(const std::vector<RecentFile>& files) {
+  QSettings settings(kSettingsOrganisation, kSettingsApplication);
+  settings.remove("recent");
+  settings.remove("recentFiles");
+  settings.beginWriteArray("recentFiles", static_cast<int>(files.size()));
+  for (int i = 0; i < static_cast<int>(files.size()); ++i) {
+    const RecentFile& f = files[static_cast<std::size_t>(i)];
+    settings.setArrayIndex(i);
+    settings.setValue("path", f.path);
+    settings.setValue("layer", f.layer);
+    settings.setValue("where", f.where);
+    settings.setValue("crs", f.crs);
+  }
+  settings.endArray();
+}
+
+bool sameInput(const io::ReadOptions& a, const io::ReadOptions& b) {
+  return a.path == b.path && a.layer == b.layer && a.where == b.where && a.crsOverride == b.crsOverride;
+}
+
 }  // namespace
 
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new SessionWorker) {
@@ -128,12 +207,20 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
   connect(worker_, &SessionWorker::failed, this, [this](const QString& message, qint64 serial) {
     // The newest request failed: the controls show the last good one, which later edits build on.
     const bool newest = controller_.failed(serial);
-    if (newest) showRequest();
+    if (newest) {
+      showRequest();
+      openedInput_.reset();  // it did not open: not a recent file
+    }
     progress_->setVisible(false);
     cancel_->setVisible(false);
+    updateActions();
     // A CRS the reader cannot use: say so, and offer to give one.
     const bool crsProblem = message.contains("CRS");
-    showError(crsProblem ? message + "  (File > Set input CRS gives the input another CRS)" : message);
+    QString shown = windowWording(message);
+    if (crsProblem && !shown.contains("File > Set input CRS")) {
+      shown += "  (File > Set input CRS... gives the input another CRS)";
+    }
+    showError(shown);
     if (crsProblem && newest && !QStandardPaths::isTestModeEnabled()) {
       QTimer::singleShot(0, this, [this, input = controller_.failedRequest()->input] { askForCrs(input); });
     }
@@ -235,6 +322,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
   statusBar()->addPermanentWidget(progress_);
   statusBar()->addPermanentWidget(cancel_);
   buildMenus();
+  updateActions();
   resize(1600, 1000);
 }
 
@@ -318,8 +406,8 @@ QWidget* MainWindow::buildControls() {
   }
   b->addLayout(overrides);
   auto* buttons = new QHBoxLayout;
-  auto* apply = new QPushButton("Override block");
-  auto* clear = new QPushButton("Clear override");
+  auto* apply = overrideBlock_ = new QPushButton("Override block");
+  auto* clear = clearOverride_ = new QPushButton("Clear override");
   connect(apply, &QPushButton::clicked, this, [this] {
     ParameterValues values;
     for (const auto& [name, widgets] : blockParameters_) {
@@ -344,19 +432,22 @@ void MainWindow::buildMenus() {
   }, QKeySequence::Open);
   file->addAction("Open &sample", this, [this] { openSample(); });
   recentMenu_ = file->addMenu("Open &recent");
+  recentMenu_->setObjectName("recentMenu");
+  recentMenu_->setToolTipsVisible(true);
   refreshRecent();
-  file->addAction("Set input &CRS...", this, [this] { askForCrs(); });
+  setCrsAction_ = file->addAction("Set input &CRS...", this, [this] { askForCrs(); });
   file->addSeparator();
   file->addAction("Open session...", this, [this] {
     const QString path = QFileDialog::getOpenFileName(this, "Open session", {}, "ParcelScope session (*.json)");
     if (!path.isEmpty()) openSession(path);
   });
-  file->addAction("Save session...", this, [this] {
+  saveSessionAction_ = file->addAction("Save session...", this, [this] {
     const QString path = QFileDialog::getSaveFileName(this, "Save session", "session.json", "ParcelScope session (*.json)");
     if (!path.isEmpty()) saveSession(path);
   });
   file->addSeparator();
-  QMenu* exports = file->addMenu("&Export");
+  // Disabled until there is a result to export (updateActions).
+  QMenu* exports = exportMenu_ = file->addMenu("&Export");
   exports->addAction("Figure...", this, [this] { exportFigureDialog(); });
   exports->addAction("Tables (CSV)...", this, [this] {
     const QString folder = QFileDialog::getExistingDirectory(this, "Export tables into folder");
@@ -378,6 +469,8 @@ void MainWindow::buildMenus() {
                                "(zoom in to see more of them)")
                            .arg(viz::kMinOutlinedPixels));
   connect(outlines, &QAction::toggled, this, [this](bool on) { setOutlinesVisible(on); });
+  zoomToExtentAction_ = view->addAction("Zoom to &extent", this, [this] { zoomToExtent(); }, Qt::Key_Home);
+  zoomToExtentAction_->setToolTip("Fit both views to the data");
   QToolBar* bar = addToolBar("Main");
   bar->setObjectName("mainToolBar");
   bar->addAction("Open sample", this, [this] { openSample(); });
@@ -425,7 +518,9 @@ void MainWindow::openFile(const QString& path, const QString& layer, const QStri
   }
   controller_.openInput(input);
   selected_ = -1;
-  rememberRecent(path);
+  // A recent file once a result of it is drawn (drawReport).
+  openedInput_ = input;
+  updateActions();
   setWindowTitle("ParcelScope - " + QFileInfo(path).fileName());
   submit();
 }
@@ -442,7 +537,9 @@ void MainWindow::openSession(const QString& path) {
     return;
   }
   selected_ = -1;
+  openedInput_.reset();  // a session's input is not a recent file
   showRequest();
+  updateActions();
   submit();
 }
 
@@ -563,6 +660,13 @@ void MainWindow::setColourBy(const QString& quantity) {
   emit viewsUpdated(controller_.completeSerial());
 }
 
+void MainWindow::zoomToExtent() {
+  if (!extent_) return;
+  observedView_->fit(*extent_);  // the procedural view shares its camera
+  observedView_->render();
+  proceduralView_->render();
+}
+
 void MainWindow::setOutlinesVisible(bool visible) {
   observedView_->layer().setOutlinesVisible(visible);
   proceduralView_->layer().setOutlinesVisible(visible);
@@ -624,6 +728,7 @@ void MainWindow::drawReport(const UpdateReport& report) {
   if (decision.action == pipeline::Controller::Action::Numbers) {
     fillNumbers();
     showBlock();
+    updateActions();
     noteContextCompleted(report.serial);
     return;
   }
@@ -689,6 +794,7 @@ void MainWindow::drawReport(const UpdateReport& report) {
                   std::max(extent.maxY, x.maxY)};
       }
     }
+    extent_ = extent;
     observedView_->fit(extent);
   }
   drawHistogram();
@@ -700,6 +806,12 @@ void MainWindow::drawReport(const UpdateReport& report) {
   proceduralView_->render();
   timings.views = lap();
   lastTimings_ = timings;
+  updateActions();
+  // The input opened: it goes to the recent files, as it was opened.
+  if (openedInput_ && sameInput(report.request.input, *openedInput_)) {
+    rememberRecent(*openedInput_);
+    openedInput_.reset();
+  }
 
   const auto it = started_.find(report.serial);
   if (report.partial) {
@@ -933,10 +1045,24 @@ void MainWindow::setBlockInfo(const QString& html) {
 }
 
 void MainWindow::showError(const QString& message) {
-  errorBar_->setText(message);
+  const QString shown = windowWording(message);
+  errorBar_->setText(shown);
   errorBar_->setVisible(true);
   status_->setText("error");
-  emit errorShown(message);
+  emit errorShown(shown);
+}
+
+void MainWindow::updateActions() {
+  // setEnabled does nothing when the state is unchanged, so this costs nothing per update.
+  const bool result = controller_.finalResult() != nullptr;
+  saveSessionAction_->setEnabled(result);
+  exportMenu_->menuAction()->setEnabled(result);
+  for (QAction* a : exportMenu_->actions()) a->setEnabled(result);
+  zoomToExtentAction_->setEnabled(extent_.has_value() && controller_.shownResult() != nullptr);
+  setCrsAction_->setEnabled(controller_.loaded() || controller_.failedRequest());
+  const bool shown = controller_.shownResult() != nullptr;
+  overrideBlock_->setEnabled(shown);
+  clearOverride_->setEnabled(shown);
 }
 
 void MainWindow::dragEnterEvent(QDragEnterEvent* event) {
@@ -954,21 +1080,27 @@ void MainWindow::dropEvent(QDropEvent* event) {
   }
 }
 
-void MainWindow::rememberRecent(const QString& path) {
-  QSettings settings("ParcelScope", "parcelscope-gui");
-  QStringList recent = settings.value("recent").toStringList();
-  recent.removeAll(path);
-  recent.prepend(path);
-  while (recent.size() > 8) recent.removeLast();
-  settings.setValue("recent", recent);
+void MainWindow::rememberRecent(const io::ReadOptions& input) {
+  const RecentFile opened{QString::fromStdString(input.path), QString::fromStdString(input.layer),
+                          QString::fromStdString(input.where), QString::fromStdString(input.crsOverride)};
+  std::vector<RecentFile> files = readRecentFiles();
+  files.erase(std::remove_if(files.begin(), files.end(), [&](const RecentFile& f) { return f.path == opened.path; }),
+              files.end());
+  files.insert(files.begin(), opened);
+  if (files.size() > 8) files.resize(8);
+  writeRecentFiles(files);
   refreshRecent();
 }
 
 void MainWindow::refreshRecent() {
   recentMenu_->clear();
-  QSettings settings("ParcelScope", "parcelscope-gui");
-  for (const QString& path : settings.value("recent").toStringList()) {
-    recentMenu_->addAction(path, this, [this, path] { openFile(path); });
+  for (const RecentFile& f : readRecentFiles()) {
+    QAction* a = recentMenu_->addAction(f.path, this, [this, f] { openFile(f.path, f.layer, f.where, f.crs); });
+    QStringList how;
+    if (!f.layer.isEmpty()) how << "layer " + f.layer;
+    if (!f.where.isEmpty()) how << "filter " + f.where;
+    how << (f.crs.isEmpty() ? QString("CRS as the file declares it") : "CRS " + f.crs);
+    a->setToolTip(how.join("; "));
   }
   recentMenu_->setEnabled(!recentMenu_->isEmpty());
 }

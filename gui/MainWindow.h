@@ -15,6 +15,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include <vtkNew.h>
 #include <vtkSmartPointer.h>
@@ -69,6 +70,9 @@ public:
   void setColourBy(const QString& quantity);
   /// Shows or hides the parcel outlines in both views (View > Parcel outlines).
   void setOutlinesVisible(bool visible);
+  /// Fits both views to the observed blocks (View > Zoom to extent, Home);
+  /// nothing before the first result.
+  void zoomToExtent();
   /// Selects the observed block with this index (-1: none).
   void selectBlock(int block);
   /// Overrides the selected block's style and parameters, or clears its override.
@@ -142,7 +146,11 @@ private:
   /// The controls show the request being edited (after a session was read,
   /// or a failure brought back the last good request).
   void showRequest();
+  /// Shows `message` in the error bar, in the window's words (see windowWording).
   void showError(const QString& message);
+  /// Enables what needs a result (exports, save session, block override, zoom
+  /// to extent) or an input (set input CRS) once there is one.
+  void updateActions();
   void setBlockInfo(const QString& html);
   /// Recolours the views; returns whether the observed view changed (it is
   /// drawn again only then). `observedChanged`: its data changed.
@@ -150,7 +158,9 @@ private:
   void drawHistogram();
   void fillNumbers();
   void showBlock();
-  void rememberRecent(const QString& path);
+  /// Puts `input` first in File > Open recent, with its layer, filter and CRS
+  /// (QSettings), which opening it from there uses again.
+  void rememberRecent(const io::ReadOptions& input);
   void refreshRecent();
   void exportFigureDialog();
   /// Runs `write` on the last complete result; says `done` or shows the error.
@@ -172,6 +182,11 @@ private:
   double firstViewMs_ = -1, lastFirstViewMs_ = 0;
   int selected_ = -1;
   std::vector<std::vector<int>> histogramCounts_;
+  /// The observed blocks' extent, for View > Zoom to extent (set with the first result of an input).
+  std::optional<Box> extent_;
+  /// The input File > Open (or the recent list, drag and drop) opened last,
+  /// until a result of it is drawn: then it goes to the recent files.
+  std::optional<io::ReadOptions> openedInput_;
   std::string shownQuantity_;
   viz::ColourScale shownScale_;
   bool selectionChanged_ = false;
@@ -195,8 +210,14 @@ private:
   QTextBrowser* blockInfo_;
   QString blockInfoHtml_;  // what blockInfo_ shows
   QComboBox* blockStyle_;
+  QPushButton* overrideBlock_;
+  QPushButton* clearOverride_;
   std::map<std::string, std::pair<QCheckBox*, QDoubleSpinBox*>> blockParameters_;
   QMenu* recentMenu_;
+  QAction* setCrsAction_;
+  QAction* saveSessionAction_;
+  QMenu* exportMenu_;
+  QAction* zoomToExtentAction_;
 };
 
 }  // namespace parcelscope::gui

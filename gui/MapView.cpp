@@ -27,12 +27,26 @@ namespace {
 
 constexpr double kLegendBand = 0.14;  // of the view's height
 
-// Left drag pans, the wheel and right drag zoom, a click without movement picks.
+// Left drag pans, the wheel (about the point under the cursor) and right drag
+// (about the view's centre) zoom, a click without movement picks. VTK's own
+// keys ('w' wireframe, 's' surface, '3' stereo, 'r' reset the camera, 'e'/'q'
+// quit, ...) are not the window's: keys do nothing here, and the window's
+// shortcuts (View > Zoom to extent) reach the window.
 class PanZoomStyle : public vtkInteractorStyleTrackballCamera {
 public:
   static PanZoomStyle* New();
   vtkTypeMacro(PanZoomStyle, vtkInteractorStyleTrackballCamera)
   std::function<void(int, int)> onClick;
+
+  void OnChar() override {}
+  void OnKeyPress() override {}
+  void OnKeyRelease() override {}
+  void OnKeyDown() override {}
+  void OnKeyUp() override {}
+
+  // One notch zooms by VTK's step (1.1 ^ (MotionFactor / 5)), as before.
+  void OnMouseWheelForward() override { zoomAtCursor(std::pow(1.1, MotionFactor * 0.2 * MouseWheelMotionFactor)); }
+  void OnMouseWheelBackward() override { zoomAtCursor(std::pow(1.1, -MotionFactor * 0.2 * MouseWheelMotionFactor)); }
 
   void OnLeftButtonDown() override {
     int* p = GetInteractor()->GetEventPosition();
@@ -53,6 +67,47 @@ public:
   }
 
 private:
+  // The world point at display position (x, y) of the current renderer.
+  bool worldAt(int x, int y, double out[2]) {
+    CurrentRenderer->SetDisplayPoint(x, y, 0);
+    CurrentRenderer->DisplayToWorld();
+    double w[4];
+    CurrentRenderer->GetWorldPoint(w);
+    if (w[3] == 0) return false;
+    out[0] = w[0] / w[3];
+    out[1] = w[1] / w[3];
+    return true;
+  }
+
+  // Zooms by `factor` (> 1: in) keeping the world point under the cursor under it.
+  void zoomAtCursor(double factor) {
+    const int* p = GetInteractor()->GetEventPosition();
+    FindPokedRenderer(p[0], p[1]);
+    if (!CurrentRenderer) return;
+    GrabFocus(EventCallbackCommand);
+    StartDolly();
+    vtkCamera* camera = CurrentRenderer->GetActiveCamera();
+    double before[2], after[2];
+    const bool anchored = worldAt(p[0], p[1], before);
+    if (camera->GetParallelProjection()) {
+      camera->SetParallelScale(camera->GetParallelScale() / factor);
+    } else {
+      camera->Dolly(factor);
+    }
+    if (anchored && worldAt(p[0], p[1], after)) {
+      double focal[3], position[3];
+      camera->GetFocalPoint(focal);
+      camera->GetPosition(position);
+      const double dx = before[0] - after[0], dy = before[1] - after[1];
+      camera->SetFocalPoint(focal[0] + dx, focal[1] + dy, focal[2]);
+      camera->SetPosition(position[0] + dx, position[1] + dy, position[2]);
+    }
+    if (AutoAdjustCameraClippingRange) CurrentRenderer->ResetCameraClippingRange();
+    EndDolly();
+    ReleaseFocus();
+    GetInteractor()->Render();
+  }
+
   int pressX_ = 0, pressY_ = 0;
 };
 vtkStandardNewMacro(PanZoomStyle);

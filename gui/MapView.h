@@ -1,7 +1,8 @@
 #pragma once
 // One parcel map view: a VTK render window in a Qt widget, a map layer, the
 // selected block's outline and, optionally, the shared colour bar. Drag pans,
-// the wheel zooms, a click reports the world point under the cursor.
+// the wheel zooms about the point under the cursor, a click reports the world
+// point under the cursor; VTK's own keys (wireframe, stereo, quit, ...) are off.
 #include <QWidget>
 
 #include <vtkNew.h>

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 #include <stdexcept>
@@ -23,6 +24,21 @@ std::string number(double v) {
   s.precision(12);
   s << v;
   return s.str();
+}
+
+// `v` as a user typed it, for messages: an integer in full (4294967295, not
+// 4.29497e+09), any other value in the fewest digits that read back as `v`.
+std::string exactNumber(double v) {
+  char buffer[64];
+  if (std::isfinite(v) && std::floor(v) == v && std::fabs(v) < 1e21) {
+    std::snprintf(buffer, sizeof buffer, "%.0f", v);
+    return buffer;
+  }
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buffer, sizeof buffer, "%.*g", digits, v);
+    if (!std::isfinite(v) || std::strtod(buffer, nullptr) == v) break;
+  }
+  return buffer;
 }
 
 // "0 street-width, 1 street-length"
@@ -104,13 +120,13 @@ void appendParameters(std::vector<ParameterDescription>& to, const std::vector<P
 void checkValue(const ParameterDescription& d, double value) {
   std::ostringstream m;
   if (!std::isfinite(value) || value < d.minimum || value > d.maximum) {
-    m << "--" << d.name << " " << value << " is outside [" << d.minimum << ", " << d.maximum << "]"
-      << (d.unit.empty() ? "" : " " + d.unit);
+    m << "--" << d.name << " " << exactNumber(value) << " is outside [" << exactNumber(d.minimum) << ", "
+      << exactNumber(d.maximum) << "]" << (d.unit.empty() ? "" : " " + d.unit);
     if (d.kind == ParameterKind::Enum) m << " (" << labelList(d) << ")";
     throw usageError(m.str());
   }
   if (d.integer() && std::floor(value) != value) {
-    m << "--" << d.name << " " << value << " must be an integer";
+    m << "--" << d.name << " " << exactNumber(value) << " must be an integer";
     throw usageError(m.str());
   }
 }

@@ -27,8 +27,9 @@ using detail::QuietErrors;
 // zero-area slivers, not parcels.
 constexpr double kMinPartArea = 1e-3;
 
-// GDAL's last message on one line (some span several, with a caret marker).
-std::string lastGdalMessage() {
+// GDAL's last message on one line (some span several, with a caret marker);
+// empty when GDAL left none.
+std::string gdalMessage() {
   std::string m, raw = CPLGetLastErrorMsg();
   for (char c : raw) {
     if (c == '\n' || c == '\r' || c == '\t') c = ' ';
@@ -36,21 +37,88 @@ std::string lastGdalMessage() {
     m += c;
   }
   while (!m.empty() && m.back() == ' ') m.pop_back();
+  return m;
+}
+
+std::string lastGdalMessage() {
+  const std::string m = gdalMessage();
   return m.empty() ? "unknown GDAL error" : m;
 }
 
+// What a path that is neither a regular file nor a folder is, for messages.
+std::string describeFileType(std::filesystem::file_type type) {
+  using std::filesystem::file_type;
+  switch (type) {
+    case file_type::fifo:
+      return "a named pipe (FIFO)";
+    case file_type::character:
+      return "a character device";
+    case file_type::block:
+      return "a block device";
+    case file_type::socket:
+      return "a socket";
+    default:
+      return "not a regular file";
+  }
+}
+
+// Opens `path` as a vector dataset. The path is looked at first (stat), so that
+// what GDAL cannot read is named (an empty file, a folder, a device) and a named
+// pipe without a writer is refused instead of blocking GDAL's open.
 GDALDatasetUniquePtr openVector(const std::string& path) {
+  namespace fs = std::filesystem;
   detail::ensureGdalRegistered();
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw inputError(path + ": no such file");
+  const fs::file_status status = fs::status(path, ec);
+  if (status.type() == fs::file_type::not_found) throw inputError(path + ": no such file");
+  if (ec) throw inputError(path + ": cannot be read (" + ec.message() + ")");
+  const bool folder = status.type() == fs::file_type::directory;
+  if (!folder && status.type() != fs::file_type::regular) {
+    throw inputError(path + ": is " + describeFileType(status.type()) +
+                     ", not a regular file or folder, so it is not read");
+  }
+  if (!folder && fs::file_size(path, ec) == 0 && !ec) throw inputError(path + ": is empty (0 bytes)");
   QuietErrors quiet;
   CPLErrorReset();
   GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
   if (!ds) {
-    throw inputError(path + ": not a vector format GDAL can read (" + lastGdalMessage() + ")");
+    const std::string why = gdalMessage();
+    if (folder) {
+      throw inputError(path + ": is a folder, not a file, and GDAL reads no vector dataset from it" +
+                       (why.empty() ? "" : " (" + why + ")"));
+    }
+    throw inputError(path + ": is not a file format GDAL reads (not a vector format GDAL can read" +
+                     (why.empty() ? "; no driver recognises its contents" : ": " + why) + ")");
   }
   if (ds->GetLayerCount() == 0) throw inputError(path + ": holds no vector layer");
   return ds;
+}
+
+// Whether every coordinate stored in `g` (x, y, and z and m where present) is
+// finite. OGR envelopes do not tell: their min and max pass over NaN.
+bool coordinatesFinite(const OGRGeometry& g) {
+  struct Visitor : OGRDefaultConstGeometryVisitor {
+    bool finite = true;
+    using OGRDefaultConstGeometryVisitor::visit;
+    // A point whose x and y are NaN counts as an empty point, so vertices are
+    // read from their curves, and only a standalone point may be empty.
+    void visit(const OGRPoint* p) override {
+      if (!finite || p->IsEmpty()) return;
+      finite = std::isfinite(p->getX()) && std::isfinite(p->getY()) && (!p->Is3D() || std::isfinite(p->getZ())) &&
+               (!p->IsMeasured() || std::isfinite(p->getM()));
+    }
+    void vertices(const OGRSimpleCurve& c) {
+      for (int i = 0, n = c.getNumPoints(); i < n && finite; ++i) {
+        finite = std::isfinite(c.getX(i)) && std::isfinite(c.getY(i)) && (!c.Is3D() || std::isfinite(c.getZ(i))) &&
+                 (!c.IsMeasured() || std::isfinite(c.getM(i)));
+      }
+    }
+    void visit(const OGRLineString* c) override { vertices(*c); }
+    void visit(const OGRLinearRing* c) override { vertices(*c); }
+    void visit(const OGRCircularString* c) override { vertices(*c); }
+  } visitor;
+  g.accept(&visitor);
+  return visitor.finite;
 }
 
 struct Feature {
@@ -322,8 +390,19 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
   };
   if (total > 0) byHash.reserve(static_cast<std::size_t>(total));
   Envelope env;
+  // A read error stops the loop as if the layer had ended (SQLite's "database
+  // disk image is malformed" after a few features of a corrupt GeoPackage), so
+  // GDAL's error state is checked for every feature and after the last one.
+  auto throwIfReadFailed = [&] {
+    if (CPLGetLastErrorType() != CE_Failure && CPLGetLastErrorType() != CE_Fatal) return;
+    throw inputError(path + ": reading layer " + result.layerName +
+                     (options.where.empty() ? "" : " with --where \"" + options.where + "\"") + " failed after " +
+                     std::to_string(report.features) + " features (" + lastGdalMessage() + ")");
+  };
+  CPLErrorReset();
   layer->ResetReading();
   for (auto& feature : *layer) {
+    throwIfReadFailed();
     ++report.features;
     if (report.features % 2000 == 0 && total > 0) {
       reportProgress(progress, 0.6 * static_cast<double>(report.features) / static_cast<double>(total),
@@ -351,8 +430,8 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
     }
     OGREnvelope e;
     g->getEnvelope(&e);
-    if (!std::isfinite(e.MinX) || !std::isfinite(e.MinY) || !std::isfinite(e.MaxX) || !std::isfinite(e.MaxY) ||
-        std::fabs(e.MinX) > 1e12 || std::fabs(e.MaxX) > 1e12 || std::fabs(e.MinY) > 1e12 ||
+    if (!coordinatesFinite(*g) || !std::isfinite(e.MinX) || !std::isfinite(e.MinY) || !std::isfinite(e.MaxX) ||
+        !std::isfinite(e.MaxY) || std::fabs(e.MinX) > 1e12 || std::fabs(e.MaxX) > 1e12 || std::fabs(e.MinY) > 1e12 ||
         std::fabs(e.MaxY) > 1e12) {
       ++report.nonFiniteSkipped;  // NaN, infinite or absurd coordinates
       continue;
@@ -368,13 +447,20 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
     features.push_back({feature->GetFID(), std::unique_ptr<OGRGeometry>(feature->StealGeometry()), 1,
                         std::move(values), key});
   }
-  if (CPLGetLastErrorType() == CE_Failure && report.features == 0) {
-    throw inputError(path + ": reading layer " + result.layerName + " failed (" + lastGdalMessage() + ")");
+  throwIfReadFailed();
+  const std::string featuresRead =
+      std::to_string(report.features) + " features read" + (options.where.empty() ? "" : " with --where");
+  if (features.empty() && report.nonFiniteSkipped > 0) {
+    const std::string absurd = "non-finite or absurd coordinates (NaN, infinite or beyond 1e12)";
+    throw inputError(path + ": layer " + result.layerName + " holds no usable polygon: every feature was skipped" +
+                     (report.nullOrEmpty == 0
+                          ? " for " + absurd
+                          : ", " + std::to_string(report.nonFiniteSkipped) + " for " + absurd + " and " +
+                                std::to_string(report.nullOrEmpty) + " for a null or empty geometry") +
+                     " (" + featuresRead + ")");
   }
   if (features.empty()) {
-    throw inputError(path + ": layer " + result.layerName + " holds no polygon geometry (" +
-                     std::to_string(report.features) + " features read" +
-                     (options.where.empty() ? "" : " with --where") + ")");
+    throw inputError(path + ": layer " + result.layerName + " holds no polygon geometry (" + featuresRead + ")");
   }
 
   result.frame = chooseFrame(path, srs, env, result.crs);

@@ -1,7 +1,9 @@
 // The command line as a user runs it: exit codes, one-line errors, and outputs
 // that appear whole or not at all.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -54,6 +56,70 @@ TEST(StatsCommand, UsageErrorsExitTwo) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("--k"), std::string::npos) << r.output;
   EXPECT_EQ(run("stats --help").code, 0);
+}
+
+// The first line of the output (the error; a usage error adds a second line
+// pointing to --help).
+std::string firstLine(const std::string& output) { return output.substr(0, output.find('\n')); }
+
+TEST(StatsCommand, NumbersOtherThanDecimalAreUsageErrors) {
+  TempDir dir;
+  for (const char* value : {"0x2", "0X2", "inf", "-infinity", "nan", "0x1p1"}) {
+    const CliRun r = run("stats '" + kSample + "' --out '" + dir.file("x") + "' --quiet --k " + value);
+    EXPECT_EQ(r.code, 2) << value << ": " << r.output;
+    EXPECT_NE(firstLine(r.output).find("--k " + std::string(value) + " is not a decimal number"), std::string::npos)
+        << r.output;
+  }
+  EXPECT_FALSE(fs::exists(dir.file("x")));
+  // Decimal numbers in every written form are still taken.
+  for (const char* value : {"2", "+2", "2.", "2.0", ".5", "1e-1", "1.5E+0"}) {
+    const CliRun r =
+        run("stats '" + kSample + "' --out '" + dir.file(std::string("k") + value) + "' --quiet --k " + value);
+    EXPECT_EQ(r.code, 0) << value << ": " << r.output;
+  }
+}
+
+TEST(StatsCommand, ARepeatedFlagIsAUsageErrorNamingIt) {
+  TempDir dir;
+  const std::string base = "stats '" + kSample + "' --out '" + dir.file("x") + "'";
+  const std::vector<std::pair<std::string, std::string>> cases = {{" --k 2 --k 3", "--k"},
+                                                                  {" --k=2 --k 2", "--k"},
+                                                                  {" --quiet --quiet", "--quiet"},
+                                                                  {" --where \"1=1\" --where \"1=0\"", "--where"},
+                                                                  {" --out '" + dir.file("y") + "'", "--out"}};
+  for (const auto& [repeated, flag] : cases) {
+    const CliRun r = run(base + repeated);
+    EXPECT_EQ(r.code, 2) << repeated << ": " << r.output;
+    EXPECT_NE(firstLine(r.output).find(flag + " is given more than once"), std::string::npos) << r.output;
+  }
+  EXPECT_FALSE(fs::exists(dir.file("x")));
+  EXPECT_FALSE(fs::exists(dir.file("y")));
+}
+
+TEST(GenerateCommand, AnOutOfRangeSeedIsPrintedExactly) {
+  TempDir dir;
+  const CliRun r =
+      run("generate '" + kSample + "' --from-parcels --seed 5000000000 --out '" + dir.file("x") + "' --quiet");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("--seed 5000000000 is outside [0, 4294967295]"), std::string::npos) << r.output;
+  const CliRun just =
+      run("generate '" + kSample + "' --from-parcels --seed 4294967296 --out '" + dir.file("x") + "' --quiet");
+  EXPECT_NE(just.output.find("--seed 4294967296 is outside [0, 4294967295]"), std::string::npos) << just.output;
+}
+
+// A named pipe without a writer would block GDAL's open forever; it is refused
+// at once. (`timeout` turns a hang into a failure of this test.)
+TEST(StatsCommand, ANamedPipeIsRefusedInsteadOfBlocking) {
+  TempDir dir;
+  const std::string fifo = dir.file("parcels.geojson");
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const CliRun r = test::runShell("timeout 30 '" + std::string(PARCELSCOPE_CLI) + "' stats '" + fifo + "' --out '" +
+                                  dir.file("out") + "' --quiet");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  EXPECT_NE(r.output.find(fifo), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("is a named pipe"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir.file("out")));
 }
 
 TEST(StatsCommand, BadInputFailsWithOneLineNamingTheFileAndLeavesNoOutput) {

@@ -91,6 +91,32 @@ TEST(Parameters, NumbersAreParsedAsBeforeAndOnlyNumbers) {
   EXPECT_EQ(formatValue(k, 0.3), "0.3");
 }
 
+// The message of a refused value, or "" when it was taken.
+std::string refusal(const ParameterDescription& d, const std::string& text) {
+  try {
+    parseValue(d, text);
+    return "";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::Usage) << e.what();
+    return e.what();
+  }
+}
+
+TEST(Parameters, RefusedValuesAndRangesArePrintedExactly) {
+  const ParameterDescription seed = integerParameter("seed", "", "", 0, 4294967295.0, 1, "Subdivision");
+  EXPECT_EQ(refusal(seed, "5000000000"), "--seed 5000000000 is outside [0, 4294967295]");
+  EXPECT_EQ(refusal(seed, "4294967296"), "--seed 4294967296 is outside [0, 4294967295]");
+  EXPECT_EQ(refusal(seed, "-1"), "--seed -1 is outside [0, 4294967295]");
+  EXPECT_EQ(refusal(seed, "1234567.5"), "--seed 1234567.5 must be an integer");
+  const ParameterDescription aMin = realParameter("a-min", "", "m2", 0, 1e8, 200, "Bounds");
+  EXPECT_EQ(refusal(aMin, "100000000.25"), "--a-min 100000000.25 is outside [0, 100000000] m2");
+  EXPECT_EQ(refusal(aMin, "1e300"), "--a-min 1e+300 is outside [0, 100000000] m2");
+  EXPECT_EQ(refusal(aMin, "-0.1"), "--a-min -0.1 is outside [0, 100000000] m2");
+  EXPECT_EQ(refusal(aMin, "123456789"), "--a-min 123456789 is outside [0, 100000000] m2");
+  const ParameterDescription k = realParameter("k", "", "", 0.1, 10, 2, "Bounds");
+  EXPECT_EQ(refusal(k, "0.05"), "--k 0.05 is outside [0.1, 10]");
+}
+
 TEST(Parameters, OutputOnlyMarksADescriptionAndEqualityComparesEveryField) {
   const ParameterDescription w = integerParameter("figure-width", "Width", "px", 200, 10000, 1800, "Figures");
   EXPECT_FALSE(w.outputOnly);

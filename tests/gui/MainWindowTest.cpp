@@ -1,8 +1,10 @@
 // parcelscope-gui driven as a user drives it, headless under Xvfb (QTest):
 // load the sample, move a slider, change the colouring, click a block,
 // override it, export every figure and table, survive a bad file, match a
-// screenshot baseline, and offer each parameter in its group with a control of
-// its kind. Run through scripts/with-xvfb.sh.
+// screenshot baseline, offer each parameter in its group with a control of
+// its kind, ignore VTK's own keys, zoom about the cursor, remember how each
+// recent file was opened, and offer only what can be done. Run through
+// scripts/with-xvfb.sh.
 #include <QApplication>
 #include <QCheckBox>
 #include <QComboBox>
@@ -10,8 +12,13 @@
 #include <QGroupBox>
 #include <QDir>
 #include <QLabel>
+#include <QMenu>
 #include <QMimeData>
+#include <QPushButton>
+#include <QRegularExpression>
 #include <QUrl>
+#include <QWheelEvent>
+#include <QWindow>
 #include <QDragEnterEvent>
 #include <QSignalSpy>
 #include <QSlider>
@@ -22,6 +29,16 @@
 #include <QTest>
 #include <QTextBrowser>
 #include <QVTKOpenGLStereoWidget.h>
+
+#include <vtkActor.h>
+#include <vtkActorCollection.h>
+#include <vtkCallbackCommand.h>
+#include <vtkCamera.h>
+#include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkProperty.h>
+#include <vtkRenderWindowInteractor.h>
+#include <vtkRenderer.h>
+#include <vtkRendererCollection.h>
 
 #include <cmath>
 #include <filesystem>
@@ -43,6 +60,49 @@ std::string slurp(const QString& path) {
   std::stringstream s;
   s << std::ifstream(path.toStdString()).rdbuf();
   return s.str();
+}
+
+// The action of a menu, by its text without the '&' of its shortcut letter.
+QAction* findAction(QWidget* window, const QString& text) {
+  for (QAction* a : window->findChildren<QAction*>()) {
+    if (QString(a->text()).remove('&') == text) return a;
+  }
+  return nullptr;
+}
+
+// The paths File > Open recent lists, newest first.
+QStringList recentFiles(QWidget* window) {
+  QStringList paths;
+  for (QMenu* menu : window->findChildren<QMenu*>()) {
+    if (QString(menu->title()).remove('&') != "Open recent") continue;
+    for (QAction* a : menu->actions()) paths << a->text();
+  }
+  return paths;
+}
+
+struct CameraState {
+  double focal[3], position[3], scale;
+};
+CameraState cameraState(vtkCamera* camera) {
+  CameraState s{};
+  camera->GetFocalPoint(s.focal);
+  camera->GetPosition(s.position);
+  s.scale = camera->GetParallelScale();
+  return s;
+}
+bool sameCamera(const CameraState& a, const CameraState& b) {
+  for (int i = 0; i < 3; ++i) {
+    if (a.focal[i] != b.focal[i] || a.position[i] != b.position[i]) return false;
+  }
+  return a.scale == b.scale;
+}
+
+// A turn of the wheel by one notch (120 eighths of a degree; negative: towards
+// the user) at `at`, in the coordinates of `window`.
+void turnWheel(QWindow* window, QPoint at, int delta) {
+  QWheelEvent wheel(QPointF(at), QPointF(window->mapToGlobal(at)), QPoint(), QPoint(0, delta), Qt::NoButton,
+                    Qt::NoModifier, Qt::NoScrollPhase, false);
+  QGuiApplication::sendEvent(window, &wheel);
 }
 
 }  // namespace
@@ -359,6 +419,203 @@ private slots:
     QCOMPARE(window_->request().parameters.at("corner-rule"), 0.0);  // setValues emits nothing
     panel->setValues(window_->request().parameters);
     QVERIFY(settle());
+  }
+
+  // VTK's own keys ('w' wireframe, 's' surface, '3' stereo, 'r' reset the
+  // camera, 'f' fly to, 'p' pick, 'e'/'q' quit, 'j'/'t' joystick or trackball)
+  // do nothing in the views or the histogram.
+  void vtkKeysDoNothingInTheViews() {
+    for (parcelscope::gui::MapView* view : {window_->observedView(), window_->proceduralView()}) {
+      vtkRenderWindow* window = view->vtkWidget()->renderWindow();
+      vtkRenderer* map = window->GetRenderers()->GetFirstRenderer();
+      QWindow* surface = view->vtkWidget()->embeddedOpenGLWindow();
+      int exits = 0;
+      vtkNew<vtkCallbackCommand> exit;
+      exit->SetClientData(&exits);
+      exit->SetCallback([](vtkObject*, unsigned long, void* count, void*) { ++*static_cast<int*>(count); });
+      const unsigned long observer = window->GetInteractor()->AddObserver(vtkCommand::ExitEvent, exit);
+      QTest::mouseMove(surface, QPoint(surface->width() / 2, surface->height() / 3));
+      const CameraState before = cameraState(view->camera());
+      for (char key : {'w', '3', 'r', 'f', 'p', 'j', 't', 'u', 'e', 'q'}) {
+        QTest::keyClick(surface, key);
+        QTest::qWait(20);
+      }
+      window->GetInteractor()->RemoveObserver(observer);
+      QCOMPARE(exits, 0);
+      QVERIFY(!window->GetStereoRender());
+      QVERIFY(sameCamera(cameraState(view->camera()), before));
+      vtkActorCollection* actors = map->GetActors();
+      actors->InitTraversal();
+      int surfaces = 0;
+      while (vtkActor* actor = actors->GetNextActor()) {
+        QCOMPARE(actor->GetProperty()->GetRepresentation(), VTK_SURFACE);
+        ++surfaces;
+      }
+      QVERIFY(surfaces > 0);
+    }
+    QVTKOpenGLStereoWidget* histogram = nullptr;
+    for (QVTKOpenGLStereoWidget* w : window_->findChildren<QVTKOpenGLStereoWidget*>()) {
+      if (w != window_->observedView()->vtkWidget() && w != window_->proceduralView()->vtkWidget()) histogram = w;
+    }
+    QVERIFY(histogram);
+    QTest::keyClick(histogram->embeddedOpenGLWindow(), '3');
+    QVERIFY(!histogram->renderWindow()->GetStereoRender());
+  }
+
+  // The wheel keeps the world point under the cursor under it; View > Zoom to
+  // extent (Home) fits the views to the data again.
+  void wheelZoomsAboutTheCursorAndHomeFitsTheData() {
+    QAction* fit = findAction(window_, "Zoom to extent");
+    QVERIFY(fit);
+    QVERIFY(fit->isEnabled());
+    QCOMPARE(fit->shortcut(), QKeySequence(Qt::Key_Home));
+    fit->trigger();
+    parcelscope::gui::MapView* view = window_->proceduralView();
+    QWindow* surface = view->vtkWidget()->embeddedOpenGLWindow();
+    const CameraState fitted = cameraState(view->camera());
+    // A point well away from the view's centre.
+    const parcelscope::Point p{fitted.focal[0] + 0.4 * fitted.scale, fitted.focal[1] + 0.4 * fitted.scale};
+    const QPoint at = view->widgetPoint(p);
+    QVERIFY(QRect(QPoint(0, 0), surface->size()).contains(at));
+    turnWheel(surface, at, 120);
+    const CameraState in = cameraState(view->camera());
+    QVERIFY(in.scale < 0.9 * fitted.scale);
+    QVERIFY2((view->widgetPoint(p) - at).manhattanLength() <= 2,
+             qPrintable(QString("(%1, %2) moved to (%3, %4)")
+                            .arg(at.x())
+                            .arg(at.y())
+                            .arg(view->widgetPoint(p).x())
+                            .arg(view->widgetPoint(p).y())));
+    // The other view follows (one camera).
+    QCOMPARE(window_->observedView()->camera()->GetParallelScale(), in.scale);
+    turnWheel(surface, at, -120);
+    QVERIFY((view->widgetPoint(p) - at).manhattanLength() <= 2);
+    QVERIFY(std::abs(view->camera()->GetParallelScale() - fitted.scale) < 1e-6 * fitted.scale);
+    for (int i = 0; i < 3; ++i) turnWheel(surface, at, 120);
+    QVERIFY(!sameCamera(cameraState(view->camera()), fitted));
+    // Home, with the keyboard focus in a view (Xvfb has no window manager to
+    // activate the window).
+    window_->activateWindow();
+    QVERIFY(QTest::qWaitForWindowActive(window_));
+    QTest::keyClick(surface, Qt::Key_Home);
+    QTest::qWait(20);
+    const CameraState home = cameraState(view->camera());
+    QCOMPARE(home.scale, fitted.scale);
+    QCOMPARE(home.focal[0], fitted.focal[0]);
+    QCOMPARE(home.focal[1], fitted.focal[1]);
+  }
+
+  // A file that fails does not go to File > Open recent; one that opens goes
+  // there with its layer, filter and CRS, which opening it from there uses.
+  void recentFilesRememberHowTheyOpened() {
+    // The sample in metres of EPSG:26986 with no CRS declared: GeoJSON means
+    // lon/lat, so it fails until it is given its CRS.
+    const QString projected = dir_.path() + "/projected_town.geojson";
+    {
+      const QString text =
+          QString::fromStdString(slurp(QString(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_town.geojson"));
+      QString out;
+      const QRegularExpression pair(R"(\[(-?\d+\.?\d*),(-?\d+\.?\d*)\])");
+      int last = 0;
+      for (auto it = pair.globalMatch(text); it.hasNext();) {
+        const auto m = it.next();
+        const double x = 231000 + (m.captured(1).toDouble() + 71.1) * 82270;
+        const double y = 902000 + (m.captured(2).toDouble() - 42.37) * 111050;
+        out += text.mid(last, m.capturedStart() - last) + QString("[%1,%2]").arg(x, 0, 'f', 3).arg(y, 0, 'f', 3);
+        last = m.capturedEnd();
+      }
+      out += text.mid(last);
+      std::ofstream(projected.toStdString()) << out.toStdString();
+    }
+    window_->openFile(projected, {}, "use <> 'ROW'");
+    QVERIFY(settle());
+    QTRY_VERIFY_WITH_TIMEOUT(!window_->lastError().isEmpty(), 10000);
+    QVERIFY2(window_->lastError().contains("File > Set input CRS"), qPrintable(window_->lastError()));
+    QVERIFY2(!window_->lastError().contains("--crs"), qPrintable(window_->lastError()));
+    QVERIFY(!recentFiles(window_).contains(projected));
+
+    window_->openFile(projected, {}, "use <> 'ROW'", "EPSG:26986");
+    QVERIFY(settle());
+    QVERIFY2(window_->lastError().isEmpty(), qPrintable(window_->lastError()));
+    QCOMPARE(static_cast<int>(window_->result()->observed->analysis.blocks.size()), 10);
+    QCOMPARE(recentFiles(window_).value(0), projected);
+
+    // A CRS GDAL does not know: a message in the window's words, and the file
+    // keeps the CRS it opened with.
+    window_->openFile(projected, {}, "use <> 'ROW'", "NOT_A_CRS");
+    QVERIFY(settle());
+    QTRY_VERIFY_WITH_TIMEOUT(!window_->lastError().isEmpty(), 10000);
+    QVERIFY2(window_->lastError().contains("NOT_A_CRS"), qPrintable(window_->lastError()));
+    QVERIFY2(!window_->lastError().contains("--"), qPrintable(window_->lastError()));
+
+    window_->openSample();
+    QVERIFY(settle());
+    QCOMPARE(window_->request().input.crsOverride, std::string());
+    QMenu* recent = nullptr;
+    for (QMenu* menu : window_->findChildren<QMenu*>()) {
+      if (QString(menu->title()).remove('&') == "Open recent") recent = menu;
+    }
+    QVERIFY(recent);
+    QAction* entry = nullptr;
+    for (QAction* a : recent->actions()) {
+      if (a->text() == projected) entry = a;
+    }
+    QVERIFY(entry);
+    entry->trigger();
+    QVERIFY(settle());
+    QVERIFY2(window_->lastError().isEmpty(), qPrintable(window_->lastError()));
+    QCOMPARE(window_->request().input.path, projected.toStdString());
+    QCOMPARE(window_->request().input.crsOverride, std::string("EPSG:26986"));
+    QCOMPARE(window_->request().input.where, std::string("use <> 'ROW'"));
+    window_->openSample();
+    QVERIFY(settle());
+  }
+
+  // Before any result, what needs one is disabled (so no file dialog opens
+  // for nothing to export); with one, it is enabled. Messages name the
+  // window's controls, not the command line's flags, which keeps its words.
+  void menusWaitForAResultAndMessagesUseTheWindowsWords() {
+    const QStringList needResult = {"Save session...", "Figure...", "Tables (CSV)...", "Generated parcels...",
+                                    "Set input CRS...", "Zoom to extent"};
+    {
+      MainWindow fresh;
+      for (const QString& text : needResult) {
+        QAction* action = findAction(&fresh, text);
+        QVERIFY2(action, qPrintable(text));
+        QVERIFY2(!action->isEnabled(), qPrintable(text));
+      }
+      for (const char* text : {"Override block", "Clear override"}) {
+        QPushButton* button = nullptr;
+        for (QPushButton* b : fresh.findChildren<QPushButton*>()) {
+          if (b->text() == text) button = b;
+        }
+        QVERIFY2(button, text);
+        QVERIFY2(!button->isEnabled(), text);
+      }
+      QVERIFY(findAction(&fresh, "Open...")->isEnabled());
+      QVERIFY(findAction(&fresh, "Open session...")->isEnabled());
+    }
+    for (const QString& text : needResult) {
+      QAction* action = findAction(window_, text);
+      QVERIFY2(action && action->isEnabled(), qPrintable(text));
+    }
+
+    const double wMax = window_->request().parameters.at("w-max");
+    window_->setParameter("w-min", wMax + 10);
+    QVERIFY(settle());
+    QTRY_VERIFY_WITH_TIMEOUT(!window_->lastError().isEmpty(), 10000);
+    QVERIFY2(window_->lastError().contains("w-min must not exceed w-max"), qPrintable(window_->lastError()));
+    QVERIFY2(!window_->lastError().contains("--"), qPrintable(window_->lastError()));
+    // The command line says it with its flags.
+    QVERIFY(window_->controller().failedRequest());
+    try {
+      parcelscope::pipeline::compare(*window_->controller().failedRequest());
+      QFAIL("w-min above w-max was accepted");
+    } catch (const std::exception& e) {
+      QVERIFY2(std::string(e.what()).find("--w-min must not exceed --w-max") != std::string::npos, e.what());
+    }
+    QCOMPARE(window_->request().parameters.at("w-max"), wMax);
+    QVERIFY(window_->request().parameters.at("w-min") < wMax);
   }
 };
 

@@ -4,6 +4,8 @@
 #include <gdal_utils.h>
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <random>
 #include <set>
 
 #include <GeographicLib/Geodesic.hpp>
@@ -111,6 +113,105 @@ TEST(ParcelReader, StrayAndNonFiniteFeaturesDoNotMoveTheFrame) {
   const ParcelLayer l = readParcels(options(stray));
   EXPECT_EQ(l.report.nonFiniteSkipped, 1);
   EXPECT_NEAR(area(l.parcels[0].shape), a, 1e-6 * a);
+}
+
+// GDAL's GeoJSON reader takes the token NaN; OGR's envelope of such a geometry
+// passes over the NaN and looks finite, so the coordinates themselves are checked.
+TEST(ParcelReader, AFeatureWithANaNCoordinateIsSkippedAndCounted) {
+  TempDir dir;
+  const double lon = 2.35, lat = 48.85, d = 0.0001;
+  const std::string square = R"({"type":"Polygon","coordinates":[)" + test::squareRing(lon, lat, d) + "]}";
+  const auto path = dir.write(
+      "nan.geojson",
+      test::collection(
+          test::feature(square, 1) + "," +
+          test::feature(R"({"type":"Polygon","coordinates":[[[2.3503,48.85],[2.3504,48.85],[2.3504,NaN],)"
+                        R"([2.3503,48.8501],[2.3503,48.85]]]})",
+                        3) +
+          "," +
+          test::feature(R"({"type":"Polygon","coordinates":[[[NaN,NaN],[2.3506,48.85],[2.3506,48.8501],[NaN,NaN]]]})",
+                        5)));
+  const ParcelLayer l = readParcels(options(path));
+  EXPECT_EQ(l.report.features, 3);
+  EXPECT_EQ(l.report.nonFiniteSkipped, 2);
+  ASSERT_EQ(l.parcels.size(), 1u);
+  EXPECT_EQ(l.parcels[0].sourceFid, 0);  // the finite square
+  for (const auto& p : l.parcels) {
+    EXPECT_TRUE(std::isfinite(area(p.shape)));
+    for (const Point& v : p.shape.outer) EXPECT_TRUE(std::isfinite(v.x) && std::isfinite(v.y));
+  }
+}
+
+// Every feature skipped for its coordinates is said to be so, not "no polygon geometry".
+TEST(ParcelReader, ALayerOfOnlyAbsurdCoordinatesSaysSo) {
+  TempDir dir;
+  const auto absurd = dir.write(
+      "absurd.geojson",
+      test::collection(
+          test::feature(R"({"type":"Polygon","coordinates":[[[1e300,0],[1e300,1],[0,1],[1e300,0]]]})", 1) + "," +
+          test::feature(
+              R"({"type":"Polygon","coordinates":[[[1e300,1e300],[2e300,1e300],[2e300,2e300],[1e300,1e300]]]})", 3)));
+  expectError(options(absurd), Error::Kind::Input,
+              {"absurd.geojson", "every feature was skipped for non-finite or absurd coordinates"});
+  const auto withNull = dir.write(
+      "absurd_and_null.geojson",
+      test::collection(test::feature(R"({"type":"Polygon","coordinates":[[[1e300,0],[1e300,1],[0,1],[1e300,0]]]})", 1) +
+                       R"(,{"type":"Feature","properties":{"pid":2},"geometry":null})"));
+  expectError(options(withNull), Error::Kind::Input,
+              {"absurd_and_null.geojson", "every feature was skipped", "1 for non-finite or absurd coordinates",
+               "1 for a null or empty geometry"});
+}
+
+// A read error in the middle of the layer (a corrupt page of a GeoPackage) ends
+// GDAL's feature loop as if the layer had ended; it must be an error, not a
+// silently truncated layer.
+TEST(ParcelReader, ACorruptGeoPackageIsAnErrorNotATruncatedLayer) {
+  TempDir dir;
+  std::string features;
+  const int n = 600;
+  for (int i = 0; i < n; ++i) {
+    const std::string square = R"({"type":"Polygon","coordinates":[)" +
+                               test::squareRing(2.35 + (i % 30) * 0.0002, 48.85 + (i / 30) * 0.0002, 0.00015) + "]}";
+    features += (i ? "," : "") + test::feature(square, i + 1);
+  }
+  const auto gpkg = convert(dir.write("many.geojson", test::collection(features)), dir.file("many.gpkg"), "GPKG");
+  ASSERT_EQ(readParcels(options(gpkg)).parcels.size(), static_cast<std::size_t>(n));
+  // Overwrite the 4 KiB page in the middle of the file (one of the table's pages) with garbage.
+  const auto size = std::filesystem::file_size(gpkg);
+  constexpr std::uintmax_t kPage = 4096;
+  ASSERT_GT(size / kPage, 20u) << "the table spans too few pages";
+  std::string garbage(kPage, '\0');
+  std::minstd_rand bytes(1);
+  for (char& c : garbage) c = static_cast<char>(bytes() & 0xff);
+  {
+    std::fstream f(gpkg, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(static_cast<std::streamoff>(size / kPage / 2 * kPage));
+    f.write(garbage.data(), static_cast<std::streamsize>(garbage.size()));
+    ASSERT_TRUE(f.good());
+  }
+  expectError(options(gpkg), Error::Kind::Input, {"many.gpkg", "reading layer many failed", "malformed"});
+}
+
+// What GDAL cannot read is named for what it is, not "unknown GDAL error".
+TEST(ParcelReader, EmptyFilesFoldersDevicesAndGarbageAreNamedForWhatTheyAre) {
+  TempDir dir;
+  expectError(options(dir.write("empty.geojson", "")), Error::Kind::Input, {"empty.geojson", "is empty"});
+  std::filesystem::create_directory(dir.file("folder"));
+  expectError(options(dir.file("folder")), Error::Kind::Input, {"folder", "is a folder, not a file"});
+  expectError(options("/dev/zero"), Error::Kind::Input, {"/dev/zero", "is a character device"});
+  const auto garbage = dir.write("garbage.dat", std::string("\x01\x02 garbage \xff\xfe", 14));
+  expectError(options(garbage), Error::Kind::Input, {"garbage.dat", "is not a file format GDAL reads"});
+  for (const char* path : {"empty.geojson", "folder", "garbage.dat"}) {
+    try {
+      readParcels(options(dir.file(path)));
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()).find("unknown GDAL error"), std::string::npos) << e.what();
+    }
+  }
+  // A folder GDAL reads (one of shapefiles) is still read.
+  std::filesystem::create_directory(dir.file("shapefiles"));
+  convert(dir.write("sq.geojson", test::quirksGeoJson()), dir.file("shapefiles/sq.shp"), "ESRI Shapefile");
+  EXPECT_EQ(readParcels(options(dir.file("shapefiles"))).parcels.size(), 6u);
 }
 
 TEST(ParcelReader, GeographicCrsInGradsIsConverted) {

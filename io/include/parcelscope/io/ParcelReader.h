@@ -36,7 +36,7 @@ struct CleaningReport {
   std::int64_t nullOrEmpty = 0;         ///< skipped: null or empty geometry
   std::int64_t nonPolygonal = 0;        ///< skipped: points or lines only
   std::int64_t nonPolygonalParts = 0;   ///< point or line members dropped from mixed collections
-  std::int64_t nonFiniteSkipped = 0;    ///< skipped: NaN, infinite or beyond 1e12 coordinates
+  std::int64_t nonFiniteSkipped = 0;    ///< skipped: a NaN or infinite coordinate (any vertex), or beyond 1e12
   std::int64_t multipartFeatures = 0;   ///< multipolygon features with more than one part
   std::int64_t partsFromMultipart = 0;  ///< parcels those features were split into (after repair)
   std::int64_t withHoles = 0;           ///< parcels that keep one or more holes
@@ -73,10 +73,14 @@ std::vector<std::string> layerNames(const std::string& path);
 
 /// Reads, projects and cleans the polygons of one layer.
 /// Throws Error(Input) with a one-line message naming the file (and the feature
-/// or layer) when the file is missing or unreadable, the layer or the filter is
-/// wrong, the layer holds no polygon, or the CRS cannot be used (including
-/// lon/lat claimed for coordinates that cannot be degrees); Error(Usage) when
-/// `crsOverride` is not a CRS GDAL knows.
+/// or layer) when the file is missing, empty, neither a regular file nor a folder
+/// (a device or a named pipe is refused before GDAL opens it, so it never
+/// blocks), not a format GDAL reads, or fails to read part way through the layer
+/// (GDAL's message; the layer is never returned truncated); when the layer or the
+/// filter is wrong, the layer holds no polygon (saying so when every feature was
+/// skipped for non-finite or absurd coordinates), or the CRS cannot be used
+/// (including lon/lat claimed for coordinates that cannot be degrees);
+/// Error(Usage) when `crsOverride` is not a CRS GDAL knows.
 ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress = {});
 
 }  // namespace parcelscope::io
