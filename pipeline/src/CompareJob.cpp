@@ -331,14 +331,11 @@ void exportSession(const CompareRequest& request, const std::string& path) {
   file.commit();
 }
 
-JobOutcome runCompare(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress,
-                      const FigureRenderer* renderer) {
-  const auto started = std::chrono::steady_clock::now();
+namespace {
+JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request, const ProgressFn& progress,
+                        const FigureRenderer* renderer, std::chrono::steady_clock::time_point started) {
   const bool figures = value(request, "figures") != 0;
   const bool spatialIndex = value(request, "spatial-index") != 0;
-  if (figures && !renderer) throw usageError("compare: this program draws no figures (use --figures 0)");
-  if (figures && renderer->check) renderer->check();  // before the long work, not after it
-  io::OutputDirectory out(outDir, {request.input.path});
   const CompareResult r = compare(request, scaledProgress(progress, 0.0, 0.8));
   const analysis::ObservedAnalysis& a = r.observed->analysis;
 
@@ -461,6 +458,22 @@ JobOutcome runCompare(const CompareRequest& request, const std::string& outDir, 
                 r.city.aspectRatio.ks, r.city.area.wasserstein, r.city.width.wasserstein,
                 r.city.observed.undesirableShare, r.city.generated.undesirableShare, secondsSince(started));
   return {run, summarize(*r.observed) + line};
+}
+
+}  // namespace
+
+JobOutcome runCompare(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress,
+                      const FigureRenderer* renderer) {
+  const auto started = std::chrono::steady_clock::now();
+  const bool figures = value(request, "figures") != 0;
+  if (figures && !renderer) throw usageError("compare: this program draws no figures (use --figures 0)");
+  if (figures && renderer->check) renderer->check();  // before the long work, not after it
+  io::OutputDirectory out(outDir, {request.input.path});
+  try {
+    return writeCompare(out, request, progress, renderer, started);
+  } catch (const Error& e) {
+    throw out.explain(e);  // a writer's error names --out, not the staging folder, with its cause
+  }
 }
 
 }  // namespace parcelscope::pipeline

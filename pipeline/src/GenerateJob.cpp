@@ -374,9 +374,8 @@ Table generatedParcelTable(const GeneratedParcels& g, std::vector<std::vector<Po
   return table;
 }
 
-pipeline::JobOutcome runGenerate(const GenerateRequest& request, const std::string& outDir,
-                                 const ProgressFn& progress) {
-  io::OutputDirectory out(outDir, {request.input.path});
+namespace {
+JobOutcome writeGenerate(io::OutputDirectory& out, const GenerateRequest& request, const ProgressFn& progress) {
   const GeneratedParcels g = generate(request, scaledProgress(progress, 0.0, 0.9));
 
   reportProgress(progress, 0.9, "writing");
@@ -434,6 +433,17 @@ pipeline::JobOutcome runGenerate(const GenerateRequest& request, const std::stri
                         std::to_string(g.failedBlocks) + " blocks refused";
   for (const auto& f : g.failures) summary += "\n  " + f;
   return {run, summary};
+}
+
+}  // namespace
+
+JobOutcome runGenerate(const GenerateRequest& request, const std::string& outDir, const ProgressFn& progress) {
+  io::OutputDirectory out(outDir, {request.input.path});
+  try {
+    return writeGenerate(out, request, progress);
+  } catch (const Error& e) {
+    throw out.explain(e);  // a writer's error names --out, not the staging folder, with its cause
+  }
 }
 
 }  // namespace parcelscope::pipeline

@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "parcelscope/core/Error.h"
 #include "parcelscope/io/OutputDirectory.h"
 #include "parcelscope/io/Writers.h"
 
@@ -96,9 +97,9 @@ std::string summarize(const ObservedData& data) {
   return s.str();
 }
 
-JobOutcome runStats(const io::ReadOptions& input, const ParameterValues& parameters, const std::string& outDir,
-                    const ProgressFn& progress) {
-  io::OutputDirectory out(outDir, {input.path});
+namespace {
+JobOutcome writeStats(io::OutputDirectory& out, const io::ReadOptions& input, const ParameterValues& parameters,
+                      const ProgressFn& progress) {
   ObservedData data = loadObserved(input, parameters, scaledProgress(progress, 0.0, 0.9));
 
   reportProgress(progress, 0.9, "writing");
@@ -117,6 +118,18 @@ JobOutcome runStats(const io::ReadOptions& input, const ParameterValues& paramet
   out.commit();
   reportProgress(progress, 1.0, "writing");
   return {run, summarize(data)};
+}
+
+}  // namespace
+
+JobOutcome runStats(const io::ReadOptions& input, const ParameterValues& parameters, const std::string& outDir,
+                    const ProgressFn& progress) {
+  io::OutputDirectory out(outDir, {input.path});
+  try {
+    return writeStats(out, input, parameters, progress);
+  } catch (const Error& e) {
+    throw out.explain(e);  // a writer's error names --out, not the staging folder, with its cause
+  }
 }
 
 }  // namespace parcelscope::pipeline
