@@ -1,6 +1,8 @@
 #!/bin/sh
-# Runs a command that renders figures (a render test, or `parcelscope compare`)
-# under a virtual X server of its own:  scripts/with-xvfb.sh COMMAND ARGS...
+# Runs a command that renders figures (the render tests, the application under
+# test) under a virtual X server of its own:  scripts/with-xvfb.sh COMMAND ARGS...
+# (`parcelscope compare` needs no wrapper: without a display it starts a
+# private Xvfb itself.)
 # Xvfb picks a free display number itself (-displayfd) and reports it once it
 # accepts connections, so commands started in parallel never share or race for
 # a display. It listens on a local socket only, without an authorisation

@@ -276,6 +276,9 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
           }
         })
              : std::function<void(std::size_t)>());
+    // Asked once more at the end: the loop's ticks may all come before its
+    // first block is done, or none at all when its blocks finish at once.
+    reportProgress(sub, 1.0, "subdividing");
   } catch (const Error& e) {
     if (e.kind() == Error::Kind::Cancelled && !newInputs) {
       keepFinished();

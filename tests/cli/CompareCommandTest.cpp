@@ -1,7 +1,8 @@
 // `parcelscope compare` as a user runs it, end to end: every output exists and
 // parses, generated parcels tile their blocks, the distances lie in their
 // ranges, the figures have the requested size and ink, one figure matches its
-// baseline image; no display, a bad style and Ctrl-C leave nothing behind.
+// baseline image; without a display the figures render on a private Xvfb that
+// is gone afterwards; a bad style and Ctrl-C leave nothing behind.
 // Runs under scripts/with-xvfb.sh (its own Xvfb).
 #include <cpl_json.h>
 #include <gdal_priv.h>
@@ -9,15 +10,18 @@
 #include <ogrsf_frmts.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <fcntl.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <set>
 #include <thread>
 
 #include "TestUtil.h"
@@ -258,12 +262,88 @@ TEST(CompareCommand, FiguresMatchTheirBaselines) {
   if (update) GTEST_SKIP() << "baselines written to tests/data/baseline";
 }
 
-TEST(CompareCommand, WithoutDisplayFiguresFailCleanlyAndFiguresZeroSkipsThem) {
+// Processes named `name` whose parent is this process (children, and orphans
+// handed to it as their subreaper), zombies included.
+std::vector<std::string> childrenNamed(const std::string& name) {
+  std::vector<std::string> found;
+  for (const auto& entry : fs::directory_iterator("/proc")) {
+    const std::string pid = entry.path().filename().string();
+    if (pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    const std::string stat = test::slurp(entry.path().string() + "/stat");  // pid (comm) state ppid ...
+    const std::size_t open = stat.find('('), close = stat.rfind(')');
+    if (open == std::string::npos || close == std::string::npos || close + 4 > stat.size()) continue;
+    std::istringstream rest(stat.substr(close + 2));
+    char state = '?';
+    long ppid = 0;
+    rest >> state >> ppid;
+    if (stat.substr(open + 1, close - open - 1) == name && ppid == static_cast<long>(::getpid())) {
+      found.push_back(pid + " (state " + state + ")");
+    }
+  }
+  return found;
+}
+
+// X server lock files (/tmp/.X<n>-lock) that name no running process.
+std::set<std::string> staleXLocks() {
+  std::set<std::string> stale;
+  for (const auto& entry : fs::directory_iterator("/tmp")) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(".X", 0) != 0 || name.size() < 8 || name.compare(name.size() - 5, 5, "-lock") != 0) continue;
+    const long pid = std::atol(test::slurp(entry.path().string()).c_str());
+    if (pid <= 0 || !fs::exists("/proc/" + std::to_string(pid))) stale.insert(name);
+  }
+  return stale;
+}
+
+// Without a display (DISPLAY unset, or naming no server), compare starts a
+// private Xvfb, draws every figure on it and stops it: no Xvfb of the run is
+// left, running or as a zombie (this process is made their subreaper, so an
+// Xvfb orphaned by the run would become its child), and no stale lock file.
+// Without Xvfb either, it fails in one line naming the package to install.
+TEST(CompareCommand, WithoutDisplayFiguresRenderOnAPrivateXvfbAndFiguresZeroSkipsThem) {
   TempDir dir;
+  ASSERT_EQ(::prctl(PR_SET_CHILD_SUBREAPER, 1), 0);
+  const std::set<std::string> staleBefore = staleXLocks();
   const CliRun r = runCli("compare " + kSampleArgs + " --out '" + dir.file("a") + "' --quiet", "env -u DISPLAY");
-  EXPECT_EQ(r.code, 1) << r.output;
-  EXPECT_NE(r.output.find("xvfb-run"), std::string::npos) << r.output;
-  EXPECT_FALSE(fs::exists(dir.file("a")));
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::vector<std::string> left = childrenNamed("Xvfb");
+  std::set<std::string> staleAfter = staleXLocks();
+  for (const std::string& lock : staleBefore) staleAfter.erase(lock);
+  ::prctl(PR_SET_CHILD_SUBREAPER, 0);
+  for (const std::string& pid : left) ADD_FAILURE() << "an Xvfb of the run is left: " << pid;
+  for (const std::string& lock : staleAfter) ADD_FAILURE() << "stale X lock file left: /tmp/" << lock;
+  std::set<std::string> pngs;
+  for (const auto& entry : fs::directory_iterator(dir.file("a") + "/figures")) {
+    if (entry.path().extension() == ".png") pngs.insert(entry.path().filename().string());
+  }
+  for (const char* name : {"map_aspect_ratio", "hist_area", "hist_width", "hist_aspect_ratio", "map_blocks"}) {
+    EXPECT_EQ(pngs.count(std::string(name) + ".png"), 1u) << name << " was not written";
+  }
+  for (const std::string& name : pngs) {
+    const std::string png = dir.file("a") + "/figures/" + name;
+    EXPECT_GT(fs::file_size(png), 0u) << png;
+    const test::Image image = test::readPng(png);
+    EXPECT_EQ(image.width, 1800) << png << " does not decode at the default size";
+    EXPECT_EQ(image.height, 900) << png;
+    EXPECT_GT(test::ink(image).share, 0.03) << png << " looks blank";
+  }
+
+  // DISPLAY naming a server that is not there: the same.
+  const CliRun elsewhere =
+      runCli("compare " + kSampleArgs + " --figure-width 400 --figure-height 200 --out '" + dir.file("c") + "' --quiet",
+             "env DISPLAY=:65432");
+  ASSERT_EQ(elsewhere.code, 0) << elsewhere.output;
+  EXPECT_EQ(test::readPng(dir.file("c") + "/figures/map_blocks.png").width, 400);
+
+  // No Xvfb either (PATH leads to none): one line naming the package, nothing written.
+  const CliRun noXvfb =
+      runCli("compare " + kSampleArgs + " --out '" + dir.file("d") + "' --quiet", "env -u DISPLAY PATH=/nonexistent");
+  EXPECT_EQ(noXvfb.code, 1) << noXvfb.output;
+  EXPECT_NE(noXvfb.output.find("Debian package xvfb"), std::string::npos) << noXvfb.output;
+  EXPECT_NE(noXvfb.output.find("--figures 0"), std::string::npos) << noXvfb.output;
+  EXPECT_EQ(std::count(noXvfb.output.begin(), noXvfb.output.end(), '\n'), 1) << noXvfb.output;
+  EXPECT_FALSE(fs::exists(dir.file("d")));
+
   const CliRun tablesOnly = runCli(
       "compare " + kSampleArgs + " --figures 0 --spatial-index 0 --out '" + dir.file("b") + "' --quiet",
       "env -u DISPLAY");

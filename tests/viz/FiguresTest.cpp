@@ -366,5 +366,60 @@ TEST(RenderHistogram, OverlaidSeriesInTheirColoursWithTextInTheSvg) {
   EXPECT_THROW(renderHistogram("x", "x", "y", {0, 1, 2}, {{"bad", {1}, {}}}, out), Error);
 }
 
+// The band of the title (the top `share` of the image): no ink in the columns
+// at either border or in the top row (text cut off there), and ink spanning
+// most of the width (the title is there, in a legible size).
+void expectTitleInside(const test::Image& image, double share, const std::string& what) {
+  ASSERT_GT(image.width, 0) << what;
+  const auto inked = [&](int x, int y) {
+    const std::uint32_t c = image.rgb(x, y);
+    return red(c) < 230 || green(c) < 230 || blue(c) < 230;
+  };
+  const int rows = static_cast<int>(share * image.height);
+  int left = image.width, right = -1, touching = 0;
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      if (!inked(x, y)) continue;
+      left = std::min(left, x);
+      right = std::max(right, x);
+      touching += x <= 1 || x >= image.width - 2 || y == 0;
+    }
+  }
+  EXPECT_EQ(touching, 0) << what << ": the title touches the border (cut off); its ink runs from x = " << left << " to "
+                         << right << " of " << image.width;
+  EXPECT_GT(right - left, image.width / 2) << what << ": the title is missing or tiny";
+}
+
+const std::string kLongTitle =
+    "Parcel area: observed and procedural (skeleton, seed 12345, 3 blocks overridden), "
+    "ASSESSING_ParcelsFY2014_with_a_long_file_name.topojson";
+
+TEST(RenderHistogram, LongTitlesFitTheFigureWidth) {
+  TempDir dir;
+  for (const auto& [width, height] : {std::pair{600, 300}, {800, 600}, {1800, 900}}) {
+    const FigureOutput out = output(dir, "hist" + std::to_string(width), width, height);
+    renderHistogram(kLongTitle, "area (m\xc2\xb2)", "parcels (count)", {0, 100, 200, 300},
+                    {{"observed", {5, 10, 2}, {0.84, 0.15, 0.16}}, {"procedural", {3, 12, 4}, {0.12, 0.38, 0.75}}},
+                    out);
+    // The title band: above the plot, whose top is below 12 % of the height at these sizes.
+    expectTitleInside(test::readPng(out.png), 0.06, out.png);
+  }
+}
+
+TEST(RenderMaps, LongTitlesFitTheFigureWidth) {
+  TempDir dir;
+  const Polygon a = rect(0, 0, 100, 60), b = rect(120, 0, 200, 60);
+  MapPanel panel{"10 blocks (10 with parcels on both sides)", {&a, &b}, {0.2, 0.7}};
+  ColourScale scale;
+  scale.kind = ColourScale::Kind::Sequential;
+  scale.title = "KS statistic of parcel area (0: same distribution, 1: disjoint)";
+  for (const auto& [width, height] : {std::pair{600, 300}, {800, 600}, {1800, 900}}) {
+    const FigureOutput out = output(dir, "blocks" + std::to_string(width), width, height);
+    renderMaps("Per-block difference in " + kLongTitle, {panel}, scale, out);
+    // The title band is the top 13 %; its upper part holds the figure's title.
+    expectTitleInside(test::readPng(out.png), 0.08, out.png);
+  }
+}
+
 }  // namespace
 }  // namespace parcelscope::viz

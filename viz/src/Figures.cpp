@@ -37,6 +37,7 @@
 #include <vtkTable.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
+#include <vtkTextRenderer.h>
 #include <vtkVersion.h>
 #include <vtkWindowToImageFilter.h>
 
@@ -47,6 +48,7 @@
 #include <unordered_map>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <limits>
 
 #include "EarClip.h"
@@ -82,6 +84,91 @@ void styleText(vtkTextProperty* p, int size, bool bold = false) {
   p->SetColor(0.1, 0.1, 0.1);
 }
 
+// The smallest font a fitted text shrinks to before it wraps, and the smallest
+// at all (a single word wider than the figure at that size is cut off).
+constexpr int kMinFontSize = 8;
+constexpr int kLastResortFontSize = 6;
+
+// Width in pixels of `text` (lines separated by '\n') drawn with `style` at
+// `size`, at the window's `dpi`.
+int textWidth(vtkTextProperty* style, const std::string& text, int size, int dpi) {
+  vtkNew<vtkTextProperty> p;
+  p->ShallowCopy(style);
+  p->SetFontSize(size);
+  p->SetOrientation(0);
+  int box[4] = {0, 0, 0, 0};
+  if (!vtkTextRenderer::GetInstance()->GetBoundingBox(p, text, box, dpi)) return 0;
+  return box[1] - box[0] + 1;
+}
+
+// `text` as two lines, broken at the space that leaves the longer line
+// shortest; a break after punctuation (", ", ": ", "; ") is taken if its
+// longer line is at most a fifth longer than that. Empty when there is no space.
+std::string splitInTwo(vtkTextProperty* style, const std::string& text, int size, int dpi) {
+  std::string best, bestAfterPunctuation;
+  int bestWidth = std::numeric_limits<int>::max(), bestPunctuationWidth = bestWidth;
+  for (std::size_t i = text.find(' '); i != std::string::npos; i = text.find(' ', i + 1)) {
+    const std::size_t end = text.find_last_not_of(' ', i);
+    const std::size_t start = text.find_first_not_of(' ', i);
+    if (end == std::string::npos || start == std::string::npos) continue;
+    const std::string first = text.substr(0, end + 1), second = text.substr(start);
+    const int width = std::max(textWidth(style, first, size, dpi), textWidth(style, second, size, dpi));
+    if (width < bestWidth) {
+      bestWidth = width;
+      best = first + "\n" + second;
+    }
+    const char last = text[end];
+    if ((last == ',' || last == ':' || last == ';') && width < bestPunctuationWidth) {
+      bestPunctuationWidth = width;
+      bestAfterPunctuation = first + "\n" + second;
+    }
+  }
+  if (!bestAfterPunctuation.empty() && bestPunctuationWidth <= 1.2 * bestWidth) return bestAfterPunctuation;
+  return best;
+}
+
+// The largest font size from `size` down to `floor` at which `text` is at
+// most `maxWidth` pixels wide; 0 when none is.
+int largestFitting(vtkTextProperty* style, const std::string& text, int size, int floor, double maxWidth, int dpi) {
+  const int full = textWidth(style, text, size, dpi);
+  if (full <= maxWidth) return size;
+  // Widths grow about in proportion to the size: start there, and step down.
+  int s = std::min(size - 1, static_cast<int>(std::floor(size * maxWidth / std::max(1, full))));
+  while (s >= floor && textWidth(style, text, s, dpi) > maxWidth) --s;
+  return s >= floor ? s : 0;
+}
+
+// A text laid out to fit a width: its lines (joined by '\n') and font size.
+struct FittedText {
+  std::string text;
+  int size = 0;
+};
+
+// Lays `text` out within `maxWidth` pixels, drawn with `style` at up to
+// `size`: on one line, shrunk to no less than 4/5 of `size`; otherwise on two
+// lines (splitInTwo) at the largest size that fits, down to kMinFontSize;
+// otherwise (a long word on a narrow figure) at the size that fits, down to
+// kLastResortFontSize. With `oneLine`, it only shrinks (down to
+// kLastResortFontSize): vector copies (GL2PS) draw a text as one line whatever
+// it holds, and their text stays sharp when enlarged.
+FittedText fitText(vtkTextProperty* style, const std::string& text, int size, double maxWidth, int dpi,
+                   bool oneLine = false) {
+  detail::prepareTextRendering();
+  if (text.empty()) return {text, size};
+  if (oneLine) {
+    const int s = largestFitting(style, text, size, std::min(size, kLastResortFontSize), maxWidth, dpi);
+    return {text, s > 0 ? s : std::min(size, kLastResortFontSize)};
+  }
+  if (size <= kMinFontSize) return {text, size};
+  const int shrunk = std::max(kMinFontSize, static_cast<int>(std::ceil(0.8 * size)));
+  if (const int s = largestFitting(style, text, size, shrunk, maxWidth, dpi)) return {text, s};
+  const std::string twoLines = splitInTwo(style, text, size, dpi);
+  const std::string& laidOut = twoLines.empty() ? text : twoLines;
+  if (const int s = largestFitting(style, laidOut, size, kMinFontSize, maxWidth, dpi)) return {laidOut, s};
+  const int s = largestFitting(style, laidOut, kMinFontSize, kLastResortFontSize, maxWidth, dpi);
+  return {laidOut, s > 0 ? s : kLastResortFontSize};
+}
+
 // One hidden window serves every figure of the process: a new window means a
 // new OpenGL context, whose shaders a software renderer (llvmpipe under Xvfb)
 // compiles again, about half a second each time. Each figure starts by
@@ -103,9 +190,14 @@ vtkSmartPointer<vtkRenderWindow> offscreenWindow(const FigureOutput& out) {
   return window;
 }
 
-// Writes the PNG (and the vector copy) of what `window` shows.
-void writeFigure(vtkRenderWindow* window, const FigureOutput& out, const std::string& title) {
+// Writes the PNG (and the vector copy) of what `window` shows. `adjust` runs
+// after the scene was drawn (and laid out) once, and returns whether it changed
+// it, which is then drawn again; `beforeVector` may change the scene between
+// the PNG and the vector copy.
+void writeFigure(vtkRenderWindow* window, const FigureOutput& out, const std::string& title,
+                 const std::function<bool()>& adjust = {}, const std::function<void()>& beforeVector = {}) {
   window->Render();
+  if (adjust && adjust()) window->Render();
   vtkNew<vtkWindowToImageFilter> grab;
   grab->SetInput(window);
   grab->SetInputBufferTypeToRGB();
@@ -123,6 +215,7 @@ void writeFigure(vtkRenderWindow* window, const FigureOutput& out, const std::st
   png->Write();
   if (png->GetErrorCode() != 0 || !std::filesystem::exists(out.png)) throw ioError(out.png + ": cannot write PNG");
   if (out.vector.empty()) return;
+  if (beforeVector) beforeVector();
 
   const std::filesystem::path path(out.vector);
   vtkNew<vtkGL2PSExporter> exporter;
@@ -406,10 +499,15 @@ std::string lengthLabel(double metres) {
   return buf;
 }
 
-void addText(vtkRenderer* r, const std::string& text, double x, double y, int size, bool bold, int vertical) {
+// A text centred at (x, y) of `r` (normalised viewport coordinates), fitted
+// to `maxWidth` pixels (fitText).
+void addText(vtkRenderer* r, const std::string& text, double x, double y, int size, bool bold, int vertical,
+             double maxWidth, int dpi) {
   vtkNew<vtkTextActor> a;
-  a->SetInput(text.c_str());
   styleText(a->GetTextProperty(), size, bold);
+  const FittedText fitted = fitText(a->GetTextProperty(), text, size, maxWidth, dpi);
+  a->GetTextProperty()->SetFontSize(fitted.size);
+  a->SetInput(fitted.text.c_str());
   a->GetTextProperty()->SetJustificationToCentered();
   a->GetTextProperty()->SetVerticalJustification(vertical);
   a->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
@@ -491,16 +589,20 @@ void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, c
       std::max(0.5 * extent.height() + margin, (0.5 * extent.width() + margin) / panelAspect);
   const double cx = 0.5 * (extent.minX + extent.maxX), cy = 0.5 * (extent.minY + extent.maxY);
 
+  // Texts keep a margin of 2 % of the width on either side.
+  const int dpi = window->GetDPI();
+  const double textRoom = 0.96 * out.width;
   vtkNew<vtkRenderer> titles;
   titles->SetViewport(0, titleBottom, 1, 1);
   titles->SetBackground(1, 1, 1);
-  addText(titles, title, 0.5, 0.66, fontSize(out, 0.034), true, VTK_TEXT_CENTERED);
+  addText(titles, title, 0.5, 0.66, fontSize(out, 0.034), true, VTK_TEXT_CENTERED, textRoom, dpi);
   window->AddRenderer(titles);
 
   std::vector<PanelGeometry> geometry(panels.size());
   const double metresPerPixel = 2 * halfHeight / (out.height * (titleBottom - barTop));
   for (int i = 0; i < n; ++i) {
-    addText(titles, panels[i].title, (i + 0.5) / n, 0.18, fontSize(out, 0.026), false, VTK_TEXT_CENTERED);
+    addText(titles, panels[i].title, (i + 0.5) / n, 0.18, fontSize(out, 0.026), false, VTK_TEXT_CENTERED, textRoom / n,
+            dpi);
     buildPanel(panels[i], geometry[i], nullptr, nullptr, kMinOutlinedPixels * metresPerPixel);
     vtkNew<vtkRenderer> r;
     r->SetViewport(static_cast<double>(i) / n, barTop, static_cast<double>(i + 1) / n, titleBottom);
@@ -539,7 +641,7 @@ void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, c
   bar->SetLookupTable(lut);
   bar->SetOrientationToHorizontal();
   // The bar's own title would sit among the labels: the title is a text of its own above the bar.
-  addText(legend, scale.title, 0.5, 0.97, fontSize(out, 0.024), false, VTK_TEXT_TOP);
+  addText(legend, scale.title, 0.5, 0.97, fontSize(out, 0.024), false, VTK_TEXT_TOP, textRoom, dpi);
   bar->SetNumberOfLabels(6);
   bar->SetLabelFormat("%.3g");
   bar->UnconstrainedFontSizeOn();
@@ -655,7 +757,53 @@ void renderHistogram(const std::string& title, const std::string& xTitle, const 
   vtkNew<vtkChartXY> chart;
   view->GetScene()->AddItem(chart);
   fillHistogramChart(chart, title, xTitle, yTitle, edges, series, out.height);
-  writeFigure(window, out, title);
+  // The chart centres its title and the x axis's title on the plot area
+  // horizontally, and the y axis's title vertically, and lays the plot area out
+  // when drawn: once drawn, each is fitted to the room around its centre (less
+  // a margin of 2 % of the figure on either side), and, when that changed one,
+  // the chart is drawn again. The vector copy has them on one line.
+  struct ChartText {
+    std::string text;
+    vtkTextProperty* style;
+    std::function<void(const std::string&)> set;
+    bool horizontal;
+    int size = 0;
+    double room = 0;
+    FittedText fitted{};
+  };
+  vtkAxis* x = chart->GetAxis(vtkAxis::BOTTOM);
+  vtkAxis* y = chart->GetAxis(vtkAxis::LEFT);
+  std::array<ChartText, 3> texts{{
+      {title, chart->GetTitleProperties(), [&](const std::string& t) { chart->SetTitle(t); }, true},
+      {xTitle, x->GetTitleProperties(), [x](const std::string& t) { x->SetTitle(t); }, true},
+      {yTitle, y->GetTitleProperties(), [y](const std::string& t) { y->SetTitle(t); }, false},
+  }};
+  const int dpi = window->GetDPI();
+  const auto fitTexts = [&] {
+    const int* p1 = chart->GetPoint1();
+    const int* p2 = chart->GetPoint2();
+    bool changed = false;
+    for (ChartText& t : texts) {
+      const double centre = t.horizontal ? 0.5 * (p1[0] + p2[0]) : 0.5 * (p1[1] + p2[1]);
+      const double extent = t.horizontal ? out.width : out.height;
+      t.size = t.style->GetFontSize();
+      t.room = 2 * std::min(centre, extent - centre) - 0.04 * extent;
+      t.fitted = fitText(t.style, t.text, t.size, t.room, dpi);
+      if (t.fitted.text == t.text && t.fitted.size == t.size) continue;
+      t.set(t.fitted.text);
+      t.style->SetFontSize(t.fitted.size);
+      changed = true;
+    }
+    return changed;
+  };
+  const auto oneLine = [&] {
+    for (ChartText& t : texts) {
+      if (t.fitted.text == t.text) continue;
+      t.style->SetFontSize(fitText(t.style, t.text, t.size, t.room, dpi, true).size);
+      t.set(t.text);
+    }
+  };
+  writeFigure(window, out, title, fitTexts, oneLine);
 }
 
 // Interactive pieces (Scenes.h).

@@ -5,9 +5,10 @@
 // VTK's headers.
 //
 // Rendering needs an X server (VTK on Debian renders through GLX, off screen
-// in a hidden window). Without one, every function throws Error(IO) naming the
-// display instead of crashing; run under `xvfb-run -a` on a machine without a
-// screen.
+// in a hidden window). When $DISPLAY names none (unset, or nothing answers),
+// the first figure starts a private Xvfb for the process (requireDisplay), so
+// figures render headless with nothing to set up; only when Xvfb is missing
+// too does every function throw Error(IO) naming what to install.
 #include <string>
 #include <vector>
 
@@ -27,7 +28,16 @@ struct FigureOutput {
   int height = 900;    ///< pixels
 };
 
-/// Throws Error(IO) unless an X server answers on $DISPLAY.
+/// Makes sure an X server is there to render on, once per process: the one on
+/// $DISPLAY if it answers; otherwise (DISPLAY unset, or nothing answers) a
+/// private `Xvfb -displayfd FD -screen 0 1920x1080x24 -nolisten tcp
+/// -terminate` on a display number it picks itself, with $DISPLAY set to it for
+/// the rest of the process. That server is stopped and reaped when the process
+/// exits (normally or through an error); if the process is killed, it ends by
+/// itself once the process's connections close. Keeps a connection open for
+/// the process's life. Throws Error(IO) when Xvfb is needed but not installed
+/// (naming the package) or does not start. Not for concurrent use with VTK
+/// rendering (it may set DISPLAY).
 void requireDisplay();
 
 /// A colour scale for map values. Values below `minimum` or above `maximum` take
@@ -60,9 +70,10 @@ double outlineSize(const Polygon& shape);
 
 /// Renders `panels` side by side with the same extent (the union of every
 /// panel's shapes) and the same scale, each with its title and a scale bar in
-/// metres, one shared colour bar below and `title` above. Throws Error(Usage)
-/// when a panel's values do not match its shapes or no panel has a shape,
-/// Error(IO) when there is no display or a file cannot be written.
+/// metres, one shared colour bar below and `title` above. A text too wide for
+/// its room is set smaller (to 4/5 of its size), then on two lines. Throws
+/// Error(Usage) when a panel's values do not match its shapes or no panel has a
+/// shape, Error(IO) when there is no display or a file cannot be written.
 void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, const ColourScale& scale,
                 const FigureOutput& output);
 
@@ -75,8 +86,10 @@ struct HistogramSeries {
 
 /// Renders overlaid frequency histograms on shared bins `edges` (bins + 1
 /// increasing values): each series as a translucent filled step outline, with
-/// axis titles, a legend and `title`. Throws Error(Usage) when a series does not
-/// have one count per bin, Error(IO) as renderMaps.
+/// axis titles, a legend and `title`; the titles are fitted to the width as
+/// renderMaps's (the vector copy keeps each on one line, only smaller). Throws
+/// Error(Usage) when a series does not have one count per bin, Error(IO) as
+/// renderMaps.
 void renderHistogram(const std::string& title, const std::string& xTitle, const std::string& yTitle,
                      const std::vector<double>& edges, const std::vector<HistogramSeries>& series,
                      const FigureOutput& output);
