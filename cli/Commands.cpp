@@ -5,12 +5,12 @@
 
 #include "Args.h"
 #include "TermProgress.h"
-#include "parcelscope/pipeline/StatsJob.h"
-#include "parcelscope/core/Error.h"
-#include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/analysis/Comparison.h"
+#include "parcelscope/core/Error.h"
 #include "parcelscope/pipeline/CompareJob.h"
 #include "parcelscope/pipeline/CompareSession.h"
+#include "parcelscope/pipeline/GenerateJob.h"
+#include "parcelscope/pipeline/StatsJob.h"
 #include "parcelscope/viz/CompareFigures.h"
 
 namespace parcelscope::cli {
@@ -36,8 +36,9 @@ std::vector<FlagSpec> inputFlags() {
   return {{"layer", "layer to read (default: the first)"},
           {"where", "OGR SQL attribute filter, e.g. \"ML <> 'ROAD'\""},
           {"crs", "CRS of the input (e.g. EPSG:2286), replacing a missing or wrong one"},
-          {"key-field", "field whose value is each feature's stable key (parcel_key, block_key); default: the "
-                        "features' geometries"}};
+          {"key-field",
+           "field whose value is each feature's stable key (parcel_key, block_key); default: the "
+           "features' geometries"}};
 }
 
 FlagSpec styleFlag() {
@@ -101,9 +102,10 @@ int dispatch(const std::vector<std::string>& args) {
 
 int metricsCommand(const std::vector<std::string>& args) {
   if (wantsHelp(args)) {
-    std::fputs("usage: parcelscope metrics\n\nPrints every parcel metric (name, unit, formula, range, source) as a\n"
-               "Markdown table: the table of docs/user/metrics.md, made from the metric registry.\n",
-               stdout);
+    std::fputs(
+        "usage: parcelscope metrics\n\nPrints every parcel metric (name, unit, formula, range, source) as a\n"
+        "Markdown table: the table of docs/user/metrics.md, made from the metric registry.\n",
+        stdout);
     return 0;
   }
   if (!args.empty()) throw usageError("metrics takes no arguments");
@@ -140,19 +142,21 @@ int statsCommand(const std::vector<std::string>& args) {
 int generateCommand(const std::vector<std::string>& args) {
   auto flags = inputFlags();
   flags.push_back(styleFlag());
-  flags.push_back({"from-parcels", "INPUT holds observed parcels: build blocks and per-block bounds as 'stats' does",
-                   false});
+  flags.push_back(
+      {"from-parcels", "INPUT holds observed parcels: build blocks and per-block bounds as 'stats' does", false});
   flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
   flags.push_back({"quiet", "no progress or summary on stderr", false});
   const std::vector<ParameterDescription> params = generation::generationParameterDescriptions();
   if (wantsHelp(args)) {
-    std::fputs(usageText("parcelscope generate INPUT [--style obb|skeleton|offset|auto] [options] [--seed N] --out DIR", flags, params)
+    std::fputs(usageText("parcelscope generate INPUT [--style obb|skeleton|offset|auto] [options] [--seed N] --out DIR",
+                         flags, params)
                    .c_str(),
                stdout);
-    std::fputs("\nINPUT holds block polygons (e.g. blocks.gpkg from 'parcelscope stats', whose a_min, a_max,\n"
-               "w_min and w_max fields are used per block unless given here), or observed parcels with\n"
-               "--from-parcels. Writes DIR/parcels.gpkg, DIR/parcels.csv and DIR/run.json.\n",
-               stdout);
+    std::fputs(
+        "\nINPUT holds block polygons (e.g. blocks.gpkg from 'parcelscope stats', whose a_min, a_max,\n"
+        "w_min and w_max fields are used per block unless given here), or observed parcels with\n"
+        "--from-parcels. Writes DIR/parcels.gpkg, DIR/parcels.csv and DIR/run.json.\n",
+        stdout);
     return 0;
   }
   const Args a(args, flags, params);
@@ -175,24 +179,27 @@ int compareCommand(const std::vector<std::string>& args) {
   }
   flags.push_back({"vector", "format of the histograms' vector copy: svg (default) or pdf"});
   flags.push_back({"parcels-format", "generated parcels as gpkg (parcels.gpkg, default) or geojson (parcels.geojson)"});
-  flags.push_back({"session", "session file (saved by parcelscope-gui, or a compare run.json): input, style,\n"
-                              "      parameters, per-block overrides (the only way to give those here) and seed;\n"
-                              "      INPUT and options given here win"});
+  flags.push_back({"session",
+                   "session file (saved by parcelscope-gui, or a compare run.json): input, style,\n"
+                   "      parameters, per-block overrides (the only way to give those here) and seed;\n"
+                   "      INPUT and options given here win"});
   flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
   flags.push_back({"quiet", "no progress or summary on stderr", false});
   const auto params = pipeline::compareParameters();
   if (wantsHelp(args)) {
-    std::fputs(usageText("parcelscope compare INPUT|--session FILE [--style obb|skeleton|offset|auto] [--k 2] [--seed N] [options] --out DIR", flags,
-                         params)
+    std::fputs(usageText("parcelscope compare INPUT|--session FILE [--style obb|skeleton|offset|auto] [--k 2] [--seed "
+                         "N] [options] --out DIR",
+                         flags, params)
                    .c_str(),
                stdout);
-    std::fputs("\nINPUT holds observed parcels. They are grouped into blocks and measured as 'stats' does; every\n"
-               "block is subdivided with its own bounds (A-bar -/+ k s_A, W-bar -/+ k s_W) unless --a-min etc.\n"
-               "are given; both sets are measured alike and compared. Writes DIR/parcels.gpkg, blocks.gpkg,\n"
-               "observed_parcels.csv, generated_parcels.csv, blocks.csv, summary.csv, distances.csv,\n"
-               "summary.json, run.json and DIR/figures/*.png and *.svg or *.pdf (figures need an X server: use\n"
-               "'xvfb-run -a' without a screen, or --figures no).\n",
-               stdout);
+    std::fputs(
+        "\nINPUT holds observed parcels. They are grouped into blocks and measured as 'stats' does; every\n"
+        "block is subdivided with its own bounds (A-bar -/+ k s_A, W-bar -/+ k s_W) unless --a-min etc.\n"
+        "are given; both sets are measured alike and compared. Writes DIR/parcels.gpkg, blocks.gpkg,\n"
+        "observed_parcels.csv, generated_parcels.csv, blocks.csv, summary.csv, distances.csv,\n"
+        "summary.json, run.json and DIR/figures/*.png and *.svg or *.pdf (figures need an X server: use\n"
+        "'xvfb-run -a' without a screen, or --figures no).\n",
+        stdout);
     return 0;
   }
   const Args a(args, flags, params);

@@ -1,5 +1,6 @@
 #include "MainWindow.h"
 
+#include <QVTKOpenGLStereoWidget.h>
 #include <QAction>
 #include <QApplication>
 #include <QCheckBox>
@@ -25,13 +26,12 @@
 #include <QSettings>
 #include <QSplitter>
 #include <QStandardPaths>
-#include <QTimer>
 #include <QStatusBar>
 #include <QTableWidget>
 #include <QTextBrowser>
+#include <QTimer>
 #include <QToolBar>
 #include <QVBoxLayout>
-#include <QVTKOpenGLStereoWidget.h>
 
 #include <vtkAxis.h>
 #include <vtkChartXY.h>
@@ -54,8 +54,8 @@
 #include "parcelscope/analysis/Comparison.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
-#include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/io/ParcelReader.h"
+#include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/viz/CompareFigures.h"
 #include "parcelscope/viz/Scenes.h"
 
@@ -66,8 +66,7 @@ namespace parcelscope::gui {
 class ChartStyle : public vtkContextInteractorStyle {
 public:
   static ChartStyle* New();
-  vtkTypeMacro(ChartStyle, vtkContextInteractorStyle)
-  void drawNow() { RenderNow(); }
+  vtkTypeMacro(ChartStyle, vtkContextInteractorStyle) void drawNow() { RenderNow(); }
   // VTK's own keys ('3' stereo, 'r' reset the camera, 'e'/'q' quit, ...) do
   // nothing; the chart still receives key presses (OnKeyPress).
   void OnChar() override {}
@@ -356,8 +355,9 @@ QWidget* MainWindow::buildControls() {
   form->addRow("colour by", colourBy_);
   perBlockBounds_ = new QCheckBox("per-block bounds (A-bar -/+ k s_A, W-bar -/+ k s_W)");
   perBlockBounds_->setChecked(true);
-  perBlockBounds_->setToolTip("Each block's A_min, A_max, W_min, W_max come from its observed parcels; "
-                              "moving one of those sliders sets it for every block instead");
+  perBlockBounds_->setToolTip(
+      "Each block's A_min, A_max, W_min, W_max come from its observed parcels; "
+      "moving one of those sliders sets it for every block instead");
   connect(perBlockBounds_, &QCheckBox::toggled, this, [this](bool on) {
     controller_.setPerBlockBounds(on);
     submit();
@@ -425,11 +425,14 @@ QWidget* MainWindow::buildControls() {
 
 void MainWindow::buildMenus() {
   QMenu* file = menuBar()->addMenu("&File");
-  file->addAction("&Open...", this, [this] {
-    const QString path = QFileDialog::getOpenFileName(
-        this, "Open parcels", {}, "Parcel data (*.gpkg *.geojson *.json *.topojson *.shp *.fgb);;All files (*)");
-    if (!path.isEmpty()) openFile(path);
-  }, QKeySequence::Open);
+  file->addAction(
+      "&Open...", this,
+      [this] {
+        const QString path = QFileDialog::getOpenFileName(
+            this, "Open parcels", {}, "Parcel data (*.gpkg *.geojson *.json *.topojson *.shp *.fgb);;All files (*)");
+        if (!path.isEmpty()) openFile(path);
+      },
+      QKeySequence::Open);
   file->addAction("Open &sample", this, [this] { openSample(); });
   recentMenu_ = file->addMenu("Open &recent");
   recentMenu_->setObjectName("recentMenu");
@@ -442,7 +445,8 @@ void MainWindow::buildMenus() {
     if (!path.isEmpty()) openSession(path);
   });
   saveSessionAction_ = file->addAction("Save session...", this, [this] {
-    const QString path = QFileDialog::getSaveFileName(this, "Save session", "session.json", "ParcelScope session (*.json)");
+    const QString path =
+        QFileDialog::getSaveFileName(this, "Save session", "session.json", "ParcelScope session (*.json)");
     if (!path.isEmpty()) saveSession(path);
   });
   file->addSeparator();
@@ -469,7 +473,8 @@ void MainWindow::buildMenus() {
                                "(zoom in to see more of them)")
                            .arg(viz::kMinOutlinedPixels));
   connect(outlines, &QAction::toggled, this, [this](bool on) { setOutlinesVisible(on); });
-  zoomToExtentAction_ = view->addAction("Zoom to &extent", this, [this] { zoomToExtent(); }, Qt::Key_Home);
+  zoomToExtentAction_ = view->addAction(
+      "Zoom to &extent", this, [this] { zoomToExtent(); }, Qt::Key_Home);
   zoomToExtentAction_->setToolTip("Fit both views to the data");
   QToolBar* bar = addToolBar("Main");
   bar->setObjectName("mainToolBar");
@@ -506,8 +511,8 @@ void MainWindow::openFile(const QString& path, const QString& layer, const QStri
         QStringList items;
         for (const auto& n : names) items << QString::fromStdString(n);
         bool ok = false;
-        const QString chosen = QInputDialog::getItem(this, "Layer", QFileInfo(path).fileName() + " holds several layers:",
-                                                     items, 0, false, &ok);
+        const QString chosen = QInputDialog::getItem(
+            this, "Layer", QFileInfo(path).fileName() + " holds several layers:", items, 0, false, &ok);
         if (!ok) return;
         input.layer = chosen.toStdString();
       }
@@ -525,9 +530,7 @@ void MainWindow::openFile(const QString& path, const QString& layer, const QStri
   submit();
 }
 
-void MainWindow::openSample() {
-  openFile(sampleDirectory() + "/sample_town.geojson", {}, "use <> 'ROW'");
-}
+void MainWindow::openSample() { openFile(sampleDirectory() + "/sample_town.geojson", {}, "use <> 'ROW'"); }
 
 void MainWindow::openSession(const QString& path) {
   try {
@@ -842,8 +845,10 @@ void MainWindow::drawReport(const UpdateReport& report) {
                        .arg(report.blocksTotal)
                        .arg(lastLatencyMs_, 0, 'f', 0));
   if (!r.generated.failures.empty()) {
-    status_->setToolTip(QString::fromStdString(std::to_string(r.generated.failures.size()) + " blocks fell back or "
-                                               "were refused; first: " + r.generated.failures.front()));
+    status_->setToolTip(QString::fromStdString(std::to_string(r.generated.failures.size()) +
+                                               " blocks fell back or "
+                                               "were refused; first: " +
+                                               r.generated.failures.front()));
   }
   emit viewsUpdated(report.serial);
 }
@@ -913,7 +918,8 @@ QImage MainWindow::screenshot() {
   QPixmap shot = grab();
   QPainter painter(&shot);
   for (QVTKOpenGLStereoWidget* view : findChildren<QVTKOpenGLStereoWidget*>()) {
-    if (view->isVisible()) painter.drawImage(QRect(view->mapTo(this, QPoint(0, 0)), view->size()), view->grabFramebuffer());
+    if (view->isVisible())
+      painter.drawImage(QRect(view->mapTo(this, QPoint(0, 0)), view->size()), view->grabFramebuffer());
   }
   painter.end();
   return shot.toImage();
@@ -1016,24 +1022,23 @@ void MainWindow::showBlock() {
     }
   }
   const bool overridden = controller_.overridden(block);
-  setBlockInfo(
-      QString("<b>Block %1</b> (%2 m&sup2;; subdivided with %3%4)<br>"
-              "<table cellspacing=4><tr><th></th><th>observed</th><th>procedural</th></tr>"
-              "<tr><td>parcels</td><td>%5</td><td>%6</td></tr>"
-              "<tr><td>A-bar, s_A (m&sup2;)</td><td>%7, %8</td><td>%9, %10</td></tr>"
-              "<tr><td>W-bar, s_W (m)</td><td>%11, %12</td><td>%13, %14</td></tr></table>"
-              "derived A_min %15, A_max %16 m&sup2;; W_min %17, W_max %18 m; street access %19; KS area %20")
-          .arg(block.id)
-          .arg(number(s.blockArea))
-          .arg(styles)
-          .arg(overridden ? ", overridden" : "")
-          .arg(c.observed.parcels)
-          .arg(c.generated.parcels)
-          .arg(number(c.observed.meanArea), number(c.observed.sdArea), number(c.generated.meanArea),
-               number(c.generated.sdArea), number(c.observed.meanWidth), number(c.observed.sdWidth),
-               number(c.generated.meanWidth))
-          .arg(number(c.generated.sdWidth), number(s.aMin), number(s.aMax), number(s.wMin), number(s.wMax),
-               number(s.streetAccessShare), number(c.area.ks)));
+  setBlockInfo(QString("<b>Block %1</b> (%2 m&sup2;; subdivided with %3%4)<br>"
+                       "<table cellspacing=4><tr><th></th><th>observed</th><th>procedural</th></tr>"
+                       "<tr><td>parcels</td><td>%5</td><td>%6</td></tr>"
+                       "<tr><td>A-bar, s_A (m&sup2;)</td><td>%7, %8</td><td>%9, %10</td></tr>"
+                       "<tr><td>W-bar, s_W (m)</td><td>%11, %12</td><td>%13, %14</td></tr></table>"
+                       "derived A_min %15, A_max %16 m&sup2;; W_min %17, W_max %18 m; street access %19; KS area %20")
+                   .arg(block.id)
+                   .arg(number(s.blockArea))
+                   .arg(styles)
+                   .arg(overridden ? ", overridden" : "")
+                   .arg(c.observed.parcels)
+                   .arg(c.generated.parcels)
+                   .arg(number(c.observed.meanArea), number(c.observed.sdArea), number(c.generated.meanArea),
+                        number(c.generated.sdArea), number(c.observed.meanWidth), number(c.observed.sdWidth),
+                        number(c.generated.meanWidth))
+                   .arg(number(c.generated.sdWidth), number(s.aMin), number(s.aMax), number(s.wMin), number(s.wMax),
+                        number(s.streetAccessShare), number(c.area.ks)));
 }
 
 QString MainWindow::lastError() const { return errorBar_->isVisible() ? errorBar_->text() : QString(); }

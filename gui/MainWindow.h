@@ -52,8 +52,7 @@ public:
   ~MainWindow() override;
 
   /// Opens `path` (asks for a layer when it holds several and none is given).
-  void openFile(const QString& path, const QString& layer = {}, const QString& where = {},
-                const QString& crs = {});
+  void openFile(const QString& path, const QString& layer = {}, const QString& where = {}, const QString& crs = {});
   /// Opens the bundled sample.
   void openSample();
   /// Restores input, parameters, overrides and seed from a session file.

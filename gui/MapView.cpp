@@ -1,9 +1,9 @@
 #include "MapView.h"
 
+#include <QVTKOpenGLStereoWidget.h>
 #include <QLabel>
 #include <QTimer>
 #include <QVBoxLayout>
-#include <QVTKOpenGLStereoWidget.h>
 
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
@@ -35,8 +35,7 @@ constexpr double kLegendBand = 0.14;  // of the view's height
 class PanZoomStyle : public vtkInteractorStyleTrackballCamera {
 public:
   static PanZoomStyle* New();
-  vtkTypeMacro(PanZoomStyle, vtkInteractorStyleTrackballCamera)
-  std::function<void(int, int)> onClick;
+  vtkTypeMacro(PanZoomStyle, vtkInteractorStyleTrackballCamera) std::function<void(int, int)> onClick;
 
   void OnChar() override {}
   void OnKeyPress() override {}
@@ -158,7 +157,8 @@ MapView::MapView(const QString& title, bool withColourBar, QWidget* parent) : QW
   scale->SetCallback([](vtkObject*, unsigned long, void* self, void*) {
     auto* view = static_cast<MapView*>(self);
     const int* size = view->renderer_->GetSize();
-    if (size[1] > 0) view->layer_.setMetresPerPixel(2 * view->renderer_->GetActiveCamera()->GetParallelScale() / size[1]);
+    if (size[1] > 0)
+      view->layer_.setMetresPerPixel(2 * view->renderer_->GetActiveCamera()->GetParallelScale() / size[1]);
   });
   scaleObserver_ = renderer_->AddObserver(vtkCommand::StartEvent, scale);
   if (withColourBar) {
@@ -205,9 +205,8 @@ void MapView::useCamera(vtkCamera* camera) {
   renderer_->SetActiveCamera(camera);
   vtkNew<vtkCallbackCommand> command;
   command->SetClientData(this);
-  command->SetCallback([](vtkObject*, unsigned long, void* self, void*) {
-    static_cast<MapView*>(self)->scheduleRender();
-  });
+  command->SetCallback(
+      [](vtkObject*, unsigned long, void* self, void*) { static_cast<MapView*>(self)->scheduleRender(); });
   observer_ = camera->AddObserver(vtkCommand::ModifiedEvent, command);
 }
 

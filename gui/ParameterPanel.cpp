@@ -19,8 +19,7 @@ namespace {
 constexpr int kSteps = 1000;
 }
 
-ParameterPanel::ParameterPanel(const std::vector<ParameterDescription>& parameters, QWidget* parent)
-    : QWidget(parent) {
+ParameterPanel::ParameterPanel(const std::vector<ParameterDescription>& parameters, QWidget* parent) : QWidget(parent) {
   auto* column = new QVBoxLayout(this);
   column->setContentsMargins(0, 0, 0, 0);
   for (const auto& [group, members] : groupParameters(parameters)) {

@@ -1,10 +1,10 @@
 // parcelscope-gui [INPUT] [--layer L] [--where SQL] [--crs EPSG:N] [--session FILE] [--sample]
 //                 [--subdivision-style STYLE] [--screenshot PNG]
+#include <QVTKOpenGLStereoWidget.h>
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QSurfaceFormat>
 #include <QTimer>
-#include <QVTKOpenGLStereoWidget.h>
 
 #include <cstdio>
 
@@ -23,7 +23,9 @@ int main(int argc, char** argv) {
   const QCommandLineOption crs("crs", "CRS of the input, replacing a missing or wrong one", "CRS");
   const QCommandLineOption session("session", "session file to restore", "FILE");
   const QCommandLineOption sample("sample", "open the bundled sample");
-  const QCommandLineOption style("subdivision-style", "subdivision style: obb, skeleton, offset or auto (Qt takes --style for its widget style)", "STYLE");
+  const QCommandLineOption style(
+      "subdivision-style", "subdivision style: obb, skeleton, offset or auto (Qt takes --style for its widget style)",
+      "STYLE");
   const QCommandLineOption screenshot("screenshot", "save the window as PNG once it shows its first result, then quit",
                                       "PNG");
   parser.addOptions({layer, where, crs, session, sample, style, screenshot});

@@ -13,6 +13,7 @@ packages=(
   libgdal-dev gdal-bin libssl-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   libx11-dev xvfb xauth libgl1-mesa-dri
+  clang-format
 )
 
 missing=()

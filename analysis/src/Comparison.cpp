@@ -139,9 +139,12 @@ bool isUndesirable(const ShapeMetrics& m) { return m.pAngle > 15.0 || m.pArea > 
 
 const char* metricName(ComparedMetric m) {
   switch (m) {
-    case ComparedMetric::Area: return "area";
-    case ComparedMetric::Width: return "width";
-    case ComparedMetric::AspectRatio: return "aspect_ratio";
+    case ComparedMetric::Area:
+      return "area";
+    case ComparedMetric::Width:
+      return "width";
+    case ComparedMetric::AspectRatio:
+      return "aspect_ratio";
   }
   return "";
 }
@@ -158,8 +161,8 @@ const std::vector<ParcelQuantity>& parcelMetrics() {
       {"width", "width, short side of the minimum bounding rectangle (m)", [](const M& m) { return m.width; }, false,
        "m", false, "short side of the minimum-area bounding rectangle (MBR)", ">= 0",
        "Vanegas et al. 2012, section 6 (minimum width W)"},
-      {"length", "length, long side of the minimum bounding rectangle (m)", [](const M& m) { return m.length; },
-       false, "m", false, "long side of the MBR", ">= width", ""},
+      {"length", "length, long side of the minimum bounding rectangle (m)", [](const M& m) { return m.length; }, false,
+       "m", false, "long side of the MBR", ">= width", ""},
       {"aspect_ratio", "aspect ratio (length / width)", [](const M& m) { return m.aspectRatio; }, false, "", false,
        "length / width", "[1, inf)", "Vanegas et al. 2012, Figure 1 (the colour maps)"},
       {"elongation", "elongation (MBR width / length)", [](const M& m) { return m.elongation; }, false, "", false,
@@ -168,8 +171,8 @@ const std::vector<ParcelQuantity>& parcelMetrics() {
        false, "area / MBR area; 1 is a rectangle", "(0, 1]", "momepy.rectangularity (Dibble et al. 2019)"},
       {"p_angle", "p_angle, mean corner deviation from 90\xc2\xb0 (degrees)", [](const M& m) { return m.pAngle; },
        false, "deg", false,
-       "mean over the outer ring's corners (turns above 10 degrees) of | |turn| - 90 |; 0 without corners",
-       "[0, 90)", "Yang et al. 2013, section 6"},
+       "mean over the outer ring's corners (turns above 10 degrees) of | |turn| - 90 |; 0 without corners", "[0, 90)",
+       "Yang et al. 2013, section 6"},
       {"p_area", "p_area, bounding rectangle area / area", [](const M& m) { return m.pArea; }, false, "", false,
        "MBR area / area", "[1, inf)", "Yang et al. 2013, section 6 (undesirable: p_angle > 15 or p_area > 1.2)"},
       {"neighbours", "neighbours (parcels sharing at least 1 m of boundary)",
@@ -178,12 +181,13 @@ const std::vector<ParcelQuantity>& parcelMetrics() {
        "min(block tolerance, 1 m))",
        ">= 0", ""},
       {"frontage", "frontage, boundary on the block's outer contour (m)", [](const M& m) { return m.frontage; }, true,
-       "m", false, "boundary length on the block's outer outline (facing a street), edges within half the block tolerance "
+       "m", false,
+       "boundary length on the block's outer outline (facing a street), edges within half the block tolerance "
        "(5 cm to 0.5 m)",
        ">= 0", "Vanegas et al. 2012, section 4 (street access)"},
       {"street_access", "street access (1: at least min-frontage on the block contour)",
-       [](const M& m) { return m.streetAccess ? 1.0 : 0.0; }, true, "", true, "1 when frontage >= --min-frontage (default 1 m)",
-       "0 or 1", "Vanegas et al. 2012, section 4"},
+       [](const M& m) { return m.streetAccess ? 1.0 : 0.0; }, true, "", true,
+       "1 when frontage >= --min-frontage (default 1 m)", "0 or 1", "Vanegas et al. 2012, section 4"},
   };
   return q;
 }
@@ -192,8 +196,10 @@ const std::vector<ParcelQuantity>& parcelQuantities() {
   static const std::vector<ParcelQuantity> q = [] {
     std::vector<ParcelQuantity> out;
     for (const ParcelQuantity& m : parcelMetrics()) {
-      if (m.name == "aspect_ratio") out.insert(out.begin(), m);
-      else out.push_back(m);
+      if (m.name == "aspect_ratio")
+        out.insert(out.begin(), m);
+      else
+        out.push_back(m);
     }
     return out;
   }();
@@ -232,8 +238,8 @@ SetSummary summarizeSet(const std::vector<ParcelMetrics>& metrics) {
     return s;
   }
   // Means and sample SDs exactly as the per-block statistics compute them.
-  const BlockStatistics st = blockStatistics(metricSample(metrics, ComparedMetric::Area),
-                                             metricSample(metrics, ComparedMetric::Width), 0.0);
+  const BlockStatistics st =
+      blockStatistics(metricSample(metrics, ComparedMetric::Area), metricSample(metrics, ComparedMetric::Width), 0.0);
   s.meanArea = st.meanArea;
   s.sdArea = st.sdArea;
   s.meanWidth = st.meanWidth;
@@ -304,10 +310,9 @@ Table blockComparisonTable(const std::vector<BlockComparison>& blocks) {
   t.columns = {{"block_id", T::Integer, ""}, {"block_key", T::String, ""}, {"block_area", T::Real, "m2"}};
   // Observed and generated side by side, in the order of the paper's table.
   const std::pair<const char*, const char*> pairs[] = {
-      {"parcels", ""},          {"mean_area", "m2"},           {"sd_area", "m2"},
-      {"mean_width", "m"},      {"sd_width", "m"},             {"mean_aspect_ratio", ""},
-      {"street_access_share", ""}, {"mean_p_angle", "deg"},    {"mean_p_area", ""},
-      {"undesirable_share", ""}};
+      {"parcels", ""},     {"mean_area", "m2"},       {"sd_area", "m2"},           {"mean_width", "m"},
+      {"sd_width", "m"},   {"mean_aspect_ratio", ""}, {"street_access_share", ""}, {"mean_p_angle", "deg"},
+      {"mean_p_area", ""}, {"undesirable_share", ""}};
   for (const auto& [name, unit] : pairs) {
     for (const char* side : {"observed_", "generated_"}) {
       t.columns.push_back({side + std::string(name), name == std::string("parcels") ? T::Integer : T::Real, unit});
@@ -322,11 +327,15 @@ Table blockComparisonTable(const std::vector<BlockComparison>& blocks) {
     const SetSummary& o = b.comparison.observed;
     const SetSummary& g = b.comparison.generated;
     std::vector<Value> row = {b.blockId, keyText(b.blockKey), b.blockArea, o.parcels, g.parcels};
-    for (const auto& [ov, gv] : {std::pair{o.meanArea, g.meanArea}, {o.sdArea, g.sdArea},
-                                 {o.meanWidth, g.meanWidth}, {o.sdWidth, g.sdWidth},
+    for (const auto& [ov, gv] : {std::pair{o.meanArea, g.meanArea},
+                                 {o.sdArea, g.sdArea},
+                                 {o.meanWidth, g.meanWidth},
+                                 {o.sdWidth, g.sdWidth},
                                  {o.meanAspectRatio, g.meanAspectRatio},
-                                 {o.streetAccessShare, g.streetAccessShare}, {o.meanPAngle, g.meanPAngle},
-                                 {o.meanPArea, g.meanPArea}, {o.undesirableShare, g.undesirableShare}}) {
+                                 {o.streetAccessShare, g.streetAccessShare},
+                                 {o.meanPAngle, g.meanPAngle},
+                                 {o.meanPArea, g.meanPArea},
+                                 {o.undesirableShare, g.undesirableShare}}) {
       row.emplace_back(std::in_place_type<double>, ov);
       row.emplace_back(std::in_place_type<double>, gv);
     }
@@ -342,8 +351,8 @@ Table blockComparisonTable(const std::vector<BlockComparison>& blocks) {
 Table summaryTable(const Comparison& city) {
   using T = Column::Type;
   Table t;
-  t.columns = {{"quantity", T::String, ""}, {"unit", T::String, ""}, {"observed", T::Real, ""},
-               {"generated", T::Real, ""}};
+  t.columns = {
+      {"quantity", T::String, ""}, {"unit", T::String, ""}, {"observed", T::Real, ""}, {"generated", T::Real, ""}};
   const SetSummary& o = city.observed;
   const SetSummary& g = city.generated;
   auto add = [&](const char* name, const char* unit, double ov, double gv) {
@@ -365,12 +374,14 @@ Table summaryTable(const Comparison& city) {
 Table distanceTable(const Comparison& city) {
   using T = Column::Type;
   Table t;
-  t.columns = {{"metric", T::String, ""}, {"unit", T::String, ""}, {"ks", T::Real, ""},
-               {"wasserstein_1", T::Real, ""}, {"histogram_intersection", T::Real, ""}};
+  t.columns = {{"metric", T::String, ""},
+               {"unit", T::String, ""},
+               {"ks", T::Real, ""},
+               {"wasserstein_1", T::Real, ""},
+               {"histogram_intersection", T::Real, ""}};
   for (ComparedMetric m : kComparedMetrics) {
     const Distances& d = city.distances(m);
-    t.rows.push_back({std::string(metricName(m)), std::string(metricUnit(m)), d.ks, d.wasserstein,
-                      d.intersection});
+    t.rows.push_back({std::string(metricName(m)), std::string(metricUnit(m)), d.ks, d.wasserstein, d.intersection});
   }
   return t;
 }

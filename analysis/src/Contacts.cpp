@@ -61,13 +61,13 @@ inline bool coveredAlong(const Point& p, double len, double ux, double uy, const
 
 }  // namespace
 
-bool coveredInterval(const Point& p, const Point& q, const Point& r, const Point& s, double tolerance,
-                     double& lo, double& hi) {
+bool coveredInterval(const Point& p, const Point& q, const Point& r, const Point& s, double tolerance, double& lo,
+                     double& hi) {
   const double len = norm(q.x - p.x, q.y - p.y);
   const double l2 = norm(s.x - r.x, s.y - r.y);
   if (len == 0 || l2 == 0) return false;
-  return coveredAlong(p, len, (q.x - p.x) / len, (q.y - p.y) / len, r, s, (s.x - r.x) / l2, (s.y - r.y) / l2,
-                      tolerance, lo, hi);
+  return coveredAlong(p, len, (q.x - p.x) / len, (q.y - p.y) / len, r, s, (s.x - r.x) / l2, (s.y - r.y) / l2, tolerance,
+                      lo, hi);
 }
 
 double unionLength(std::vector<std::pair<double, double>>& intervals) {
@@ -274,8 +274,8 @@ PairMeasure measurePair(const Polygon& a, const Polygon& b, const Box& boxA, con
 
 }  // namespace
 
-std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons, double tolerance,
-                              double sharedTolerance, double enough) {
+std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons, double tolerance, double sharedTolerance,
+                              double enough) {
   std::vector<Box> boxes(polygons.size());
   for (std::size_t i = 0; i < polygons.size(); ++i) boxes[i] = contactBox(*polygons[i], tolerance);
   return contacts(polygons, intersectingPairs(boxes), tolerance, sharedTolerance, enough);
@@ -300,9 +300,8 @@ std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons,
   if (candidates.size() < 4 * kChunk) {
     measureRange(0, candidates.size());
   } else {
-    parallelFor((candidates.size() + kChunk - 1) / kChunk, [&](std::size_t c) {
-      measureRange(c * kChunk, std::min(candidates.size(), (c + 1) * kChunk));
-    });
+    parallelFor((candidates.size() + kChunk - 1) / kChunk,
+                [&](std::size_t c) { measureRange(c * kChunk, std::min(candidates.size(), (c + 1) * kChunk)); });
   }
   std::vector<Contact> out;
   for (std::size_t k = 0; k < candidates.size(); ++k) {
@@ -404,9 +403,9 @@ namespace parcelscope::analysis {
 
 struct PreparedBoundary::Impl {
   std::vector<detail::NearEdge> edges;  // every edge of the reference, boxes grown by half the tolerance, ring order
-  detail::EdgeIndex index;               // of edges
-  Box box;                      // the reference's contact box
-  Box bounds;                   // the reference's bounds
+  detail::EdgeIndex index;              // of edges
+  Box box;                              // the reference's contact box
+  Box bounds;                           // the reference's bounds
   double tolerance = 0;
 };
 

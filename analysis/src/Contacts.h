@@ -13,9 +13,9 @@
 namespace parcelscope::analysis::detail {
 
 struct Contact {
-  int a = -1, b = -1;   ///< polygon indices, a < b
-  double shared = 0;    ///< m of boundary running along each other (see sharedBoundaryLength)
-  bool close = false;   ///< some pair of edges lies within the tolerance
+  int a = -1, b = -1;  ///< polygon indices, a < b
+  double shared = 0;   ///< m of boundary running along each other (see sharedBoundaryLength)
+  bool close = false;  ///< some pair of edges lies within the tolerance
 };
 
 /// The bounds of all of `polygon`'s rings grown by half of `tolerance`: two
@@ -53,8 +53,8 @@ std::vector<double> lengthAlong(const std::vector<const Polygon*>& polygons, con
 
 /// The part of edge [p, q] (as an interval of distances from p) covered by edge
 /// [r, s] lying parallel to it within `tolerance`; false when none is.
-bool coveredInterval(const Point& p, const Point& q, const Point& r, const Point& s, double tolerance,
-                     double& lo, double& hi);
+bool coveredInterval(const Point& p, const Point& q, const Point& r, const Point& s, double tolerance, double& lo,
+                     double& hi);
 
 /// Length of the union of intervals (sorted in place).
 double unionLength(std::vector<std::pair<double, double>>& intervals);

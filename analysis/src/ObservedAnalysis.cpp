@@ -8,8 +8,8 @@
 #include "Contacts.h"
 #include "parcelscope/analysis/Comparison.h"
 #include "parcelscope/core/Error.h"
-#include "parcelscope/core/Parallel.h"
 #include "parcelscope/core/GeosOps.h"
+#include "parcelscope/core/Parallel.h"
 
 namespace parcelscope::analysis {
 
@@ -107,8 +107,8 @@ void countNeighbours(const std::vector<detail::Contact>& contacts, std::vector<P
 
 // Frontage and street access of a block's parcels, measured on its outline.
 // Returns how many have street access.
-int measureFrontage(const Block& block, const std::vector<const Polygon*>& shapes, double tolerance,
-                    double minFrontage, std::vector<ParcelMetrics>& metrics) {
+int measureFrontage(const Block& block, const std::vector<const Polygon*>& shapes, double tolerance, double minFrontage,
+                    std::vector<ParcelMetrics>& metrics) {
   std::vector<const Polygon*> members;
   for (int i : block.parcels) members.push_back(shapes[i]);
   std::vector<Ring> outline;
@@ -131,8 +131,7 @@ constexpr double kNetworkWidthRatio = 6.0;
 
 }  // namespace
 
-BlockStatistics blockStatistics(const std::vector<double>& areas, const std::vector<double>& widths,
-                                double k) {
+BlockStatistics blockStatistics(const std::vector<double>& areas, const std::vector<double>& widths, double k) {
   BlockStatistics s;
   s.parcelCount = static_cast<int>(areas.size());
   s.meanArea = mean(areas);
@@ -335,9 +334,7 @@ void rederiveBlockBounds(ObservedAnalysis& a, double k) {
 
 std::vector<ParcelMetrics> measureShapes(const std::vector<Polygon>& shapes) {
   std::vector<ParcelMetrics> metrics(shapes.size());
-  parallelFor(shapes.size(), [&](std::size_t i) {
-    static_cast<ShapeMetrics&>(metrics[i]) = shapeMetrics(shapes[i]);
-  });
+  parallelFor(shapes.size(), [&](std::size_t i) { static_cast<ShapeMetrics&>(metrics[i]) = shapeMetrics(shapes[i]); });
   return metrics;
 }
 
@@ -389,9 +386,9 @@ std::vector<Value> metricValues(const ParcelMetrics& m) {
 Table parcelTable(const std::vector<Parcel>& parcels, const ObservedAnalysis& a) {
   using T = Column::Type;
   Table t;
-  t.columns = {{"parcel_id", T::Integer, ""},  {"parcel_key", T::String, ""}, {"source_fid", T::Integer, ""},
-               {"part", T::Integer, ""},       {"block_id", T::Integer, ""},   {"block_key", T::String, ""},
-               {"role", T::String, ""},        {"stack_count", T::Integer, ""}, {"repaired", T::Integer, ""}};
+  t.columns = {{"parcel_id", T::Integer, ""}, {"parcel_key", T::String, ""},   {"source_fid", T::Integer, ""},
+               {"part", T::Integer, ""},      {"block_id", T::Integer, ""},    {"block_key", T::String, ""},
+               {"role", T::String, ""},       {"stack_count", T::Integer, ""}, {"repaired", T::Integer, ""}};
   for (Column& c : metricColumns()) t.columns.push_back(std::move(c));
   static const char* roles[] = {"lot", "right_of_way_holes", "right_of_way_network"};
   for (std::size_t i = 0; i < parcels.size(); ++i) {
@@ -414,21 +411,20 @@ Table parcelTable(const std::vector<Parcel>& parcels, const ObservedAnalysis& a)
 Table blockTable(const ObservedAnalysis& a) {
   using T = Column::Type;
   Table t;
-  t.columns = {{"block_id", T::Integer, ""},       {"block_key", T::String, ""},
-               {"parcel_count", T::Integer, ""},
-               {"block_area", T::Real, "m2"},      {"parts", T::Integer, ""},
-               {"mean_area", T::Real, "m2"},       {"sd_area", T::Real, "m2"},
-               {"mean_width", T::Real, "m"},       {"sd_width", T::Real, "m"},
-               {"a_min", T::Real, "m2"},           {"a_max", T::Real, "m2"},
-               {"w_min", T::Real, "m"},            {"w_max", T::Real, "m"},
-               {"a_min_clamped", T::Integer, ""},  {"w_min_clamped", T::Integer, ""},
-               {"street_access_share", T::Real, ""}};
+  t.columns = {{"block_id", T::Integer, ""},      {"block_key", T::String, ""},
+               {"parcel_count", T::Integer, ""},  {"block_area", T::Real, "m2"},
+               {"parts", T::Integer, ""},         {"mean_area", T::Real, "m2"},
+               {"sd_area", T::Real, "m2"},        {"mean_width", T::Real, "m"},
+               {"sd_width", T::Real, "m"},        {"a_min", T::Real, "m2"},
+               {"a_max", T::Real, "m2"},          {"w_min", T::Real, "m"},
+               {"w_max", T::Real, "m"},           {"a_min_clamped", T::Integer, ""},
+               {"w_min_clamped", T::Integer, ""}, {"street_access_share", T::Real, ""}};
   for (std::size_t b = 0; b < a.blocks.size(); ++b) {
     const BlockStatistics& s = a.statistics[b];
     t.rows.push_back({std::int64_t(s.blockId), keyText(a.blocks[b].key), std::int64_t(s.parcelCount), s.blockArea,
-                      std::int64_t(a.blocks[b].parts.size()), s.meanArea, s.sdArea, s.meanWidth, s.sdWidth,
-                      s.aMin, s.aMax, s.wMin, s.wMax, std::int64_t(s.aMinClamped),
-                      std::int64_t(s.wMinClamped), s.streetAccessShare});
+                      std::int64_t(a.blocks[b].parts.size()), s.meanArea, s.sdArea, s.meanWidth, s.sdWidth, s.aMin,
+                      s.aMax, s.wMin, s.wMax, std::int64_t(s.aMinClamped), std::int64_t(s.wMinClamped),
+                      s.streetAccessShare});
   }
   return t;
 }

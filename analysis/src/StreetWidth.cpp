@@ -55,7 +55,7 @@ double rayHit(const Point& o, const Point& d, const Segment& s) {
   const double denom = d.x * ey - d.y * ex;
   if (std::fabs(denom) < 1e-12 * norm(ex, ey)) return std::numeric_limits<double>::infinity();
   const double wx = s.a.x - o.x, wy = s.a.y - o.y;
-  const double t = (wx * ey - wy * ex) / denom;  // along the ray
+  const double t = (wx * ey - wy * ex) / denom;    // along the ray
   const double u = (wx * d.y - wy * d.x) / denom;  // along the segment
   if (t <= 0 || u < 0 || u > 1) return std::numeric_limits<double>::infinity();
   return t;
@@ -63,8 +63,7 @@ double rayHit(const Point& o, const Point& d, const Segment& s) {
 
 }  // namespace
 
-std::vector<std::vector<std::vector<double>>> streetWidths(const std::vector<const Polygon*>& blocks,
-                                                           double maxWidth) {
+std::vector<std::vector<std::vector<double>>> streetWidths(const std::vector<const Polygon*>& blocks, double maxWidth) {
   std::vector<Segment> segments;
   auto rings = [](const Polygon& p) {
     std::vector<const Ring*> r{&p.outer};
@@ -91,15 +90,14 @@ std::vector<std::vector<std::vector<double>>> streetWidths(const std::vector<con
         const Point o{0.5 * (a.x + c.x), 0.5 * (a.y + c.y)};
         const Point e{o.x + d.x * maxWidth, o.y + d.y * maxWidth};
         double best = std::numeric_limits<double>::infinity();
-        grid.forCells(std::min(o.x, e.x), std::min(o.y, e.y), std::max(o.x, e.x), std::max(o.y, e.y),
-                      [&](long long k) {
-                        const auto* cell = grid.cell(k);
-                        if (!cell) return;
-                        for (std::size_t s : *cell) {
-                          if (grid.segment(s).block == b) continue;
-                          best = std::min(best, rayHit(o, d, grid.segment(s)));
-                        }
-                      });
+        grid.forCells(std::min(o.x, e.x), std::min(o.y, e.y), std::max(o.x, e.x), std::max(o.y, e.y), [&](long long k) {
+          const auto* cell = grid.cell(k);
+          if (!cell) return;
+          for (std::size_t s : *cell) {
+            if (grid.segment(s).block == b) continue;
+            best = std::min(best, rayHit(o, d, grid.segment(s)));
+          }
+        });
         if (best <= maxWidth) widths[i] = best;
       }
       out[b].push_back(std::move(widths));

@@ -43,8 +43,8 @@ std::vector<Edge> splitAtVertices(const std::vector<Edge>& edges, double snap) {
     const double dx = e.b.x - e.a.x, dy = e.b.y - e.a.y;
     const double length2 = dx * dx + dy * dy;
     inner.clear();
-    auto it = std::lower_bound(vertices.begin(), vertices.end(), minX,
-                               [](const Point& p, double x) { return p.x < x; });
+    auto it =
+        std::lower_bound(vertices.begin(), vertices.end(), minX, [](const Point& p, double x) { return p.x < x; });
     for (; it != vertices.end() && it->x <= maxX; ++it) {
       const Point& v = *it;
       if (v.y < minY || v.y > maxY || same(v, e.a) || same(v, e.b)) continue;
@@ -124,16 +124,15 @@ void splitAtRepeats(const Ring& ring, const std::vector<char>& pinch, std::vecto
 // valid polygon's rings may, instead of running through it. Nothing when two
 // edges would continue with the same edge.
 std::optional<std::vector<Ring>> chainRings(std::vector<Edge> edges) {
-  std::sort(edges.begin(), edges.end(), [](const Edge& p, const Edge& q) {
-    return before(p.a, q.a) || (same(p.a, q.a) && before(p.b, q.b));
-  });
+  std::sort(edges.begin(), edges.end(),
+            [](const Edge& p, const Edge& q) { return before(p.a, q.a) || (same(p.a, q.a) && before(p.b, q.b)); });
   const std::size_t n = edges.size();
   std::vector<std::size_t> next(n);
   std::vector<char> taken(n, 0), pinch(n, 0);
   for (std::size_t e = 0; e < n; ++e) {
     const Point& v = edges[e].b;
-    auto first = std::lower_bound(edges.begin(), edges.end(), v,
-                                  [](const Edge& x, const Point& p) { return before(x.a, p); });
+    auto first =
+        std::lower_bound(edges.begin(), edges.end(), v, [](const Edge& x, const Point& p) { return before(x.a, p); });
     if (first == edges.end() || !same(first->a, v)) return std::nullopt;
     auto last = first + 1;
     while (last != edges.end() && same(last->a, v)) ++last;

@@ -48,8 +48,8 @@ double perimeter(const Polygon& polygon) {
 }
 
 Box bounds(const Ring& ring) {
-  Box b{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
-        std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest()};
+  Box b{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(), std::numeric_limits<double>::lowest(),
+        std::numeric_limits<double>::lowest()};
   for (const auto& p : ring) {
     b.minX = std::min(b.minX, p.x);
     b.minY = std::min(b.minY, p.y);
@@ -183,8 +183,7 @@ double cross(const Point& o, const Point& a, const Point& b) {
 bool segmentsCross(const Point& a, const Point& b, const Point& c, const Point& d) {
   const double d1 = cross(c, d, a), d2 = cross(c, d, b);
   const double d3 = cross(a, b, c), d4 = cross(a, b, d);
-  return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0)) && d1 != 0 && d2 != 0 && d3 != 0 &&
-         d4 != 0;
+  return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0)) && d1 != 0 && d2 != 0 && d3 != 0 && d4 != 0;
 }
 
 }  // namespace
@@ -279,9 +278,9 @@ void convexHullInto(const std::vector<Point>& points, Ring& hull) {
   pts.assign(points.begin(), points.end());
   std::sort(pts.begin(), pts.end(),
             [](const Point& a, const Point& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
-  pts.erase(std::unique(pts.begin(), pts.end(),
-                        [](const Point& a, const Point& b) { return a.x == b.x && a.y == b.y; }),
-            pts.end());
+  pts.erase(
+      std::unique(pts.begin(), pts.end(), [](const Point& a, const Point& b) { return a.x == b.x && a.y == b.y; }),
+      pts.end());
   if (pts.size() < 3) {
     hull.assign(pts.begin(), pts.end());
     return;

@@ -56,8 +56,7 @@ GEOSGeometry* ringToGeos(GEOSContextHandle_t ctx, const Ring& ring) {
     xy.push_back(ring.front().x);
     xy.push_back(ring.front().y);
   }
-  GEOSCoordSequence* seq =
-      GEOSCoordSeq_copyFromBuffer_r(ctx, xy.data(), static_cast<unsigned>(xy.size() / 2), 0, 0);
+  GEOSCoordSequence* seq = GEOSCoordSeq_copyFromBuffer_r(ctx, xy.data(), static_cast<unsigned>(xy.size() / 2), 0, 0);
   return seq ? GEOSGeom_createLinearRing_r(ctx, seq) : nullptr;  // takes the sequence, even on failure
 }
 
@@ -190,7 +189,8 @@ std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, 
     // Gaps or holes: close them where narrower than the tolerance. Buffering
     // out unions the parts; buffering back in restores the outline. Mitred
     // joins give corners back exactly (round joins would cut them).
-    if (Geom grown = mitreBuffer(result.get(), 0.5 * closeDistance)) result = mitreBuffer(grown.get(), -0.5 * closeDistance);
+    if (Geom grown = mitreBuffer(result.get(), 0.5 * closeDistance))
+      result = mitreBuffer(grown.get(), -0.5 * closeDistance);
   }
   if (!result) throw geometryError("union of " + std::to_string(polygons.size()) + " parcels failed");
   // Parts smaller than half a tolerance square are artefacts of the closing.

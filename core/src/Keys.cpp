@@ -21,9 +21,7 @@ Key mixKeys(Key a, Key b) {
   return x ^ (x >> 31);
 }
 
-Key partKey(Key feature, int part) {
-  return part == 0 ? feature : mixKeys(feature, static_cast<Key>(part));
-}
+Key partKey(Key feature, int part) { return part == 0 ? feature : mixKeys(feature, static_cast<Key>(part)); }
 
 Key setKey(std::vector<Key> keys) {
   if (keys.empty()) return 0;

@@ -53,13 +53,13 @@ std::string labelList(const ParameterDescription& d) {
 }  // namespace
 
 bool operator==(const ParameterDescription& a, const ParameterDescription& b) {
-  return a.name == b.name && a.help == b.help && a.unit == b.unit && a.minimum == b.minimum &&
-         a.maximum == b.maximum && a.defaultValue == b.defaultValue && a.kind == b.kind && a.group == b.group &&
-         a.labels == b.labels && a.outputOnly == b.outputOnly;
+  return a.name == b.name && a.help == b.help && a.unit == b.unit && a.minimum == b.minimum && a.maximum == b.maximum &&
+         a.defaultValue == b.defaultValue && a.kind == b.kind && a.group == b.group && a.labels == b.labels &&
+         a.outputOnly == b.outputOnly;
 }
 
-ParameterDescription realParameter(std::string name, std::string help, std::string unit, double minimum,
-                                   double maximum, double defaultValue, std::string group) {
+ParameterDescription realParameter(std::string name, std::string help, std::string unit, double minimum, double maximum,
+                                   double defaultValue, std::string group) {
   ParameterDescription d;
   d.name = std::move(name);
   d.help = std::move(help);
@@ -83,9 +83,9 @@ ParameterDescription enumParameter(std::string name, std::string help, std::vect
                                    const std::string& defaultLabel, std::string group) {
   const auto at = std::find(labels.begin(), labels.end(), defaultLabel);
   if (at == labels.end()) throw std::logic_error("parameter " + name + ": default " + defaultLabel + " is no label");
-  ParameterDescription d = realParameter(std::move(name), std::move(help), "", 0,
-                                         static_cast<double>(labels.size()) - 1,
-                                         static_cast<double>(at - labels.begin()), std::move(group));
+  ParameterDescription d =
+      realParameter(std::move(name), std::move(help), "", 0, static_cast<double>(labels.size()) - 1,
+                    static_cast<double>(at - labels.begin()), std::move(group));
   d.kind = ParameterKind::Enum;
   d.labels = std::move(labels);
   return d;

@@ -12,9 +12,7 @@ void reportProgress(const ProgressFn& progress, double fraction, const std::stri
 
 ProgressFn scaledProgress(const ProgressFn& parent, double begin, double end) {
   if (!parent) return {};
-  return [parent, begin, end](double f, const std::string& stage) {
-    return parent(begin + (end - begin) * f, stage);
-  };
+  return [parent, begin, end](double f, const std::string& stage) { return parent(begin + (end - begin) * f, stage); };
 }
 
 }  // namespace parcelscope

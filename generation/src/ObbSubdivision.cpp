@@ -6,13 +6,13 @@
 #include <limits>
 #include <memory>
 
+#include "BlockFailure.h"
 #include "LocalShift.h"
 #include "PolygonSplit.h"
 #include "Random.h"
 #include "parcelscope/analysis/Metrics.h"
 #include "parcelscope/analysis/ObservedAnalysis.h"
 #include "parcelscope/core/GeosOps.h"
-#include "BlockFailure.h"
 
 namespace parcelscope::generation {
 
@@ -20,18 +20,17 @@ const std::vector<ParameterDescription>& obbParameterDescriptions() {
   static const std::vector<ParameterDescription> d = {
       realParameter("a-min", "Smallest parcel area a split may create", "m2", 0.0, 1e8, 200.0, "Bounds"),
       realParameter("a-max", "Parcels larger than this are split", "m2", 1.0, 1e8, 800.0, "Bounds"),
-      realParameter("w-min", "Smallest parcel width (OBB short side) a split may create", "m", 0.0, 1e5, 8.0,
-                    "Bounds"),
+      realParameter("w-min", "Smallest parcel width (OBB short side) a split may create", "m", 0.0, 1e5, 8.0, "Bounds"),
       realParameter("w-max", "Parcels wider than this are split", "m", 0.1, 1e5, 30.0, "Bounds"),
       realParameter("omega",
-                    "Split irregularity: the split line moves up to omega x 1/4 of the parcel's length off centre",
-                    "", 0.0, 1.0, 0.3, "Subdivision"),
+                    "Split irregularity: the split line moves up to omega x 1/4 of the parcel's length off centre", "",
+                    0.0, 1.0, 0.3, "Subdivision"),
       realParameter("xi",
                     "Street-access preference: probability that a split leaving a parcel without street access "
                     "is replaced by one that does not",
                     "", 0.0, 1.0, 1.0, "Subdivision"),
-      realParameter("snap", "Split lines passing this close to a block contour vertex are moved through it", "m",
-                    0.0, 1000.0, 2.0, "Subdivision"),
+      realParameter("snap", "Split lines passing this close to a block contour vertex are moved through it", "m", 0.0,
+                    1000.0, 2.0, "Subdivision"),
       analysis::minFrontageParameter(),
       integerParameter("seed", "Seed of the random choices; the same seed gives the same parcels", "", 0.0,
                        4294967295.0, 1.0, "Subdivision"),
@@ -194,9 +193,8 @@ private:
   // where the clearance is 1e-6 of it.
   // `pieceSimple`: the piece has no holes and its ring is proven strictly
   // simple. `simple` receives which parts are (see judge).
-  std::vector<Polygon> admissibleSplit(const Polygon& piece, double pieceArea, const Point& through,
-                                       const Point& dir, bool pieceSimple, std::vector<double>& areas,
-                                       std::vector<char>& simple) const {
+  std::vector<Polygon> admissibleSplit(const Polygon& piece, double pieceArea, const Point& through, const Point& dir,
+                                       bool pieceSimple, std::vector<double>& areas, std::vector<char>& simple) const {
     detail::SplitPieces split;
     areas.clear();
     areas.reserve(4);
@@ -288,8 +286,8 @@ private:
         if (offLine(p) > onLine || offLine(q) > onLine) continue;  // not a cut edge
         // Edges whose boxes stay farther than the clearance from the cut
         // edge's box are farther from the edge itself.
-        const Box near = Box{std::min(p.x, q.x), std::min(p.y, q.y), std::max(p.x, q.x), std::max(p.y, q.y)}
-                             .expanded(clearance);
+        const Box near =
+            Box{std::min(p.x, q.x), std::min(p.y, q.y), std::max(p.x, q.x), std::max(p.y, q.y)}.expanded(clearance);
         for (std::size_t rj = 0; rj < rings; ++rj) {
           const Ring& t = ring(rj);
           for (std::size_t j = 0, m = t.size(); j < m; ++j) {
@@ -437,9 +435,8 @@ private:
       node->split = previous->split;
       node->children = previous->children;  // their nodes and widths, replaced below
     } else {
-      node->split = std::make_shared<const ObbSplits::Split>(
-          split(piece, a, hullOf(), simple < 0 ? blockSimple() : simple == 1, access, wantAccess, shiftAcross,
-                shiftAlong));
+      node->split = std::make_shared<const ObbSplits::Split>(split(
+          piece, a, hullOf(), simple < 0 ? blockSimple() : simple == 1, access, wantAccess, shiftAcross, shiftAlong));
     }
     const ObbSplits::Split& chosen = *node->split;
     if (chosen.parts.empty()) {
@@ -473,7 +470,7 @@ private:
   std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;  // outline_, for the access test
   bool record_ = false;
   int blockSimple_ = -1;
-  Ring hull_;  // the hull of the piece recurse() is deciding on
+  Ring hull_;                            // the hull of the piece recurse() is deciding on
   std::vector<Vertex> outlineVertices_;  // of block_.outer, by position
 };
 

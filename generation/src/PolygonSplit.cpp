@@ -249,8 +249,7 @@ bool isValidForSplit(const Polygon& polygon) {
 
 SplitPieces splitByLine(const Polygon& polygon, const Point& pivot, const Point& dir) {
   const Box b = bounds(polygon);
-  const double reach = 4.0 * (b.width() + b.height()) + 1.0 +
-                       std::fabs(pivot.x - b.minX) + std::fabs(pivot.y - b.minY);
+  const double reach = 4.0 * (b.width() + b.height()) + 1.0 + std::fabs(pivot.x - b.minX) + std::fabs(pivot.y - b.minY);
   const K::Point_2 through(pivot.x, pivot.y);
   const K::Vector_2 d(dir.x, dir.y);
   const PWH p = toExact(polygon);
@@ -327,10 +326,10 @@ bool splitRingFast(const Polygon& polygon, const Point& pivot, const Point& dir,
   // the exact split.
   struct Node {
     Point p;
-    int side = 0;      // of the vertex; 0 on the line
+    int side = 0;  // of the vertex; 0 on the line
     bool touch = false;
-    double along = 0;  // on the line (crossings and touches): position along it
-    int exit = -1;     // crossings: the other end of its cut; touches on a cut: the next stop along it
+    double along = 0;          // on the line (crossings and touches): position along it
+    int exit = -1;             // crossings: the other end of its cut; touches on a cut: the next stop along it
     std::vector<int> through;  // the touches from the other side passed on the way to `exit`
   };
   thread_local std::vector<Node> nodes;
@@ -352,8 +351,8 @@ bool splitRingFast(const Polygon& polygon, const Point& pivot, const Point& dir,
     const Point& from = forward ? a : b;
     const Point& to = forward ? b : a;
     const double dx = to.x - from.x, dy = to.y - from.y;
-    const double t = std::clamp(((pivot.x - from.x) * dir.y - (pivot.y - from.y) * dir.x) / (dx * dir.y - dy * dir.x),
-                                0.0, 1.0);
+    const double t =
+        std::clamp(((pivot.x - from.x) * dir.y - (pivot.y - from.y) * dir.x) / (dx * dir.y - dy * dir.x), 0.0, 1.0);
     Node crossing;
     crossing.p = t == 1.0 ? to : Point{from.x + dx * t, from.y + dy * t};
     crossing.side = 0;

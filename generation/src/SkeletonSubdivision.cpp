@@ -10,19 +10,19 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <memory>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <unordered_map>
 
+#include "BlockFailure.h"
 #include "Exact.h"
 #include "LocalShift.h"
 #include "PolygonSplit.h"
+#include "PostProcess.h"
 #include "Random.h"
 #include "parcelscope/analysis/Metrics.h"
 #include "parcelscope/core/GeosOps.h"
-#include "BlockFailure.h"
-#include "PostProcess.h"
 
 namespace parcelscope::generation {
 
@@ -32,8 +32,8 @@ const std::vector<ParameterDescription>& skeletonParameterDescriptions() {
                     "d_offset: depth of the parcel strips from the street; a patio fills what lies deeper. 0: no "
                     "patio, parcels reach the skeleton's centre line (style offset: 0 means 30 m)",
                     "m", 0.0, 1e5, 0.0, "Skeleton"),
-      realParameter("street-angle", "Contour corners turning by less than this continue the same logical street",
-                    "deg", 0.0, 180.0, 30.0, "Skeleton"),
+      realParameter("street-angle", "Contour corners turning by less than this continue the same logical street", "deg",
+                    0.0, 180.0, 30.0, "Skeleton"),
       enumParameter("corner-rule",
                     "Which street a corner parcel faces: street-width, the wider one (the longer one when "
                     "widths are equal or unknown); street-length, the longer one",
@@ -204,7 +204,7 @@ struct Face {
 };
 
 struct Strip {
-  std::vector<int> edges;  // contour edges in order along the ring
+  std::vector<int> edges;     // contour edges in order along the ring
   double start = 0, end = 0;  // the part of the street chain that keeps its own parcels (m along it)
   double length = 0;
 };
@@ -269,8 +269,8 @@ void dropMicroFeatures(Polygon& p, double eps) {
 
 class SkeletonBuilder {
 public:
-  SkeletonBuilder(const Polygon& block, const SkeletonParameters& p, const detail::Rng& rng,
-                  const StreetWidths& widths, double chordTolerance)
+  SkeletonBuilder(const Polygon& block, const SkeletonParameters& p, const detail::Rng& rng, const StreetWidths& widths,
+                  double chordTolerance)
       : block_(block), outline_{block.outer, {}}, p_(p), rng_(rng), widths_(widths), chordTolerance_(chordTolerance) {
     const Box b = bounds(block);
     size_ = b.width() + b.height();
@@ -294,8 +294,8 @@ public:
       buildEdges();
       buildSkeleton();
       if (record) {
-        memo.skeleton = std::make_shared<const SkeletonStage>(
-            SkeletonStage{edges_, ringStart_, vertices_, faces_, maxTime_});
+        memo.skeleton =
+            std::make_shared<const SkeletonStage>(SkeletonStage{edges_, ringStart_, vertices_, faces_, maxTime_});
       }
     }
     const double depth = maxTime_;
@@ -361,8 +361,8 @@ private:
           e.chain.push_back(ring[i]);
           if (i == to) break;
           const double len = norm(ring[(i + 1) % n].x - ring[i].x, ring[(i + 1) % n].y - ring[i].y);
-          const double w = r < widths.size() && i < widths[r].size() ? widths[r][i]
-                                                                      : std::numeric_limits<double>::quiet_NaN();
+          const double w =
+              r < widths.size() && i < widths[r].size() ? widths[r][i] : std::numeric_limits<double>::quiet_NaN();
           widthSum += w * len;
           lengthSum += len;
         }
@@ -443,7 +443,8 @@ private:
     maker.enter_contour(outer.begin(), outer.end());
     for (const auto& hole : holes) maker.enter_contour(hole.vertices_begin(), hole.vertices_end());
     const auto ss = maker.construct_skeleton();
-    if (!ss) throw Fallback(guard.broken ? "the straight skeleton came out broken" : "no straight skeleton could be built");
+    if (!ss)
+      throw Fallback(guard.broken ? "the straight skeleton came out broken" : "no straight skeleton could be built");
 
     std::unordered_map<const void*, int> vertexIndex;
     auto vertexOf = [&](auto v) {
@@ -466,8 +467,7 @@ private:
       const auto h = f->halfedge();
       const auto a = h->opposite()->vertex()->point(), b = h->vertex()->point();
       auto it = edgeByStart.find({a.x(), a.y()});
-      if (it == edgeByStart.end() || input[nextEdge(it->second)].x != b.x() ||
-          input[nextEdge(it->second)].y != b.y()) {
+      if (it == edgeByStart.end() || input[nextEdge(it->second)].x != b.x() || input[nextEdge(it->second)].y != b.y()) {
         throw Fallback("a skeleton face does not match a contour edge");
       }
       if (!edgeOfFace.emplace(&*f, it->second).second) throw Fallback("two skeleton faces on one edge");
@@ -500,7 +500,8 @@ private:
     std::vector<std::pair<Point, double>> out;
     const auto& chain = edges_[g].chain;
     for (std::size_t i = 0; i + 1 < chain.size(); ++i) out.push_back({chain[i], 0.0});
-    for (std::size_t k = 1; k < f.vertices.size(); ++k) out.push_back({vertices_[f.vertices[k]].p, vertices_[f.vertices[k]].time});
+    for (std::size_t k = 1; k < f.vertices.size(); ++k)
+      out.push_back({vertices_[f.vertices[k]].p, vertices_[f.vertices[k]].time});
     return out;
   }
 
@@ -878,9 +879,7 @@ private:
   }
 
   // ---- 5. post-processing -----------------------------------------------------
-  bool hasAccess(const Polygon& piece) const {
-    return outlineEdges_->sharesAtLeast(piece, p_.bounds.minFrontage);
-  }
+  bool hasAccess(const Polygon& piece) const { return outlineEdges_->sharesAtLeast(piece, p_.bounds.minFrontage); }
 
   bool rounded(const PWH& exactShape, Polygon& out) const {
     if (!detail::toDouble(exactShape, out)) return false;
@@ -1188,7 +1187,7 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
         std::size_t vertices = local.outer.size();
         for (const Ring& h : local.holes) vertices += h.size();
         const bool last = attempt + 2 == std::size(kChordTolerances) ? vertices > kMaxFullVertices
-                                                                      : attempt + 1 == std::size(kChordTolerances);
+                                                                     : attempt + 1 == std::size(kChordTolerances);
         if (last) throw;
       }
     }

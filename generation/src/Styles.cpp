@@ -76,7 +76,7 @@ public:
   bool usesStreetWidths() const override { return true; }
   const Style& resolve(const BlockFacts& facts) const override {
     return std::isfinite(facts.accessShare) && facts.accessShare < kAutoSkeletonAccessShare ? obbStyle()
-                                                                                             : skeletonStyle();
+                                                                                            : skeletonStyle();
   }
   Subdivision run(const StyleRun&) const override {
     throw usageError("style auto chooses a style per block; it does not subdivide by itself");

@@ -438,8 +438,8 @@ StagedFile::StagedFile(std::string target, const std::vector<std::string>& input
   const fs::path t(target_);
   const fs::path folder = t.parent_path().empty() ? fs::path(".") : t.parent_path();
   if (!fs::is_directory(folder, ec)) throw ioError(target_ + ": folder " + folder.string() + " does not exist");
-  staging_ = (folder / ("." + t.stem().string() + ".partial-" + std::to_string(::getpid()) + t.extension().string()))
-                 .string();
+  staging_ =
+      (folder / ("." + t.stem().string() + ".partial-" + std::to_string(::getpid()) + t.extension().string())).string();
   fs::remove(staging_, ec);
 }
 

@@ -164,16 +164,14 @@ std::string fmt(double v) {
 }
 
 // Chooses the local frame and records the CRS, or throws when the CRS cannot be used.
-LocalFrame chooseFrame(const std::string& path, const OGRSpatialReference* srs, Envelope& env,
-                       CrsInfo& crs) {
+LocalFrame chooseFrame(const std::string& path, const OGRSpatialReference* srs, Envelope& env, CrsInfo& crs) {
   const Point c = env.centre();
   const double cx = c.x, cy = c.y;
   const std::string hint = "; give the real CRS with --crs EPSG:N";
   if (!srs) {
     if (!env.looksLikeDegrees()) {
-      throw inputError(path + ": the layer declares no CRS and its coordinates (x " + fmt(env.minX) +
-                       " to " + fmt(env.maxX) + ", y " + fmt(env.minY) + " to " + fmt(env.maxY) +
-                       ") are not degrees" + hint);
+      throw inputError(path + ": the layer declares no CRS and its coordinates (x " + fmt(env.minX) + " to " +
+                       fmt(env.maxX) + ", y " + fmt(env.minY) + " to " + fmt(env.maxY) + ") are not degrees" + hint);
     }
     crs.assumedLonLat = true;
     crs.name = "assumed OGC:CRS84 (no CRS declared)";
@@ -189,9 +187,9 @@ LocalFrame chooseFrame(const std::string& path, const OGRSpatialReference* srs, 
     const double degreesPerUnit = srs->GetAngularUnits() * 180.0 / M_PI;  // 0.9 for grads
     if (!(degreesPerUnit > 0)) throw inputError(path + ": CRS " + crs.name + " has no usable angular unit");
     if (!env.looksLikeDegrees(degreesPerUnit)) {
-      throw inputError(path + ": the layer claims lon/lat (" + crs.name + ") but its coordinates (x " +
-                       fmt(env.minX) + " to " + fmt(env.maxX) + ", y " + fmt(env.minY) + " to " +
-                       fmt(env.maxY) + ") cannot be degrees" + hint);
+      throw inputError(path + ": the layer claims lon/lat (" + crs.name + ") but its coordinates (x " + fmt(env.minX) +
+                       " to " + fmt(env.maxX) + ", y " + fmt(env.minY) + " to " + fmt(env.maxY) +
+                       ") cannot be degrees" + hint);
     }
     OGRErr err = OGRERR_NONE;
     const double a = srs->GetSemiMajor(&err);
@@ -204,8 +202,8 @@ LocalFrame chooseFrame(const std::string& path, const OGRSpatialReference* srs, 
     if (!(unit > 0)) throw inputError(path + ": CRS " + crs.name + " has no usable linear unit");
     return LocalFrame::projected(unit, cx, cy);
   }
-  throw inputError(path + ": CRS " + crs.name +
-                   " is neither geographic nor projected, so parcels cannot be measured" + hint);
+  throw inputError(path + ": CRS " + crs.name + " is neither geographic nor projected, so parcels cannot be measured" +
+                   hint);
 }
 
 // Projects every vertex of `g` to the local frame, in place.
@@ -336,8 +334,8 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
   if (!options.where.empty()) {
     CPLErrorReset();
     if (layer->SetAttributeFilter(options.where.c_str()) != OGRERR_NONE) {
-      throw inputError(path + ": --where \"" + options.where + "\" is not a valid filter on layer " +
-                       result.layerName + " (" + lastGdalMessage() + ")");
+      throw inputError(path + ": --where \"" + options.where + "\" is not a valid filter on layer " + result.layerName +
+                       " (" + lastGdalMessage() + ")");
     }
   }
 
@@ -347,8 +345,8 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
   if (!options.crsOverride.empty()) {
     CPLErrorReset();
     if (overrideSrs.SetFromUserInput(options.crsOverride.c_str()) != OGRERR_NONE) {
-      throw usageError(path + ": --crs " + options.crsOverride + " is not a CRS GDAL knows (" +
-                       lastGdalMessage() + ")");
+      throw usageError(path + ": --crs " + options.crsOverride + " is not a CRS GDAL knows (" + lastGdalMessage() +
+                       ")");
     }
     overrideSrs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
     srs = &overrideSrs;
@@ -405,8 +403,7 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
     throwIfReadFailed();
     ++report.features;
     if (report.features % 2000 == 0 && total > 0) {
-      reportProgress(progress, 0.6 * static_cast<double>(report.features) / static_cast<double>(total),
-                     "reading");
+      reportProgress(progress, 0.6 * static_cast<double>(report.features) / static_cast<double>(total), "reading");
     }
     OGRGeometry* g = feature->GetGeometryRef();
     if (!g || g->IsEmpty()) {
@@ -440,12 +437,12 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
     std::vector<double> values;
     for (int idx : fieldIndex) {
       values.push_back(idx >= 0 && feature->IsFieldSetAndNotNull(idx) ? feature->GetFieldAsDouble(idx)
-                                                                    : std::numeric_limits<double>::quiet_NaN());
+                                                                      : std::numeric_limits<double>::quiet_NaN());
     }
     byHash.emplace(hash, features.size());
     const Key key = featureKey(*feature, wkb);
-    features.push_back({feature->GetFID(), std::unique_ptr<OGRGeometry>(feature->StealGeometry()), 1,
-                        std::move(values), key});
+    features.push_back(
+        {feature->GetFID(), std::unique_ptr<OGRGeometry>(feature->StealGeometry()), 1, std::move(values), key});
   }
   throwIfReadFailed();
   const std::string featuresRead =

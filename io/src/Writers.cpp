@@ -90,12 +90,17 @@ Json fromCpl(const CPLJSONObject& o) {
       for (int i = 0; i < a.Size(); ++i) j.push(fromCpl(a[i]));
       return j;
     }
-    case CPLJSONObject::Type::Boolean: return Json(o.ToBool());
-    case CPLJSONObject::Type::String: return Json(o.ToString());
+    case CPLJSONObject::Type::Boolean:
+      return Json(o.ToBool());
+    case CPLJSONObject::Type::String:
+      return Json(o.ToString());
     case CPLJSONObject::Type::Integer:
-    case CPLJSONObject::Type::Long: return Json(static_cast<long long>(o.ToLong()));
-    case CPLJSONObject::Type::Double: return Json(o.ToDouble());
-    default: return Json();
+    case CPLJSONObject::Type::Long:
+      return Json(static_cast<long long>(o.ToLong()));
+    case CPLJSONObject::Type::Double:
+      return Json(o.ToDouble());
+    default:
+      return Json();
   }
 }
 }  // namespace

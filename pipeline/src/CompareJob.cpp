@@ -12,13 +12,13 @@
 #include <numeric>
 #include <optional>
 
+#include "CompareStages.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
 #include "parcelscope/io/FileHash.h"
 #include "parcelscope/io/OutputDirectory.h"
 #include "parcelscope/io/Writers.h"
 #include "parcelscope/pipeline/CompareSession.h"
-#include "CompareStages.h"
 
 namespace parcelscope::pipeline {
 
@@ -27,16 +27,16 @@ using analysis::ParcelMetrics;
 
 const std::vector<ParameterDescription>& comparisonParameters() {
   static const std::vector<ParameterDescription> d = {
-      integerParameter("bins", "Shared bins of the histograms, in the figures and in the histogram intersection",
-                       "", 2, 500, 30, "Comparison"),
+      integerParameter("bins", "Shared bins of the histograms, in the figures and in the histogram intersection", "", 2,
+                       500, 30, "Comparison"),
       realParameter("histogram-quantile",
                     "The bins run from the smallest value to this quantile of both sets pooled; larger values "
                     "count in the last bin",
                     "", 0.5, 1.0, 0.99, "Comparison"),
-      realParameter("map-aspect-ratio-max", "Aspect ratio drawn fully green in map_aspect_ratio (1:1 is red)", "",
-                    1.5, 100, 5, "Figures"),
-      outputOnly(booleanParameter("figures", "Render the figures (needs an X server); no: tables and layers only",
-                                  true, "Figures")),
+      realParameter("map-aspect-ratio-max", "Aspect ratio drawn fully green in map_aspect_ratio (1:1 is red)", "", 1.5,
+                    100, 5, "Figures"),
+      outputOnly(booleanParameter("figures", "Render the figures (needs an X server); no: tables and layers only", true,
+                                  "Figures")),
       outputOnly(booleanParameter("spatial-index",
                                   "Give the GeoPackage layers an R-tree spatial index (GIS tools draw large layers "
                                   "faster); no: written faster without one",
@@ -101,7 +101,8 @@ pipeline::GenerateRequest generateRequest(const CompareRequest& request, const p
 
 void requireBlocks(const CompareRequest& request, const pipeline::ObservedData& observed) {
   if (observed.analysis.blocks.empty()) {
-    throw inputError(request.input.path + ": no block to compare (no parcel is left once right-of-way parcels "
+    throw inputError(request.input.path +
+                     ": no block to compare (no parcel is left once right-of-way parcels "
                      "are set aside)");
   }
 }
@@ -116,7 +117,8 @@ void checkRequest(const CompareRequest& request) {
     throw usageError("--vector " + request.vectorFormat + ": the histograms' vector copy is svg or pdf");
   }
   if (request.parcelsFormat != "gpkg" && request.parcelsFormat != "geojson") {
-    throw usageError("--parcels-format " + request.parcelsFormat + ": generated parcels are written as gpkg or geojson");
+    throw usageError("--parcels-format " + request.parcelsFormat +
+                     ": generated parcels are written as gpkg or geojson");
   }
 }
 
@@ -228,8 +230,8 @@ CompareResult compare(const CompareRequest& request, const ProgressFn& progress)
       pipeline::loadObserved(request.input, request.parameters, scaledProgress(progress, 0.0, 0.45)));
   const analysis::ObservedAnalysis& a = r.observed->analysis;
   detail::requireBlocks(request, *r.observed);
-  r.generated = pipeline::generate(detail::generateRequest(request, r.observed.get()),
-                                     scaledProgress(progress, 0.45, 0.9));
+  r.generated =
+      pipeline::generate(detail::generateRequest(request, r.observed.get()), scaledProgress(progress, 0.45, 0.9));
 
   // Both sets measured with the same metrics; compared block by block, in parallel.
   reportProgress(progress, 0.9, "comparing");
@@ -342,9 +344,8 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
   reportProgress(progress, 0.8, "writing");
   const auto writeStart = std::chrono::steady_clock::now();
   const std::string parcelsFile = "parcels." + request.parcelsFormat;
-  std::vector<std::string> outputs = {parcelsFile,             "blocks.gpkg", "observed_parcels.csv",
-                                      "generated_parcels.csv", "blocks.csv",  "summary.csv",
-                                      "distances.csv"};
+  std::vector<std::string> outputs = {parcelsFile,  "blocks.gpkg", "observed_parcels.csv", "generated_parcels.csv",
+                                      "blocks.csv", "summary.csv", "distances.csv"};
   // The two layers (SQLite inserts, one thread each) are written while this
   // thread formats and writes the tables.
   const Table blocks = analysis::blockComparisonTable(r.blocks);
@@ -375,8 +376,8 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
   if (figures) {
     reportProgress(progress, 0.85, "figures");
     const auto figureStart = std::chrono::steady_clock::now();
-    const auto written = renderer->draw(r, request, [&](const std::string& name) { return out.stage(name); },
-                                        scaledProgress(progress, 0.85, 0.95));
+    const auto written = renderer->draw(
+        r, request, [&](const std::string& name) { return out.stage(name); }, scaledProgress(progress, 0.85, 0.95));
     outputs.insert(outputs.end(), written.begin(), written.end());
     figureSeconds = secondsSince(figureStart);
   }
@@ -417,15 +418,16 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
   addObservedRecord(run, *r.observed);
   std::error_code ec;
   const bool regular = std::filesystem::is_regular_file(request.input.path, ec);
-  run.set("input_file", Json::object()
-                            .set("path", request.input.path)
-                            .set("layer", request.input.layer)
-                            .set("where", request.input.where)
-                            .set("crs_override", request.input.crsOverride)
-                            .set("bytes", regular ? Json(static_cast<std::int64_t>(
-                                                        std::filesystem::file_size(request.input.path, ec)))
-                                                  : Json())
-                            .set("sha256", regular ? Json(io::sha256File(request.input.path)) : Json()));
+  run.set(
+      "input_file",
+      Json::object()
+          .set("path", request.input.path)
+          .set("layer", request.input.layer)
+          .set("where", request.input.where)
+          .set("crs_override", request.input.crsOverride)
+          .set("bytes",
+               regular ? Json(static_cast<std::int64_t>(std::filesystem::file_size(request.input.path, ec))) : Json())
+          .set("sha256", regular ? Json(io::sha256File(request.input.path)) : Json()));
   Json failures = Json::array();
   for (const auto& f : r.generated.failures) failures.push(f);
   run.set("generated", Json::object()

@@ -109,7 +109,8 @@ void carryOver(const pipeline::BlockInputs& oldInputs, const std::vector<pipelin
     if (!oldOutcomes[j] || oldPlans[j] != plans[k] || !sameShape(oldInputs.entries[j].shape, e.shape)) continue;
     if (generation::style(plans[k].style).usesStreetWidths()) {
       const bool widths = inputs.widths.size() == inputs.entries.size() &&
-                          oldInputs.widths.size() == oldInputs.entries.size() && sameWidths(inputs.widths[k], oldInputs.widths[j]);
+                          oldInputs.widths.size() == oldInputs.entries.size() &&
+                          sameWidths(inputs.widths[k], oldInputs.widths[j]);
       if (!widths) continue;
     }
     outcomes[k] = oldOutcomes[j];
@@ -212,9 +213,8 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   // The first result in between comes after half the interval, so that a long
   // edit shows something soon (and a short one is not slowed by drawing one);
   // then one per interval.
-  auto lastPartial = std::chrono::steady_clock::now() -
-                     std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                         std::chrono::duration<double>(0.5 * partialSeconds));
+  auto lastPartial = std::chrono::steady_clock::now() - std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                            std::chrono::duration<double>(0.5 * partialSeconds));
   std::size_t partialDone = 0;
   auto emitPartial = [&] {
     std::vector<const pipeline::BlockOutcome*> pointers;

@@ -33,8 +33,8 @@ void checkStyle(const std::string& style, bool allowAuto, const std::string& whe
     names += (names.empty() ? "" : ", ") + name;
   }
   if (!known) {
-    throw usageError((where.empty() ? "--style " : where + ": style ") + style + " is not available (styles: " +
-                     names + ")");
+    throw usageError((where.empty() ? "--style " : where + ": style ") + style + " is not available (styles: " + names +
+                     ")");
   }
 }
 
@@ -211,8 +211,8 @@ Block entryBlock(const BlockInputs& inputs, std::size_t entry, std::size_t parce
   return block;
 }
 
-std::vector<analysis::ParcelMetrics> measureEntry(const BlockInputs& inputs, std::size_t entry,
-                                                  const Subdivision& s, double minFrontage) {
+std::vector<analysis::ParcelMetrics> measureEntry(const BlockInputs& inputs, std::size_t entry, const Subdivision& s,
+                                                  double minFrontage) {
   return analysis::measureParcels(s.parcels, {entryBlock(inputs, entry, s.parcels.size())}, kContactTolerance,
                                   minFrontage);
 }

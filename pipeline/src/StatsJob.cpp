@@ -16,12 +16,11 @@ using namespace analysis;
 
 std::string version() { return PARCELSCOPE_VERSION; }
 
-ObservedData loadObserved(const io::ReadOptions& input, const ParameterValues& parameters,
-                          const ProgressFn& progress) {
+ObservedData loadObserved(const io::ReadOptions& input, const ParameterValues& parameters, const ProgressFn& progress) {
   ObservedData data;
   data.layer = io::readParcels(input, scaledProgress(progress, 0.0, 0.4));
-  data.analysis = analyseParcels(data.layer.parcels, analysisOptionsFrom(parameters),
-                                 scaledProgress(progress, 0.4, 1.0));
+  data.analysis =
+      analyseParcels(data.layer.parcels, analysisOptionsFrom(parameters), scaledProgress(progress, 0.4, 1.0));
   return data;
 }
 
@@ -88,9 +87,9 @@ std::string summarize(const ObservedData& data) {
     << "  " << r.parcels << " parcels: " << r.invalidRepaired << " repaired, " << r.multipartFeatures
     << " multipart features split into " << r.partsFromMultipart << " parcels, " << r.duplicatesCollapsed
     << " duplicates collapsed into " << r.duplicateStacks << " stacks\n"
-    << "  skipped: " << r.nullOrEmpty << " null or empty, " << r.nonPolygonal << " not polygons, "
-    << r.nonFiniteSkipped << " with non-finite coordinates, "
-    << r.invalidSkipped << " beyond repair, " << r.degenerateSkipped << " degenerate parts\n"
+    << "  skipped: " << r.nullOrEmpty << " null or empty, " << r.nonPolygonal << " not polygons, " << r.nonFiniteSkipped
+    << " with non-finite coordinates, " << r.invalidSkipped << " beyond repair, " << r.degenerateSkipped
+    << " degenerate parts\n"
     << "  " << a.rightOfWayCount << " right-of-way parcels kept out of blocks\n"
     << "  " << a.blocks.size() << " blocks (" << a.clampedAMin << " with A_min clamped, " << a.clampedWMin
     << " with W_min clamped)";
@@ -108,8 +107,7 @@ JobOutcome writeStats(io::OutputDirectory& out, const io::ReadOptions& input, co
   io::writeCsv(out.stage("blocks.csv"), blocks);
   std::vector<std::vector<Polygon>> outlines;
   for (const Block& b : data.analysis.blocks) outlines.push_back(b.parts);
-  io::writePolygonLayer(out.stage("blocks.gpkg"), "blocks", outlines, blocks, data.layer.frame,
-                        data.layer.crs);
+  io::writePolygonLayer(out.stage("blocks.gpkg"), "blocks", outlines, blocks, data.layer.frame, data.layer.crs);
 
   Json run = runRecord("stats", parameters);
   addObservedRecord(run, data);

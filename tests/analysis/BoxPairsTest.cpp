@@ -36,7 +36,8 @@ TEST(BoxPairs, EveryMeetingPairOnceSortedAtEverySize) {
     // Expected: boxes in order of minX, each against those starting before it ends.
     std::vector<std::size_t> order(n);
     std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return boxes[a].minX < boxes[b].minX; });
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return boxes[a].minX < boxes[b].minX; });
     std::vector<std::pair<int, int>> expected;
     for (std::size_t k = 0; k < n; ++k) {
       const Box& a = boxes[order[k]];
@@ -173,8 +174,8 @@ TEST(LengthAlong, EqualsTheEdgeByEdgeDefinitionOnRandomLotsAndOutlines) {
       const std::vector<double> expected = lengthAlongEveryPair(all, rings, tolerance);
       ASSERT_EQ(got.size(), expected.size());
       for (std::size_t i = 0; i < got.size(); ++i) {
-        ASSERT_EQ(got[i], expected[i]) << "round " << round << ", lot " << i << " of " << got.size()
-                                       << ", tolerance " << tolerance;
+        ASSERT_EQ(got[i], expected[i]) << "round " << round << ", lot " << i << " of " << got.size() << ", tolerance "
+                                       << tolerance;
         fronting += got[i] > 5.0;
         inside += got[i] == 0.0;
       }

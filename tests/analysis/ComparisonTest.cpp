@@ -20,8 +20,8 @@ namespace {
 const double kInf = HUGE_VAL;
 
 TEST(KsStatistic, HandComputedValues) {
-  EXPECT_DOUBLE_EQ(ksStatistic({1, 2, 3}, {3, 1, 2}), 0.0);       // same values, any order
-  EXPECT_DOUBLE_EQ(ksStatistic({1, 2}, {3, 4}), 1.0);             // disjoint
+  EXPECT_DOUBLE_EQ(ksStatistic({1, 2, 3}, {3, 1, 2}), 0.0);  // same values, any order
+  EXPECT_DOUBLE_EQ(ksStatistic({1, 2}, {3, 4}), 1.0);        // disjoint
   EXPECT_DOUBLE_EQ(ksStatistic({3, 4}, {1, 2}), 1.0);
   EXPECT_DOUBLE_EQ(ksStatistic({1, 2, 3, 4}, {3, 4, 5, 6}), 0.5);  // F_a(2) = 1/2, F_b(2) = 0
   // Ties across samples: at x = 1, F_a = 2/3 and F_b = 1/3; at x = 2 both reach 1.
@@ -224,8 +224,8 @@ TEST(ComparisonTables, PerBlockRowsFollowThePapersTable) {
   BlockComparison b;
   b.blockId = 7;
   b.blockArea = 1234;
-  b.comparison = compareSets({parcel(100, 10, 2, 0, 1, true)}, {parcel(100, 10, 2, 0, 1, true),
-                                                                 parcel(300, 20, 2, 0, 1, true)}, 5, 1.0);
+  b.comparison = compareSets({parcel(100, 10, 2, 0, 1, true)},
+                             {parcel(100, 10, 2, 0, 1, true), parcel(300, 20, 2, 0, 1, true)}, 5, 1.0);
   const Table t = blockComparisonTable({b});
   ASSERT_EQ(t.rows.size(), 1u);
   ASSERT_EQ(t.rows[0].size(), t.columns.size());

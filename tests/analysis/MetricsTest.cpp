@@ -117,8 +117,8 @@ TEST(Metrics, SharedBoundaryOfAdjacentAndNearlyAdjacentLots) {
   const Polygon a = rect(0, 0, 10, 10);
   EXPECT_NEAR(sharedBoundaryLength(a, rect(10, 0, 20, 10), 0.5), 10, 1e-9);
   EXPECT_NEAR(sharedBoundaryLength(a, rect(10.3, 4, 20, 30), 0.5), 6, 1e-9);  // gap 0.3, overlap 4..10
-  EXPECT_NEAR(sharedBoundaryLength(a, rect(11, 0, 20, 10), 0.5), 0, 1e-12);  // gap wider than tolerance
-  EXPECT_NEAR(sharedBoundaryLength(a, rect(10, 10, 20, 20), 0.5), 0, 1e-12); // corner touch only
+  EXPECT_NEAR(sharedBoundaryLength(a, rect(11, 0, 20, 10), 0.5), 0, 1e-12);   // gap wider than tolerance
+  EXPECT_NEAR(sharedBoundaryLength(a, rect(10, 10, 20, 20), 0.5), 0, 1e-12);  // corner touch only
   // An edge crossing the other at a small angle counts where it is within the tolerance.
   EXPECT_NEAR(sharedBoundaryLength(rect(0, 0, 100, 10), poly({{0, -20}, {100, -20}, {100, 1.2}, {0, -1.2}}), 1.0),
               100.0 * 2.0 / 2.4 + 1.2, 1e-6);  // the crossing stretch, plus 1.2 m of the right sides

@@ -49,8 +49,8 @@ TEST(BlockStatistics, LowerBoundsAreClampedAndFlagged) {
 
 TEST(ObservedAnalysis, TouchingAndNearlyTouchingLotsFormBlocks) {
   // A 2 x 2 block of 10 m lots with a 0.5 m digitising gap, and a lone lot 30 m away.
-  const auto parcels = parcelsOf({rect(0, 0, 10, 10), rect(10.5, 0, 20, 10), rect(0, 10, 10, 20),
-                                  rect(10.5, 10, 20, 20), rect(50, 0, 60, 10)});
+  const auto parcels = parcelsOf(
+      {rect(0, 0, 10, 10), rect(10.5, 0, 20, 10), rect(0, 10, 10, 20), rect(10.5, 10, 20, 20), rect(50, 0, 60, 10)});
   AnalysisOptions o;
   o.blockTolerance = 1.0;
   const ObservedAnalysis a = analyseParcels(parcels, o);
@@ -59,7 +59,7 @@ TEST(ObservedAnalysis, TouchingAndNearlyTouchingLotsFormBlocks) {
   EXPECT_EQ(a.blocks[0].parts.size(), 1u);
   EXPECT_NEAR(a.statistics[0].blockArea, 20 * 20, 1e-6);  // the gap is closed, corners kept
   for (int i = 0; i < 4; ++i) {
-    EXPECT_EQ(a.metrics[i].neighbours, 2) << i;          // corner contacts do not count
+    EXPECT_EQ(a.metrics[i].neighbours, 2) << i;                          // corner contacts do not count
     EXPECT_NEAR(a.metrics[i].frontage, i % 2 ? 19.5 : 20.0, 1e-6) << i;  // two whole sides on the outline
     EXPECT_TRUE(a.metrics[i].streetAccess);
   }

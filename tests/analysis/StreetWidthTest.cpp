@@ -20,12 +20,12 @@ TEST(StreetWidth, FacingEdgesMeasureTheGapAndOpenEdgesAreUnknown) {
   // Normalised rectangles run (x0,y0) (x1,y0) (x1,y1) (x0,y1): bottom, right, top, left.
   ASSERT_EQ(w[0].size(), 1u);
   ASSERT_EQ(w[0][0].size(), 4u);
-  EXPECT_TRUE(std::isnan(w[0][0][0]));      // nothing south
-  EXPECT_NEAR(w[0][0][1], 12.0, 1e-9);      // east: the street to `east`
-  EXPECT_NEAR(w[0][0][2], 25.0, 1e-9);      // north: the street to `north`
-  EXPECT_TRUE(std::isnan(w[0][0][3]));      // nothing west
-  EXPECT_NEAR(w[1][0][3], 12.0, 1e-9);      // `east` looks back west
-  EXPECT_NEAR(w[2][0][0], 25.0, 1e-9);      // `north` looks back south
+  EXPECT_TRUE(std::isnan(w[0][0][0]));  // nothing south
+  EXPECT_NEAR(w[0][0][1], 12.0, 1e-9);  // east: the street to `east`
+  EXPECT_NEAR(w[0][0][2], 25.0, 1e-9);  // north: the street to `north`
+  EXPECT_TRUE(std::isnan(w[0][0][3]));  // nothing west
+  EXPECT_NEAR(w[1][0][3], 12.0, 1e-9);  // `east` looks back west
+  EXPECT_NEAR(w[2][0][0], 25.0, 1e-9);  // `north` looks back south
   // Beyond the cap nothing counts.
   const auto capped = streetWidths({&west, &north}, 20.0);
   EXPECT_TRUE(std::isnan(capped[0][0][2]));

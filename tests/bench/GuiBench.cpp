@@ -9,13 +9,13 @@
 // OpenGL window's buffers swapped) and the window's other widgets painted, and
 // the median time until every number is complete (the neighbours and street
 // access of regenerated parcels are measured after the views are drawn).
+#include <QVTKOpenGLStereoWidget.h>
+#include <QVTKOpenGLWindow.h>
 #include <QApplication>
 #include <QElapsedTimer>
 #include <QSurfaceFormat>
 #include <QTest>
 #include <QTimer>
-#include <QVTKOpenGLStereoWidget.h>
-#include <QVTKOpenGLWindow.h>
 
 #include <vtkCallbackCommand.h>
 #include <vtkCommand.h>
@@ -47,7 +47,7 @@ bool settle(MainWindow& w) {
 struct Row {
   std::string change;
   std::vector<double> ms;
-  std::vector<double> firstMs;  // to the first views drawn (a result in between, or the final one)
+  std::vector<double> firstMs;     // to the first views drawn (a result in between, or the final one)
   std::vector<double> completeMs;  // to every number complete
   // MainWindow::lastTimings of each change, and the time from the views drawn to the screen.
   std::vector<double> library, layers, histogram, text, views, toScreen;
@@ -141,8 +141,7 @@ private:
 int main(int argc, char** argv) {
   QSurfaceFormat::setDefaultFormat(QVTKOpenGLStereoWidget::defaultFormat());
   QApplication app(argc, argv);
-  const std::string input =
-      std::string(PARCELSCOPE_SHARED_DATASETS) + "/cambridge_ma/ASSESSING_ParcelsFY2014.topojson";
+  const std::string input = std::string(PARCELSCOPE_SHARED_DATASETS) + "/cambridge_ma/ASSESSING_ParcelsFY2014.topojson";
   if (!std::filesystem::exists(input)) {
     std::printf("skipped: %s not found (shared datasets absent)\n", input.c_str());
     return 0;
@@ -240,9 +239,8 @@ int main(int argc, char** argv) {
     std::printf("style %s, parcel outlines %s\n", s, outlines ? "on" : "off");
     if (outlines) outlined();
     localChanges();
-    measure("  omega slider (every block regenerated)", std::max(3, repeats / 3), [&](int i) {
-      w.setParameter("omega", 0.2 + 0.05 * (i % 4));
-    });
+    measure("  omega slider (every block regenerated)", std::max(3, repeats / 3),
+            [&](int i) { w.setParameter("omega", 0.2 + 0.05 * (i % 4)); });
     measure("  skeleton-only street-angle slider (obb: none regenerated)", std::max(3, repeats / 3),
             [&](int i) { w.setParameter("street-angle", 20.0 + i); });
   }

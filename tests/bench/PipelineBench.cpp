@@ -14,18 +14,18 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
 
-#include "parcelscope/pipeline/StatsJob.h"
 #include "parcelscope/io/Writers.h"
-#include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/pipeline/CompareJob.h"
 #include "parcelscope/pipeline/CompareSession.h"
+#include "parcelscope/pipeline/GenerateJob.h"
+#include "parcelscope/pipeline/StatsJob.h"
 #include "parcelscope/viz/CompareFigures.h"
 #include "parcelscope/viz/Scenes.h"
 
@@ -100,8 +100,8 @@ void ObbSubdivisionPerBlock(benchmark::State& state) {
   if (!haveData(state)) return;
   parcelscope::io::ReadOptions in;
   in.path = kCambridge;
-  const auto d = parcelscope::pipeline::loadObserved(
-      in, parcelscope::defaultValues(parcelscope::analysis::analysisParameters()));
+  const auto d =
+      parcelscope::pipeline::loadObserved(in, parcelscope::defaultValues(parcelscope::analysis::analysisParameters()));
   const auto [inputs, plans] = plannedBlocks(d, "obb");
   std::size_t blocks = 0, parcels = 0;
   for (auto _ : state) {
@@ -114,8 +114,8 @@ void ObbSubdivisionPerBlock(benchmark::State& state) {
   }
   state.counters["blocks"] = static_cast<double>(blocks);
   state.counters["parcels"] = static_cast<double>(parcels);
-  state.counters["blocks_per_s"] = benchmark::Counter(static_cast<double>(blocks),
-                                                      benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["blocks_per_s"] =
+      benchmark::Counter(static_cast<double>(blocks), benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(ObbSubdivisionPerBlock)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
@@ -126,8 +126,8 @@ void PlanBlocks(benchmark::State& state) {
   if (!haveData(state)) return;
   parcelscope::io::ReadOptions in;
   in.path = kCambridge;
-  const auto d = parcelscope::pipeline::loadObserved(
-      in, parcelscope::defaultValues(parcelscope::analysis::analysisParameters()));
+  const auto d =
+      parcelscope::pipeline::loadObserved(in, parcelscope::defaultValues(parcelscope::analysis::analysisParameters()));
   parcelscope::pipeline::GenerateRequest request;
   request.fromParcels = true;
   request.observed = &d;
@@ -199,7 +199,8 @@ std::filesystem::path tiledCambridge(std::size_t target) {
   const auto side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(copies))));
   const double dx = all.width() + 300, dy = all.height() + 300;
   parcelscope::Table table;
-  table.columns = {{"copy", parcelscope::Column::Type::Integer, ""}, {"source_fid", parcelscope::Column::Type::Integer, ""}};
+  table.columns = {{"copy", parcelscope::Column::Type::Integer, ""},
+                   {"source_fid", parcelscope::Column::Type::Integer, ""}};
   std::vector<std::vector<parcelscope::Polygon>> geometries;
   for (std::size_t c = 0; c < copies; ++c) {
     const double ox = (static_cast<double>(c % side) - 0.5 * static_cast<double>(side - 1)) * dx;
@@ -252,8 +253,8 @@ void SkeletonSubdivisionPerBlock(benchmark::State& state) {
   namespace gen = parcelscope::generation;
   parcelscope::io::ReadOptions in;
   in.path = kCambridge;
-  const auto d = parcelscope::pipeline::loadObserved(
-      in, parcelscope::defaultValues(parcelscope::analysis::analysisParameters()));
+  const auto d =
+      parcelscope::pipeline::loadObserved(in, parcelscope::defaultValues(parcelscope::analysis::analysisParameters()));
   const auto [inputs, plans] = plannedBlocks(d, "skeleton");
   std::size_t parcels = 0, fallbacks = 0;
   std::vector<double> ms;
@@ -262,9 +263,8 @@ void SkeletonSubdivisionPerBlock(benchmark::State& state) {
     ms.clear();
     for (std::size_t k = 0; k < inputs.entries.size(); ++k) {
       const auto t0 = std::chrono::steady_clock::now();
-      const auto sub =
-          gen::subdivideSkeleton(inputs.entries[k].shape, gen::skeletonParametersFrom(plans[k].values), plans[k].seed,
-                                 inputs.widths[k]);
+      const auto sub = gen::subdivideSkeleton(inputs.entries[k].shape, gen::skeletonParametersFrom(plans[k].values),
+                                              plans[k].seed, inputs.widths[k]);
       ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
       parcels += sub.parcels.size();
       fallbacks += sub.fallback;

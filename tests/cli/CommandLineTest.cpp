@@ -198,7 +198,8 @@ TEST(GenerateCommand, SkeletonOffsetAndAutoStylesRunOnTheSample) {
     EXPECT_NE(json.find("\"parcels_without_street_access\": 0"), std::string::npos) << json;
     EXPECT_NE(json.find("\"blocks_by_style\""), std::string::npos) << json;
     if (std::string(style) == "offset") {
-      EXPECT_EQ(json.find("\"patio_parcels\": 0,"), std::string::npos) << "the sample's big blocks get patios: " << json;
+      EXPECT_EQ(json.find("\"patio_parcels\": 0,"), std::string::npos)
+          << "the sample's big blocks get patios: " << json;
     } else {
       EXPECT_NE(json.find("\"patio_parcels\": 0"), std::string::npos) << json;
     }
@@ -221,8 +222,8 @@ TEST(GenerateCommand, EnumAndBooleanParametersTakeTheirLabelsAndRecordNumbers) {
   TempDir dir;
   const std::string base = "generate '" + kSample + "' --where \"use <> 'ROW'\" --from-parcels --quiet --seed 3" +
                            " --style skeleton --offset 20";
-  const CliRun numbers = run(base + " --corner-rule 1 --patio-obb 1 --detect-right-of-way 0 --out '" +
-                             dir.file("numbers") + "'");
+  const CliRun numbers =
+      run(base + " --corner-rule 1 --patio-obb 1 --detect-right-of-way 0 --out '" + dir.file("numbers") + "'");
   ASSERT_EQ(numbers.code, 0) << numbers.output;
   const CliRun labels = run(base + " --corner-rule street-length --patio-obb yes --detect-right-of-way=false --out '" +
                             dir.file("labels") + "'");
@@ -296,7 +297,8 @@ TEST(MetricsCommand, PrintsTheRegistryAsTheDocumentedTableAndTheTablesFollowIt) 
   EXPECT_NE(m.output.find("| `aspect_ratio` |"), std::string::npos) << m.output;
   const std::string doc = slurp(std::string(PARCELSCOPE_SOURCE_DIR) + "/docs/user/metrics.md");
   EXPECT_NE(doc.find(m.output), std::string::npos)
-      << "docs/user/metrics.md does not hold the table `parcelscope metrics` prints; paste it in:\n" << m.output;
+      << "docs/user/metrics.md does not hold the table `parcelscope metrics` prints; paste it in:\n"
+      << m.output;
   // The metric columns of a parcel table, in the registry's order.
   TempDir dir;
   const CliRun r = test::runCli("stats '" + std::string(PARCELSCOPE_SOURCE_DIR) +

@@ -93,13 +93,13 @@ void expectTiling(const std::string& out) {
     EXPECT_NEAR(sums[id] / blockArea, 1.0, 1e-6) << "block " << id << ": parcels do not cover it";
     std::unique_ptr<OGRGeometry> together(members[id]->UnionCascaded());
     ASSERT_TRUE(together) << "block " << id;
-    const double unionArea = together->toSurface() ? together->toSurface()->get_Area()
-                                                   : together->toMultiPolygon()->get_Area();
+    const double unionArea =
+        together->toSurface() ? together->toSurface()->get_Area() : together->toMultiPolygon()->get_Area();
     EXPECT_NEAR(unionArea / sums[id], 1.0, 1e-6) << "block " << id << ": parcels overlap";
     std::unique_ptr<OGRGeometry> inside(together->Intersection(block));
     ASSERT_TRUE(inside) << "block " << id;
-    const double insideArea = inside->toSurface() ? inside->toSurface()->get_Area()
-                                                  : inside->toGeometryCollection()->get_Area();
+    const double insideArea =
+        inside->toSurface() ? inside->toSurface()->get_Area() : inside->toGeometryCollection()->get_Area();
     EXPECT_NEAR(insideArea / unionArea, 1.0, 1e-6) << "block " << id << ": parcels leave the block";
     ++checked;
   }
@@ -108,7 +108,7 @@ void expectTiling(const std::string& out) {
 
 struct Expected {
   std::string input;
-  int epsg;    ///< CRS given with --crs, which the outputs must carry; 0: the input's CRS
+  int epsg;  ///< CRS given with --crs, which the outputs must carry; 0: the input's CRS
   int width, height;
 };
 
@@ -145,8 +145,8 @@ void expectCompareOutputs(const std::string& out, const Expected& e) {
   EXPECT_FALSE(run.GetString("version").empty());
 
   // Tables: rectangular, and their counts agree with summary.json.
-  for (const char* f : {"observed_parcels.csv", "generated_parcels.csv", "blocks.csv", "summary.csv",
-                        "distances.csv"}) {
+  for (const char* f :
+       {"observed_parcels.csv", "generated_parcels.csv", "blocks.csv", "summary.csv", "distances.csv"}) {
     const auto rows = readCsv(out + "/" + f);
     ASSERT_GE(rows.size(), 2u) << f;
     for (const auto& row : rows) ASSERT_EQ(row.size(), rows[0].size()) << f;
@@ -344,9 +344,9 @@ TEST(CompareCommand, WithoutDisplayFiguresRenderOnAPrivateXvfbAndFiguresZeroSkip
   EXPECT_EQ(std::count(noXvfb.output.begin(), noXvfb.output.end(), '\n'), 1) << noXvfb.output;
   EXPECT_FALSE(fs::exists(dir.file("d")));
 
-  const CliRun tablesOnly = runCli(
-      "compare " + kSampleArgs + " --figures 0 --spatial-index 0 --out '" + dir.file("b") + "' --quiet",
-      "env -u DISPLAY");
+  const CliRun tablesOnly =
+      runCli("compare " + kSampleArgs + " --figures 0 --spatial-index 0 --out '" + dir.file("b") + "' --quiet",
+             "env -u DISPLAY");
   ASSERT_EQ(tablesOnly.code, 0) << tablesOnly.output;
   EXPECT_TRUE(fs::exists(dir.file("b") + "/summary.json"));
   EXPECT_FALSE(fs::exists(dir.file("b") + "/figures"));
@@ -364,8 +364,8 @@ TEST(CompareCommand, WithoutDisplayFiguresRenderOnAPrivateXvfbAndFiguresZeroSkip
 TEST(CompareCommand, DrawsAProgressBarOnATerminal) {
   TempDir dir;
   // script(1) gives the command a pseudo-terminal, as a user's shell would.
-  const std::string command = "'" + std::string(PARCELSCOPE_CLI) + "' compare " + kSampleArgs +
-                              " --figures 0 --out '" + dir.file("out") + "'";
+  const std::string command =
+      "'" + std::string(PARCELSCOPE_CLI) + "' compare " + kSampleArgs + " --figures 0 --out '" + dir.file("out") + "'";
   std::string quoted;
   for (char c : command) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
   const CliRun r = test::runShell("script -qec '" + quoted + "' /dev/null");
@@ -390,8 +390,8 @@ TEST(CompareCommand, CtrlCLeavesNoOutputAndNoStagingFolder) {
   TempDir dir;
   const std::string input = test::sharedDataset("cambridge_ma/ASSESSING_ParcelsFY2014.topojson");
   const std::string out = dir.file("out");
-  std::vector<std::string> args = {PARCELSCOPE_CLI, "compare", input, "--where", "ML <> 'ROAD'", "--figures", "0",
-                                   "--out", out};
+  std::vector<std::string> args = {PARCELSCOPE_CLI, "compare", input,   "--where", "ML <> 'ROAD'",
+                                   "--figures",     "0",       "--out", out};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -428,9 +428,9 @@ namespace {
 // the GUI colours by.
 TEST(CompareCommand, SessionFileRerunsWithItsOverrides) {
   TempDir dir;
-  const std::string session = dir.write(
-      "session.json", R"({"parcelscope_session": 1, "input": {"path": ")" + kSample +
-                          R"(", "where": "use <> 'ROW'"}, "style": "obb", "parameters": {"seed": 5},
+  const std::string session =
+      dir.write("session.json", R"({"parcelscope_session": 1, "input": {"path": ")" + kSample +
+                                    R"(", "where": "use <> 'ROW'"}, "style": "obb", "parameters": {"seed": 5},
       "overrides": [{"block_id": 3, "style": "skeleton", "parameters": {"w-max": 14}}]})");
   const std::string a = dir.file("a"), b = dir.file("b");
   CliRun r = runCli("compare --session '" + session + "' --figures 0 --out '" + a + "' --quiet");

@@ -34,8 +34,8 @@ TEST(DissolveCoverage, GridOfLotsBecomesItsOutline) {
   const Polygon& block = outline->front();
   EXPECT_TRUE(block.holes.empty());
   EXPECT_DOUBLE_EQ(signedArea(block.outer), 9.0);  // counter-clockwise
-  EXPECT_EQ(block.outer.size(), 12u);             // where inner edges meet the outline too
-  EXPECT_DOUBLE_EQ(block.outer.front().x, 0.0);   // starts at the lowest vertex
+  EXPECT_EQ(block.outer.size(), 12u);              // where inner edges meet the outline too
+  EXPECT_DOUBLE_EQ(block.outer.front().x, 0.0);    // starts at the lowest vertex
   EXPECT_DOUBLE_EQ(block.outer.front().y, 0.0);
 }
 
@@ -58,8 +58,8 @@ TEST(DissolveCoverage, TJunctionsNeedTheSnap) {
 }
 
 TEST(DissolveCoverage, CourtyardKeepsItsHoleAndSeparatePartsStaySeparate) {
-  const std::vector<Polygon> ring = {rect(0, 0, 30, 10), rect(0, 20, 30, 30), rect(0, 10, 10, 20),
-                                     rect(20, 10, 30, 20), rect(50, 0, 60, 10)};
+  const std::vector<Polygon> ring = {rect(0, 0, 30, 10), rect(0, 20, 30, 30), rect(0, 10, 10, 20), rect(20, 10, 30, 20),
+                                     rect(50, 0, 60, 10)};
   const auto outline = dissolveCoverage(pointers(ring), {1e-6});
   ASSERT_TRUE(outline.has_value());
   ASSERT_EQ(outline->size(), 2u);

@@ -168,9 +168,9 @@ namespace {
 
 TEST(Geometry, ClearlySimpleAcceptsPlainRingsAndDefersDoubtfulOnes) {
   EXPECT_TRUE(isClearlySimple(test::rect(0, 0, 10, 5).outer));
-  EXPECT_FALSE(isClearlySimple({{0, 0}, {10, 10}, {10, 0}, {0, 10}}));             // bow-tie
-  EXPECT_FALSE(isClearlySimple({{0, 0}, {10, 0}, {10, 10}, {5, 0}, {0, 10}}));      // touches itself
-  EXPECT_FALSE(isClearlySimple({{0, 0}, {10, 0}, {5, 0}, {5, 5}}));                 // folds back
+  EXPECT_FALSE(isClearlySimple({{0, 0}, {10, 10}, {10, 0}, {0, 10}}));          // bow-tie
+  EXPECT_FALSE(isClearlySimple({{0, 0}, {10, 0}, {10, 10}, {5, 0}, {0, 10}}));  // touches itself
+  EXPECT_FALSE(isClearlySimple({{0, 0}, {10, 0}, {5, 0}, {5, 5}}));             // folds back
   // Long rings (checked by a sweep): a circle, then the circle with one
   // vertex moved onto a far edge, and with two vertices swapped (a crossing).
   Ring many;
@@ -211,7 +211,9 @@ TEST(Geometry, ClearlySimpleSweepAgreesWithEveryPairOnLongRandomRings) {
       r.push_back({1000 + radius * std::cos(a), 2000 + radius * std::sin(a)});
     }
     if (k % 2) {
-      for (int m = 0; m < 3; ++m) r[static_cast<std::size_t>(u(rng) * static_cast<double>(n))] = {1000 + 200 * u(rng) - 100, 2000 + 200 * u(rng) - 100};
+      for (int m = 0; m < 3; ++m)
+        r[static_cast<std::size_t>(u(rng) * static_cast<double>(n))] = {1000 + 200 * u(rng) - 100,
+                                                                        2000 + 200 * u(rng) - 100};
     }
     const Box b = bounds(r);
     const bool reference = !hasClosePair(r, 1e-9 * std::max(b.width(), b.height()));

@@ -22,9 +22,10 @@ TEST(Parallel, VisitsEveryIndexOnce) {
 }
 
 TEST(Parallel, RethrowsTheBodysException) {
-  EXPECT_THROW(parallelFor(100, [](std::size_t i) {
-                 if (i == 42) throw std::runtime_error("boom");
-               }),
+  EXPECT_THROW(parallelFor(100,
+                           [](std::size_t i) {
+                             if (i == 42) throw std::runtime_error("boom");
+                           }),
                std::runtime_error);
 }
 

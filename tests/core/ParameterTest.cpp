@@ -133,10 +133,10 @@ TEST(Parameters, OutputOnlyMarksADescriptionAndEqualityComparesEveryField) {
 }
 
 TEST(Parameters, GroupsComeInTheOrderTheyFirstAppearWithTheirMembersInListOrder) {
-  const std::vector<ParameterDescription> list = {
-      realParameter("block-tolerance", "", "m", 0, 50, 1, "Blocks"), realParameter("k", "", "", 0, 10, 2, "Bounds"),
-      realParameter("min-frontage", "", "m", 0, 1000, 1, "Blocks"), kCornerRule,
-      realParameter("a-min", "", "m2", 0, 1e8, 200, "Bounds")};
+  const std::vector<ParameterDescription> list = {realParameter("block-tolerance", "", "m", 0, 50, 1, "Blocks"),
+                                                  realParameter("k", "", "", 0, 10, 2, "Bounds"),
+                                                  realParameter("min-frontage", "", "m", 0, 1000, 1, "Blocks"),
+                                                  kCornerRule, realParameter("a-min", "", "m2", 0, 1e8, 200, "Bounds")};
   const auto groups = groupParameters(list);
   ASSERT_EQ(groups.size(), 3u);
   EXPECT_EQ(groups[0].first, "Blocks");

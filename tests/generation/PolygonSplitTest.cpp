@@ -72,7 +72,8 @@ bool sameUpToPinches(const std::vector<Polygon>& fast, const std::vector<Polygon
     for (const Point& p : f.outer) {
       bool found = false;
       for (const Polygon& e : exact) {
-        for (const Point& q : e.outer) found = found || (std::fabs(p.x - q.x) <= tolerance && std::fabs(p.y - q.y) <= tolerance);
+        for (const Point& q : e.outer)
+          found = found || (std::fabs(p.x - q.x) <= tolerance && std::fabs(p.y - q.y) <= tolerance);
       }
       if (!found) return false;
     }
@@ -153,9 +154,10 @@ TEST(PolygonSplit, FastSplitMatchesExactSplitOnRandomShapes) {
     if (f.left.size() + f.right.size() > 2) ++multiple;
     holed += !block.holes.empty();
   }
-  std::printf("%d split in floating point (%d into more than two pieces, %d pinched, %d with holes), %d left to the "
-              "exact split\n",
-              fast, multiple, pinched, holed, declined);
+  std::printf(
+      "%d split in floating point (%d into more than two pieces, %d pinched, %d with holes), %d left to the "
+      "exact split\n",
+      fast, multiple, pinched, holed, declined);
   EXPECT_GT(multiple, 0);
   EXPECT_GT(pinched, 0);
   EXPECT_GT(holed, 0);
@@ -222,8 +224,8 @@ TEST(PolygonSplit, TouchOnACutPinchesItsPieceInTwo) {
   EXPECT_TRUE(sameUpToPinches(s.left, e.left, 1e-12));
   EXPECT_TRUE(samePieces(s.right, e.right, 1e-12));
   // Two touches on one cut, one from each side, and the line the other way.
-  const Polygon zigzag = poly({{0, 0}, {10, 0}, {15, 5}, {20, 0}, {30, 0}, {30, 10}, {25, 10}, {20, 5}, {10, 10},
-                               {0, 10}});
+  const Polygon zigzag =
+      poly({{0, 0}, {10, 0}, {15, 5}, {20, 0}, {30, 0}, {30, 10}, {25, 10}, {20, 5}, {10, 10}, {0, 10}});
   ASSERT_TRUE(splitByLineFast(zigzag, {0, 5}, {-1, 0}, s));
   EXPECT_TRUE(s.pinched);
   EXPECT_EQ(s.left.size(), 2u);
@@ -258,7 +260,8 @@ TEST(PolygonSplit, FastSplitMatchesExactSplitWithHolesInConcaveShapes) {
         clear = pointSegmentDistance(c, block.outer[k], block.outer[(k + 1) % n]) > 3 * r;
       }
       for (const Ring& h : block.holes) clear = clear && std::hypot(h[0].x - c.x, h[0].y - c.y) > 6 * r;
-      if (clear) block.holes.push_back({{c.x - r, c.y - r}, {c.x - r, c.y + r}, {c.x + r, c.y + r}, {c.x + r, c.y - r}});
+      if (clear)
+        block.holes.push_back({{c.x - r, c.y - r}, {c.x - r, c.y + r}, {c.x + r, c.y + r}, {c.x + r, c.y - r}});
     }
     if (block.holes.empty() || !normalise(block)) continue;
     const double angle = u(rng) * kPi;

@@ -69,7 +69,8 @@ inline Polygon randomShape(std::mt19937_64& rng, int kind) {
     case 5: {  // holes
       p = rect(0, 0, w, h);
       p.holes.push_back({{0.2 * w, 0.3 * h}, {0.2 * w, 0.7 * h}, {0.45 * w, 0.7 * h}, {0.45 * w, 0.3 * h}});
-      if (u(rng) < 0.5) p.holes.push_back({{0.6 * w, 0.4 * h}, {0.6 * w, 0.6 * h}, {0.8 * w, 0.6 * h}, {0.8 * w, 0.4 * h}});
+      if (u(rng) < 0.5)
+        p.holes.push_back({{0.6 * w, 0.4 * h}, {0.6 * w, 0.6 * h}, {0.8 * w, 0.6 * h}, {0.8 * w, 0.4 * h}});
       break;
     }
     default: {  // near-degenerate: a rectangle with micro-edges and almost collinear vertices

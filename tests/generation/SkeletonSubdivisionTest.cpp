@@ -112,8 +112,18 @@ TEST(SkeletonSubdivision, FiniteOffsetLeavesOnePatioInARectangle) {
 
 TEST(SkeletonSubdivision, NonConvexBlockWithOffsetHasSeveralPatios) {
   // Two 70 m squares joined by a 20 m neck: at 15 m the offset contour splits.
-  const Polygon block = poly({{0, 0}, {70, 0}, {70, 25}, {110, 25}, {110, 0}, {180, 0}, {180, 70}, {110, 70},
-                              {110, 45}, {70, 45}, {70, 70}, {0, 70}});
+  const Polygon block = poly({{0, 0},
+                              {70, 0},
+                              {70, 25},
+                              {110, 25},
+                              {110, 0},
+                              {180, 0},
+                              {180, 70},
+                              {110, 70},
+                              {110, 45},
+                              {70, 45},
+                              {70, 70},
+                              {0, 70}});
   SkeletonParameters p = params(100, 1000, 10, 20);
   p.offset = 15;
   const Subdivision s = subdivideSkeleton(block, p, 11);
@@ -142,9 +152,9 @@ TEST(SkeletonSubdivision, StreetWidthAndStreetLengthFlipTheCornerParcel) {
   // StreetLength: the corner parcel faces the long bottom street, its side
   // cut perpendicular to it; StreetWidth: it faces the wide left street.
   const Box l = bounds(*cornerLength), w = bounds(*cornerWidth);
-  EXPECT_NEAR(l.maxY, 20, kNode);   // reaches back to the centre line
+  EXPECT_NEAR(l.maxY, 20, kNode);  // reaches back to the centre line
   EXPECT_LT(l.maxX, 20);           // one frontage width along the bottom
-  EXPECT_NEAR(w.maxX, 20, kNode);   // reaches back from the left street
+  EXPECT_NEAR(w.maxX, 20, kNode);  // reaches back from the left street
   EXPECT_LT(w.maxY, 20);           // one frontage width along the left street
   // Without widths, StreetWidth falls back to StreetLength.
   const Subdivision unknown = subdivideSkeleton(block, p, 1);
@@ -234,8 +244,7 @@ constexpr int kRandomShapes = 700 / test::kSanitizerDivisor;
 
 // Random bounds for a block of area a, a random street angle and, with
 // `offset`, a random finite d_offset.
-SkeletonParameters randomParameters(std::mt19937_64& rng, double a, bool offset, bool subdividePatios,
-                                    bool byLength) {
+SkeletonParameters randomParameters(std::mt19937_64& rng, double a, bool offset, bool subdividePatios, bool byLength) {
   std::uniform_real_distribution<double> u(0, 1);
   SkeletonParameters p;
   p.bounds = test::randomBounds(rng, a);
@@ -275,8 +284,8 @@ TEST(SkeletonSubdivision, RandomShapesAreTiledValidlyWithStreetAccess) {
     }
     parcels += static_cast<int>(sub.parcels.size());
   }
-  std::printf("%d shapes, %d parcels, %d patio parcels, %d fallbacks to OBB, %d without street access\n",
-              kRandomShapes, parcels, patios, fallbacks, withoutAccess);
+  std::printf("%d shapes, %d parcels, %d patio parcels, %d fallbacks to OBB, %d without street access\n", kRandomShapes,
+              parcels, patios, fallbacks, withoutAccess);
   EXPECT_EQ(withoutAccess, 0);
   EXPECT_LE(fallbacks, kRandomShapes / 20);  // the skeleton route handles at least 95 %
 }
@@ -351,7 +360,8 @@ TEST(SkeletonSubdivision, ReusedLayoutGivesWhatAFreshRunGives) {
       const SkeletonParameters before = q;
       if (change == 0) q.offset = q.offset > 0 ? 0 : 12;
       if (change == 1) q.streetAngle = 10 + 40 * u(rng);
-      if (change == 2) q.corner = q.corner == CornerRule::StreetWidth ? CornerRule::StreetLength : CornerRule::StreetWidth;
+      if (change == 2)
+        q.corner = q.corner == CornerRule::StreetWidth ? CornerRule::StreetLength : CornerRule::StreetWidth;
       EXPECT_FALSE(skeletonLayoutReusable(before, q));
       const Subdivision reused = subdivideSkeleton(block, q, s, widths, {last.skeletonLayout.get(), true});
       expectSameSubdivision(reused, subdivideSkeleton(block, q, s, widths),

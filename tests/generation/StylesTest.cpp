@@ -42,7 +42,7 @@ TEST(Styles, StyleValuesHoldWhatTheStyleReadsAndNothingElse) {
   values["street-angle"] = 45;
   values["block-tolerance"] = 2;
   const ParameterValues obb = styleValues(obbStyle(), values);
-  EXPECT_EQ(obb.count("street-angle"), 0u);  // a skeleton parameter
+  EXPECT_EQ(obb.count("street-angle"), 0u);     // a skeleton parameter
   EXPECT_EQ(obb.count("block-tolerance"), 0u);  // builds blocks, not parcels
   EXPECT_EQ(obb.at("a-max"), values.at("a-max"));
   const ParameterValues skeleton = styleValues(skeletonStyle(), values);

@@ -14,10 +14,10 @@
 namespace parcelscope::test {
 
 struct TilingReport {
-  double areaError = 0;    ///< |sum of parcel areas - block area| / block area
-  double maxOverlap = 0;   ///< largest pairwise overlap / block area
-  int invalid = 0;         ///< parcels GEOS finds invalid
-  int outside = 0;         ///< parcels with an interior point outside the block
+  double areaError = 0;   ///< |sum of parcel areas - block area| / block area
+  double maxOverlap = 0;  ///< largest pairwise overlap / block area
+  int invalid = 0;        ///< parcels GEOS finds invalid
+  int outside = 0;        ///< parcels with an interior point outside the block
 };
 
 inline TilingReport checkTiling(const Polygon& block, const std::vector<Polygon>& parcels) {
@@ -56,13 +56,13 @@ inline int measuredWithoutAccess(const Polygon& block, const std::vector<Polygon
   return without;
 }
 
-#define EXPECT_TILES(block, parcels, what)                                   \
-  do {                                                                       \
-    const auto report_ = ::parcelscope::test::checkTiling(block, parcels);   \
-    EXPECT_LE(report_.areaError, 1e-6) << what;                              \
-    EXPECT_LE(report_.maxOverlap, 1e-6) << what;                             \
-    EXPECT_EQ(report_.invalid, 0) << what;                                   \
-    EXPECT_EQ(report_.outside, 0) << what;                                   \
+#define EXPECT_TILES(block, parcels, what)                                 \
+  do {                                                                     \
+    const auto report_ = ::parcelscope::test::checkTiling(block, parcels); \
+    EXPECT_LE(report_.areaError, 1e-6) << what;                            \
+    EXPECT_LE(report_.maxOverlap, 1e-6) << what;                           \
+    EXPECT_EQ(report_.invalid, 0) << what;                                 \
+    EXPECT_EQ(report_.outside, 0) << what;                                 \
   } while (0)
 
 }  // namespace parcelscope::test

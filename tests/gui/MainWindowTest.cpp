@@ -5,21 +5,19 @@
 // its kind, ignore VTK's own keys, zoom about the cursor, remember how each
 // recent file was opened, and offer only what can be done. Run through
 // scripts/with-xvfb.sh.
+#include <QVTKOpenGLStereoWidget.h>
 #include <QApplication>
 #include <QCheckBox>
 #include <QComboBox>
-#include <QDoubleSpinBox>
-#include <QGroupBox>
 #include <QDir>
+#include <QDoubleSpinBox>
+#include <QDragEnterEvent>
+#include <QGroupBox>
 #include <QLabel>
 #include <QMenu>
 #include <QMimeData>
 #include <QPushButton>
 #include <QRegularExpression>
-#include <QUrl>
-#include <QWheelEvent>
-#include <QWindow>
-#include <QDragEnterEvent>
 #include <QSignalSpy>
 #include <QSlider>
 #include <QStandardPaths>
@@ -28,7 +26,9 @@
 #include <QTemporaryDir>
 #include <QTest>
 #include <QTextBrowser>
-#include <QVTKOpenGLStereoWidget.h>
+#include <QUrl>
+#include <QWheelEvent>
+#include <QWindow>
 
 #include <vtkActor.h>
 #include <vtkActorCollection.h>
@@ -480,12 +480,11 @@ private slots:
     turnWheel(surface, at, 120);
     const CameraState in = cameraState(view->camera());
     QVERIFY(in.scale < 0.9 * fitted.scale);
-    QVERIFY2((view->widgetPoint(p) - at).manhattanLength() <= 2,
-             qPrintable(QString("(%1, %2) moved to (%3, %4)")
-                            .arg(at.x())
-                            .arg(at.y())
-                            .arg(view->widgetPoint(p).x())
-                            .arg(view->widgetPoint(p).y())));
+    QVERIFY2((view->widgetPoint(p) - at).manhattanLength() <= 2, qPrintable(QString("(%1, %2) moved to (%3, %4)")
+                                                                                .arg(at.x())
+                                                                                .arg(at.y())
+                                                                                .arg(view->widgetPoint(p).x())
+                                                                                .arg(view->widgetPoint(p).y())));
     // The other view follows (one camera).
     QCOMPARE(window_->observedView()->camera()->GetParallelScale(), in.scale);
     turnWheel(surface, at, -120);
@@ -575,8 +574,8 @@ private slots:
   // for nothing to export); with one, it is enabled. Messages name the
   // window's controls, not the command line's flags, which keeps its words.
   void menusWaitForAResultAndMessagesUseTheWindowsWords() {
-    const QStringList needResult = {"Save session...", "Figure...", "Tables (CSV)...", "Generated parcels...",
-                                    "Set input CRS...", "Zoom to extent"};
+    const QStringList needResult = {"Save session...",      "Figure...",        "Tables (CSV)...",
+                                    "Generated parcels...", "Set input CRS...", "Zoom to extent"};
     {
       MainWindow fresh;
       for (const QString& text : needResult) {

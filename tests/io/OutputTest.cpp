@@ -493,8 +493,7 @@ TEST(StagedFile, AppearsOnlyOnCommitAndNeverOverwritesAnInput) {
 
 TEST(Writers, ReadJsonKeepsTypesAndOrderAndNamesTheFileOnError) {
   TempDir dir;
-  const std::string path =
-      dir.write("a.json", R"({"b": 1, "a": [2.5, "x", true, null], "c": {"d": -3}})");
+  const std::string path = dir.write("a.json", R"({"b": 1, "a": [2.5, "x", true, null], "c": {"d": -3}})");
   const Json j = readJson(path);
   const auto members = j.members();
   ASSERT_EQ(members.size(), 3u);

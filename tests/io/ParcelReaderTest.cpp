@@ -83,7 +83,7 @@ TEST(ParcelReader, CleaningCountsEveryRepairSplitCollapseAndSkip) {
   EXPECT_EQ(r.nonPolygonal, 1);
   EXPECT_EQ(r.duplicatesCollapsed, 1);
   EXPECT_EQ(r.duplicateStacks, 1);
-  EXPECT_EQ(r.invalidRepaired, 1);  // the bow-tie, made valid as two triangles
+  EXPECT_EQ(r.invalidRepaired, 1);    // the bow-tie, made valid as two triangles
   EXPECT_EQ(r.multipartFeatures, 1);  // the MultiPolygon; the repaired bow-tie is not one
   EXPECT_EQ(r.partsFromMultipart, 2);
   EXPECT_EQ(r.withHoles, 1);
@@ -103,12 +103,12 @@ TEST(ParcelReader, StrayAndNonFiniteFeaturesDoNotMoveTheFrame) {
   const std::string square = R"({"type":"Polygon","coordinates":[)" + test::squareRing(lon, lat, d) + "]}";
   const auto alone = dir.write("alone.geojson", test::collection(test::feature(square, 1)));
   // The same square, plus a stray record at 0, 0 and one with an absurd coordinate.
-  const auto stray = dir.write(
-      "stray.geojson",
-      test::collection(test::feature(square, 1) + "," +
-                       test::feature(R"({"type":"Polygon","coordinates":[)" + test::squareRing(0, 0, d) + "]}", 5) +
-                       "," +
-                       test::feature(R"({"type":"Polygon","coordinates":[[[1e300,0],[1e300,1],[0,1],[1e300,0]]]})", 7)));
+  const auto stray =
+      dir.write("stray.geojson",
+                test::collection(
+                    test::feature(square, 1) + "," +
+                    test::feature(R"({"type":"Polygon","coordinates":[)" + test::squareRing(0, 0, d) + "]}", 5) + "," +
+                    test::feature(R"({"type":"Polygon","coordinates":[[[1e300,0],[1e300,1],[0,1],[1e300,0]]]})", 7)));
   const double a = area(readParcels(options(alone)).parcels[0].shape);
   const ParcelLayer l = readParcels(options(stray));
   EXPECT_EQ(l.report.nonFiniteSkipped, 1);
@@ -229,9 +229,9 @@ TEST(ParcelReader, GeographicCrsInGradsIsConverted) {
 TEST(ParcelReader, ProjectedAreaMatchesGeodesicArea) {
   TempDir dir;
   const double lon = 2.35, lat = 48.85, d = 0.001;
-  const auto path = dir.write(
-      "sq.geojson", test::collection(test::feature(
-                        R"({"type":"Polygon","coordinates":[)" + test::squareRing(lon, lat, d) + "]}", 1)));
+  const auto path =
+      dir.write("sq.geojson", test::collection(test::feature(
+                                  R"({"type":"Polygon","coordinates":[)" + test::squareRing(lon, lat, d) + "]}", 1)));
   const ParcelLayer l = readParcels(options(path, "", "", ""));
   GeographicLib::PolygonArea geodesic(GeographicLib::Geodesic::WGS84());
   for (auto [x, y] : {std::pair{lon, lat}, {lon + d, lat}, {lon + d, lat + d}, {lon, lat + d}}) {
@@ -281,8 +281,8 @@ TEST(ParcelReader, RefusesMissingUnreadableAndPolygonFreeInput) {
   expectError(options(dir.file("absent.geojson"), "", "", ""), Error::Kind::Input, {"absent.geojson", "no such file"});
   const auto garbage = dir.write("garbage.geojson", "this is not { json");
   expectError(options(garbage, "", "", ""), Error::Kind::Input, {"garbage.geojson", "not a vector format"});
-  const auto points = dir.write(
-      "points.geojson", test::collection(test::feature(R"({"type":"Point","coordinates":[2.35,48.85]})", 1)));
+  const auto points =
+      dir.write("points.geojson", test::collection(test::feature(R"({"type":"Point","coordinates":[2.35,48.85]})", 1)));
   expectError(options(points, "", "", ""), Error::Kind::Input, {"points.geojson", "no usable polygon"});
 }
 
@@ -295,7 +295,8 @@ TEST(ParcelReader, RefusesLonLatClaimForCoordinatesThatCannotBeDegrees) {
   EXPECT_NEAR(totalArea(l), 100 * 100 * 0.3048006096 * 0.3048006096, 1e-6);
   expectError(options(path, "", "", "EPSG:99999999"), Error::Kind::Usage, {"--crs", "EPSG:99999999"});
   // A CRS that exists but has no plane to measure in (geocentric).
-  expectError(options(path, "", "", "EPSG:4978"), Error::Kind::Input, {"feet.geojson", "neither geographic nor projected"});
+  expectError(options(path, "", "", "EPSG:4978"), Error::Kind::Input,
+              {"feet.geojson", "neither geographic nor projected"});
 }
 
 TEST(ParcelReader, RefusesProjectedCoordinatesWithoutCrs) {
@@ -322,11 +323,11 @@ TEST(ParcelReaderKeys, KeysComeFromGeometriesOrFromTheKeyField) {
   auto square = [&](double x) {
     return std::string(R"({"type":"Polygon","coordinates":[)") + test::squareRing(lon + x * d, lat, d) + "]}";
   };
-  const std::string two = R"({"type":"MultiPolygon","coordinates":[[)" + test::squareRing(lon + 4 * d, lat, d) +
-                          "],[" + test::squareRing(lon + 6 * d, lat, d) + "]]}";
-  const auto path = dir.write("keys.geojson", test::collection(test::feature(square(0), 1) + "," +
-                                                               test::feature(square(2), 2) + "," +
-                                                               test::feature(two, 3)));
+  const std::string two = R"({"type":"MultiPolygon","coordinates":[[)" + test::squareRing(lon + 4 * d, lat, d) + "],[" +
+                          test::squareRing(lon + 6 * d, lat, d) + "]]}";
+  const auto path = dir.write(
+      "keys.geojson",
+      test::collection(test::feature(square(0), 1) + "," + test::feature(square(2), 2) + "," + test::feature(two, 3)));
   ReadOptions o;
   o.path = path;
   const ParcelLayer byGeometry = readParcels(o);
@@ -334,7 +335,7 @@ TEST(ParcelReaderKeys, KeysComeFromGeometriesOrFromTheKeyField) {
   std::set<Key> keys;
   for (const Parcel& p : byGeometry.parcels) keys.insert(parcelKey(p));
   EXPECT_EQ(keys.size(), 4u);
-  EXPECT_EQ(byGeometry.parcels[2].featureKey, byGeometry.parcels[3].featureKey);  // one feature, two parts
+  EXPECT_EQ(byGeometry.parcels[2].featureKey, byGeometry.parcels[3].featureKey);      // one feature, two parts
   EXPECT_EQ(readParcels(o).parcels[1].featureKey, byGeometry.parcels[1].featureKey);  // reproducible
 
   o.keyField = "pid";

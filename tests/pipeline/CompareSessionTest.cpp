@@ -147,13 +147,19 @@ TEST(CompareSession, RandomEditSequencesMatchAFreshCompare) {
   for (int step = 0; step < 12; ++step) {
     SCOPED_TRACE("seed " + std::to_string(seed) + ", step " + std::to_string(step));
     switch (rng() % 5) {
-      case 0: request.style = styles[rng() % 4]; break;
-      case 1: request.overridesById[static_cast<std::int64_t>(rng() % 10)].style = styles[rng() % 3]; break;
+      case 0:
+        request.style = styles[rng() % 4];
+        break;
+      case 1:
+        request.overridesById[static_cast<std::int64_t>(rng() % 10)].style = styles[rng() % 3];
+        break;
       case 2:
         request.overridesById[static_cast<std::int64_t>(rng() % 10)].parameters["w-max"] =
             12.0 + static_cast<double>(rng() % 20);
         break;
-      case 3: request.overridesById.erase(static_cast<std::int64_t>(rng() % 10)); break;
+      case 3:
+        request.overridesById.erase(static_cast<std::int64_t>(rng() % 10));
+        break;
       case 4:
         request.parameters["seed"] = static_cast<double>(rng() % 5);
         request.explicitParameters.insert("seed");
@@ -173,15 +179,18 @@ std::string gridOfBlocks(const TempDir& dir) {
       for (int p = 0; p < 4; ++p) {
         const double x0 = 500000 + bx * 90 + (p % 2) * 40, y0 = 5000000 + by * 90 + (p / 2) * 40;
         char f[512];
-        std::snprintf(f, sizeof f,
-                      R"(%s{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[%.1f,%.1f],[%.1f,%.1f],[%.1f,%.1f],[%.1f,%.1f],[%.1f,%.1f]]]}})",
-                      features.empty() ? "" : ",", x0, y0, x0 + 40, y0, x0 + 40, y0 + 40, x0, y0 + 40, x0, y0);
+        std::snprintf(
+            f, sizeof f,
+            R"(%s{"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[[%.1f,%.1f],[%.1f,%.1f],[%.1f,%.1f],[%.1f,%.1f],[%.1f,%.1f]]]}})",
+            features.empty() ? "" : ",", x0, y0, x0 + 40, y0, x0 + 40, y0 + 40, x0, y0 + 40, x0, y0);
         features += f;
       }
     }
   }
-  return dir.write("grid.geojson", R"({"type":"FeatureCollection","crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::32631"}},"features":[)" +
-                                        features + "]}");
+  return dir.write(
+      "grid.geojson",
+      R"({"type":"FeatureCollection","crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::32631"}},"features":[)" +
+          features + "]}");
 }
 
 // The sample's request on gridOfBlocks.
@@ -359,7 +368,9 @@ TEST(CompareSession, CancelledContextCompletionLeavesTheResultAndLosesNothing) {
   // nothing is completed, and the next update measures what it needs.
   CompareRequest other = request;
   other.style = "skeleton";
-  EXPECT_THROW(session.update(other, [](double f, const std::string&) { return f < 0.3; }, {}, 0.5, true), Error);
+  EXPECT_THROW(session.update(
+                   other, [](double f, const std::string&) { return f < 0.3; }, {}, 0.5, true),
+               Error);
   EXPECT_EQ(session.completeContext().result, shapes.result);
   EXPECT_FALSE(session.current()->generated.contextPending.empty());
   // A deferred one-block edit after the stopped completions, then the completion.

@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
+#include "CompareStages.h"
 #include "TestUtil.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/io/Writers.h"
 #include "parcelscope/pipeline/CompareJob.h"
 #include "parcelscope/pipeline/CompareSession.h"
-#include "CompareStages.h"
 
 namespace parcelscope::pipeline {
 namespace {
@@ -50,9 +50,8 @@ void copyFeatures(const std::string& from, const std::string& to, bool reversed,
     copy->SetFrom(f.get());
     if (f->GetFID() == edited) {
       OGRGeometry* g = copy->GetGeometryRef();
-      OGRPolygon* polygon = wkbFlatten(g->getGeometryType()) == wkbPolygon
-                                ? g->toPolygon()
-                                : g->toMultiPolygon()->getGeometryRef(0);
+      OGRPolygon* polygon =
+          wkbFlatten(g->getGeometryType()) == wkbPolygon ? g->toPolygon() : g->toMultiPolygon()->getGeometryRef(0);
       OGRLinearRing* ring = polygon->getExteriorRing();
       OGRLinearRing longer;
       longer.addPoint(ring->getX(0), ring->getY(0));

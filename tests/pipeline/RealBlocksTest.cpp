@@ -8,9 +8,9 @@
 
 #include "TestUtil.h"
 #include "generation/TilingCheck.h"
-#include "parcelscope/pipeline/StatsJob.h"
 #include "parcelscope/core/Parallel.h"
 #include "parcelscope/pipeline/GenerateJob.h"
+#include "parcelscope/pipeline/StatsJob.h"
 
 namespace parcelscope::pipeline {
 namespace {
@@ -91,9 +91,10 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
     fallbacks += results[k].fallback;
     patios += results[k].patioParcels;
   }
-  std::printf("%s %s: %zu blocks, %d parcels (%d in patios), %d oversize, %d without street access, "
-              "%d fell back to obb, %d failed\n",
-              dataset.file, style.c_str(), n, parcels, patios, oversize, withoutAccess, fallbacks, failed);
+  std::printf(
+      "%s %s: %zu blocks, %d parcels (%d in patios), %d oversize, %d without street access, "
+      "%d fell back to obb, %d failed\n",
+      dataset.file, style.c_str(), n, parcels, patios, oversize, withoutAccess, fallbacks, failed);
   EXPECT_EQ(withoutAccess, 0);
   // The skeleton route handles at least 95 % of real blocks itself.
   EXPECT_LE(fallbacks, static_cast<int>(n) / 20);
@@ -126,8 +127,8 @@ TEST_P(RealBlocks, RunsReusingTheLastRunGiveWhatFreshRunsGive) {
     const BlockOutcome reused = runBlock(inputs, k, moved[k], minFrontage, {&first, &planned->plans[k], true});
     reusedAnything[k] = first.subdivision.obbSplits != nullptr || first.subdivision.skeletonLayout != nullptr;
     auto same = [](const Subdivision& x, const Subdivision& y) {
-      bool equal = x.parcels.size() == y.parcels.size() && x.oversize == y.oversize &&
-                   x.withoutAccess == y.withoutAccess;
+      bool equal =
+          x.parcels.size() == y.parcels.size() && x.oversize == y.oversize && x.withoutAccess == y.withoutAccess;
       for (std::size_t i = 0; equal && i < x.parcels.size(); ++i) equal = test::sameBits(x.parcels[i], y.parcels[i]);
       return equal;
     };
@@ -151,7 +152,8 @@ TEST_P(RealBlocks, RunsReusingTheLastRunGiveWhatFreshRunsGive) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Datasets, RealBlocks,
-                         ::testing::Combine(::testing::Values(Dataset{"cambridge_ma/ASSESSING_ParcelsFY2014.topojson", ""},
+                         ::testing::Combine(::testing::Values(Dataset{"cambridge_ma/ASSESSING_ParcelsFY2014.topojson",
+                                                                      ""},
                                                               Dataset{"paris_18e/cadastre-75118-parcelles.json", ""},
                                                               Dataset{"malibu_ca/parcels.geojson", ""},
                                                               Dataset{"eatonville_wa/parcels.geojson", "EPSG:2286"},
@@ -187,10 +189,10 @@ TEST(PlanBlocks, UserValuesOverridePerBlockValuesWhichOverrideDefaults) {
   inputs.source = std::make_shared<const io::ParcelLayer>();
   inputs.entries.push_back({7, test::rect(0, 0, 100, 50), 100, 900, 4, std::nan(""), 1.0});
   const ObbParameters p = planBlocks(r, inputs).at(0).bounds();
-  EXPECT_DOUBLE_EQ(p.aMin, 100);   // per block
-  EXPECT_DOUBLE_EQ(p.aMax, 555);   // given by the user
-  EXPECT_DOUBLE_EQ(p.wMin, 4);     // per block
-  EXPECT_DOUBLE_EQ(p.wMax, 30);    // no per-block value: default
+  EXPECT_DOUBLE_EQ(p.aMin, 100);  // per block
+  EXPECT_DOUBLE_EQ(p.aMax, 555);  // given by the user
+  EXPECT_DOUBLE_EQ(p.wMin, 4);    // per block
+  EXPECT_DOUBLE_EQ(p.wMax, 30);   // no per-block value: default
 }
 
 }  // namespace

@@ -12,9 +12,9 @@
 #include "OgrTestUtil.h"
 #include "TestUtil.h"
 #include "parcelscope/core/Coverage.h"
+#include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
 #include "parcelscope/pipeline/StatsJob.h"
-#include "parcelscope/core/Error.h"
 
 namespace parcelscope::analysis {
 namespace {
@@ -125,13 +125,12 @@ TEST_P(SharedDataset, DissolvedBlocksEqualGeosUnion) {
 
 INSTANTIATE_TEST_SUITE_P(
     Datasets, SharedDataset,
-    ::testing::Values(
-        Expect{"cambridge_ma/ASSESSING_ParcelsFY2014.topojson", "", 13000, 13200, 650, 800, 200, 600},
-        Expect{"paris_18e/cadastre-75118-parcelles.json", "", 6800, 6830, 250, 450, 150, 350},
-        Expect{"malibu_ca/parcels.geojson", "", 7400, 7700, 60, 200, 1500, 5000},
-        Expect{"eatonville_wa/parcels.geojson", "EPSG:2286", 1250, 1350, 20, 300, 500, 10000},
-        Expect{"seoul_jamsil/parcels.geojson", "", 2300, 2400, 40, 200, 100, 2000},
-        Expect{"rhone_69114/parcelles.json", "", 5950, 6050, 80, 400, 200, 5000}),
+    ::testing::Values(Expect{"cambridge_ma/ASSESSING_ParcelsFY2014.topojson", "", 13000, 13200, 650, 800, 200, 600},
+                      Expect{"paris_18e/cadastre-75118-parcelles.json", "", 6800, 6830, 250, 450, 150, 350},
+                      Expect{"malibu_ca/parcels.geojson", "", 7400, 7700, 60, 200, 1500, 5000},
+                      Expect{"eatonville_wa/parcels.geojson", "EPSG:2286", 1250, 1350, 20, 300, 500, 10000},
+                      Expect{"seoul_jamsil/parcels.geojson", "", 2300, 2400, 40, 200, 100, 2000},
+                      Expect{"rhone_69114/parcelles.json", "", 5950, 6050, 80, 400, 200, 5000}),
     [](const ::testing::TestParamInfo<Expect>& param) {
       std::string n = param.param.file;
       return n.substr(0, n.find('/'));

@@ -19,8 +19,8 @@
 #include <iterator>
 #include <limits>
 #include <map>
-#include <stdexcept>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -94,8 +94,8 @@ Polygon readBlock(const std::string& name) {
 // it: the dataset read and its parcels grouped with the default parameters
 // (pipeline::loadObserved), in the reader's local frame.
 struct SharedBlock {
-  int id = -1;       // block id: follows the order of the features, not asserted
-  Polygon shape;     // the block part, as handed to the subdivision
+  int id = -1;    // block id: follows the order of the features, not asserted
+  Polygon shape;  // the block part, as handed to the subdivision
   std::size_t parcels = 0;
 };
 
@@ -176,8 +176,8 @@ auto bounded(const char* what, double seconds, long long maxGrowth, F work) {
     if (late || big) {
       ADD_FAILURE() << what << (late ? " did not finish within " : " grew the resident memory by more than ")
                     << (late ? seconds : static_cast<double>(maxGrowth) / 1e9) << (late ? " s" : " GB");
-      std::fprintf(stderr, "%s runs away (%.1f s, %.2f GB more resident): stopping the test process\n", what,
-                   elapsed, static_cast<double>(now - before) / 1e9);
+      std::fprintf(stderr, "%s runs away (%.1f s, %.2f GB more resident): stopping the test process\n", what, elapsed,
+                   static_cast<double>(now - before) / 1e9);
       std::fflush(stdout);
       std::fflush(stderr);
       std::_Exit(1);
@@ -218,8 +218,8 @@ TEST(SkeletonLoop, SeoulJamsilBlock0HolesTouchingAtAVertexFallBackInBoundedTimeA
   ASSERT_EQ(block.holes.size(), 7u);
   ASSERT_TRUE(holesTouchAtAVertex(block)) << "no two holes touch: the block no longer shows the failure";
   const Subdivision s = bounded("skeleton subdivision of seoul_jamsil block 0", 15.0, kGB, [&] {
-    return subdivideSkeleton(block, skeleton(683.29482634722888, 66221.715171657663, 3.5146290068745283,
-                                             164.21529143249916),
+    return subdivideSkeleton(block,
+                             skeleton(683.29482634722888, 66221.715171657663, 3.5146290068745283, 164.21529143249916),
                              1689514912832765592ull);
   });
   EXPECT_FALSE(s.failed) << s.failure;
@@ -246,8 +246,8 @@ TEST(SkeletonGuard, MalibuBlock0BrokenFaceCycleStopsTheConstruction) {
   EXPECT_EQ(vertexCount(block), 2546u);
   EXPECT_EQ(block.holes.size(), 7u);
   const Subdivision s = bounded("skeleton subdivision of malibu_ca block 0", 15.0, kGB, [&] {
-    return subdivideSkeleton(block, skeleton(961.78279663370802, 48912.454407109704, 6.9360773289904003,
-                                             192.08846265300249),
+    return subdivideSkeleton(block,
+                             skeleton(961.78279663370802, 48912.454407109704, 6.9360773289904003, 192.08846265300249),
                              4734301296798780510ull);
   });
   EXPECT_FALSE(s.failed) << s.failure;
@@ -266,9 +266,9 @@ TEST(SkeletonGuard, MalibuBlock0BrokenFaceCycleStopsTheConstruction) {
 // the OBB style.
 TEST(SkeletonFolds, Paris18eBlock279FoldsUntilEveryVertexIsKept) {
   const Polygon block = readBlock("paris_18e_block279_skeleton_folds.wkt");
-  const Subdivision s = subdivideSkeleton(
-      block, skeleton(51.056827646544093, 2138.9746755612091, 1.6615719656565728, 43.030069207659722),
-      17250980413466422333ull);
+  const Subdivision s =
+      subdivideSkeleton(block, skeleton(51.056827646544093, 2138.9746755612091, 1.6615719656565728, 43.030069207659722),
+                        17250980413466422333ull);
   EXPECT_FALSE(s.failed) << s.failure;
   EXPECT_FALSE(s.fallback) << s.fallbackReason;
   EXPECT_GE(s.parcels.size(), 10u);
@@ -280,9 +280,9 @@ TEST(SkeletonFolds, Paris18eBlock279FoldsUntilEveryVertexIsKept) {
 // next try (1 m) works. Guards the same retries.
 TEST(SkeletonFolds, CambridgeBlock542FoldsAtHalfAMetreOnly) {
   const Polygon block = readBlock("cambridge_ma_block542_skeleton_folds.wkt");
-  const Subdivision s = subdivideSkeleton(
-      block, skeleton(132.0823941472149, 555.58110305114724, 8.9518057918343317, 21.521752646246661),
-      3325223182235359509ull);
+  const Subdivision s =
+      subdivideSkeleton(block, skeleton(132.0823941472149, 555.58110305114724, 8.9518057918343317, 21.521752646246661),
+                        3325223182235359509ull);
   EXPECT_FALSE(s.failed) << s.failure;
   EXPECT_FALSE(s.fallback) << s.fallbackReason;
   EXPECT_GE(s.parcels.size(), 10u);
@@ -296,9 +296,9 @@ TEST(SkeletonFolds, CambridgeBlock542FoldsAtHalfAMetreOnly) {
 // (SkeletonFolds) and the fallback to the OBB style, which tiles the block.
 TEST(SkeletonFolds, CambridgeBlock316FoldsAtEveryToleranceAndFallsBackToObb) {
   const Polygon block = readBlock("cambridge_ma_block316_skeleton_folds_always.wkt");
-  const Subdivision s = subdivideSkeleton(
-      block, skeleton(286.96139373814248, 545.92482941149456, 11.022983144331871, 19.889018117967318),
-      17735974773883602446ull);
+  const Subdivision s =
+      subdivideSkeleton(block, skeleton(286.96139373814248, 545.92482941149456, 11.022983144331871, 19.889018117967318),
+                        17735974773883602446ull);
   EXPECT_FALSE(s.failed) << s.failure;
   EXPECT_TRUE(s.fallback);
   EXPECT_EQ(s.fallbackReason, "a skeleton face is not simple once rounded");
@@ -355,9 +355,9 @@ TEST(GeosCoverageUnion, Rhone69114OverlappingPairGivesTheGeneralUnion) {
 // ObbSubdivision.cpp): the split is refused and the line as drawn used.
 TEST(ObbCut, CambridgeBlock672CutGrazingAVertexIsRefused) {
   const Polygon block = readBlock("cambridge_ma_block672_obb_cut_grazes_vertex.wkt");
-  const Subdivision s = subdivideObb(
-      block, obbBounds(94.920651685841094, 123.42402857451596, 8.8776575576721246, 10.831659844901855),
-      9966244809606740003ull);
+  const Subdivision s =
+      subdivideObb(block, obbBounds(94.920651685841094, 123.42402857451596, 8.8776575576721246, 10.831659844901855),
+                   9966244809606740003ull);
   EXPECT_FALSE(s.failed) << s.failure;
   ASSERT_EQ(s.parcels.size(), 2u);
   EXPECT_TILES(block, s.parcels, "cambridge_ma block 672");

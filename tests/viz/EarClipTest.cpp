@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <fstream>
 #include <cmath>
+#include <fstream>
 #include <random>
 
 #include "EarClip.h"
@@ -63,7 +63,8 @@ void expectExactCover(const Ring& ring, std::mt19937& rng) {
   double sum = 0;
   for (std::size_t i = 3; i < t.size(); i += 3) {
     const double a = cross(ring[static_cast<std::size_t>(t[i])], ring[static_cast<std::size_t>(t[i + 1])],
-                           ring[static_cast<std::size_t>(t[i + 2])]) / 2;
+                           ring[static_cast<std::size_t>(t[i + 2])]) /
+                     2;
     EXPECT_GE(a * (area > 0 ? 1 : -1), -1e-12) << "triangle turning against the ring";
     sum += std::abs(a);
   }
@@ -80,7 +81,8 @@ void expectExactCover(const Ring& ring, std::mt19937& rng) {
       covering += inTriangle(ring[static_cast<std::size_t>(t[i])], ring[static_cast<std::size_t>(t[i + 1])],
                              ring[static_cast<std::size_t>(t[i + 2])], p);
     }
-    ASSERT_EQ(covering, pointInRing(p, ring) ? 1 : 0) << "at (" << p.x << ", " << p.y << "), " << ring.size() << " vertices";
+    ASSERT_EQ(covering, pointInRing(p, ring) ? 1 : 0)
+        << "at (" << p.x << ", " << p.y << "), " << ring.size() << " vertices";
   }
 }
 
@@ -138,9 +140,9 @@ TEST(EarClip, RealParcelRingsAreCoveredExactlyOnce) {
 
 TEST(EarClip, RefusesWhatItCannotClipAndLeavesTheOutputAlone) {
   std::vector<int> t{1, 2, 3};
-  EXPECT_FALSE(earClip({{0, 0}, {1, 0}}, t));                      // too few vertices
-  EXPECT_FALSE(earClip({{0, 0}, {1, 0}, {2, 0}, {3, 0}}, t));      // no area
-  EXPECT_FALSE(earClip({{0, 0}, {1, 1}, {1, 0}, {0, 1}}, t));      // a bow tie: its two lobes cancel
+  EXPECT_FALSE(earClip({{0, 0}, {1, 0}}, t));                  // too few vertices
+  EXPECT_FALSE(earClip({{0, 0}, {1, 0}, {2, 0}, {3, 0}}, t));  // no area
+  EXPECT_FALSE(earClip({{0, 0}, {1, 1}, {1, 0}, {0, 1}}, t));  // a bow tie: its two lobes cancel
   std::mt19937 rng(7);
   EXPECT_FALSE(earClip(star(rng, kEarClipMaxVertices + 1), t));  // left to VTK
   EXPECT_EQ(t, (std::vector<int>{1, 2, 3}));

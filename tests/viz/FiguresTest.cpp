@@ -18,9 +18,9 @@
 #include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
 #include <vtkRendererCollection.h>
 #include <vtkSmartPointer.h>
-#include <vtkRenderer.h>
 #include <vtkWindowToImageFilter.h>
 
 #include <cmath>
@@ -115,8 +115,8 @@ TEST(RenderMaps, ConcaveShapesFillOnlyThemselves) {
   ASSERT_EQ(image.width, 600);
   // Map band from 13 % to 85 % of the height; the U spans it vertically with a margin.
   const int top = static_cast<int>(600 * (1 - 0.87)), bottom = static_cast<int>(600 * (1 - 0.15));
-  const int notchY = top + (bottom - top) / 4;      // y = 75 in the U
-  const int baseY = top + 7 * (bottom - top) / 8;   // y = 12
+  const int notchY = top + (bottom - top) / 4;     // y = 75 in the U
+  const int baseY = top + 7 * (bottom - top) / 8;  // y = 12
   EXPECT_EQ(image.rgb(300, notchY), 0xffffffu) << "the notch is filled";
   EXPECT_NE(image.rgb(300, baseY), 0xffffffu) << "the base of the U is empty";
   EXPECT_NE(image.rgb(300 - 200, notchY), 0xffffffu) << "the left arm is empty";
@@ -222,7 +222,8 @@ std::vector<unsigned char> draw(MapLayer& layer, const Box& extent) {
   grab->Update();
   vtkDataArray* pixels = grab->GetOutput()->GetPointData()->GetScalars();
   std::vector<unsigned char> out(static_cast<std::size_t>(pixels->GetNumberOfValues()));
-  for (vtkIdType i = 0; i < pixels->GetNumberOfValues(); ++i) out[static_cast<std::size_t>(i)] = static_cast<unsigned char>(pixels->GetVariantValue(i).ToInt());
+  for (vtkIdType i = 0; i < pixels->GetNumberOfValues(); ++i)
+    out[static_cast<std::size_t>(i)] = static_cast<unsigned char>(pixels->GetVariantValue(i).ToInt());
   return out;
 }
 
@@ -340,8 +341,7 @@ TEST(RenderHistogram, OverlaidSeriesInTheirColoursWithTextInTheSvg) {
   FigureOutput out = output(dir, "hist", 900, 500);
   out.vector = dir.file("hist.svg");
   renderHistogram("Parcel area", "area (m\xc2\xb2)", "parcels (count)", {0, 100, 200, 300},
-                  {{"observed", {5, 10, 2}, {0.84, 0.15, 0.16}}, {"procedural", {3, 12, 4}, {0.12, 0.38, 0.75}}},
-                  out);
+                  {{"observed", {5, 10, 2}, {0.84, 0.15, 0.16}}, {"procedural", {3, 12, 4}, {0.12, 0.38, 0.75}}}, out);
   const test::Image image = test::readPng(out.png);
   ASSERT_EQ(image.width, 900);
   ASSERT_EQ(image.height, 500);

@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <random>
 #include <set>
@@ -16,8 +16,8 @@
 #include "Simplify.h"
 #include "TestUtil.h"
 #include "parcelscope/analysis/ObservedAnalysis.h"
-#include "parcelscope/io/ParcelReader.h"
 #include "parcelscope/core/Geometry.h"
+#include "parcelscope/io/ParcelReader.h"
 
 namespace {
 
@@ -158,8 +158,8 @@ void expectSharedAndClose(const std::vector<Polygon>& shapes, const std::vector<
         ++held;
         keeps += kept.count(key(p)) ? 1 : 0;
         if (ringDistance(p, drawn) > tolerance * (1 + 1e-9) && far++ < 5) {
-          ADD_FAILURE() << "vertex " << p.x << ", " << p.y << " of shape " << k << " lies "
-                        << ringDistance(p, drawn) << " from its drawn ring";
+          ADD_FAILURE() << "vertex " << p.x << ", " << p.y << " of shape " << k << " lies " << ringDistance(p, drawn)
+                        << " from its drawn ring";
         }
       }
       std::size_t at = 0;

@@ -101,8 +101,8 @@ void renderQuantityMap(const CompareResult& r, const CompareRequest& request, co
              {observed, generated}, quantityScale(r, request, quantity), output);
 }
 
-QuantityHistogram quantityHistogram(const CompareResult& r, const CompareRequest& request,
-                                    const std::string& quantity, HistogramTexts texts) {
+QuantityHistogram quantityHistogram(const CompareResult& r, const CompareRequest& request, const std::string& quantity,
+                                    HistogramTexts texts) {
   const bool numbers = texts == HistogramTexts::WithNumbers;
   const analysis::ParcelQuantity& q = analysis::parcelQuantity(quantity);
   const int bins = static_cast<int>(value(request, "bins"));
@@ -158,16 +158,16 @@ void renderBlocksMap(const CompareResult& r, const CompareRequest& request, cons
       blocks.values.push_back(ks);
     }
   }
-  blocks.title = std::to_string(a.blocks.size()) + " blocks (" + std::to_string(withValue) +
-                 " with parcels on both sides)";
+  blocks.title =
+      std::to_string(a.blocks.size()) + " blocks (" + std::to_string(withValue) + " with parcels on both sides)";
   ColourScale scale;
   scale.kind = ColourScale::Kind::Sequential;
   scale.minimum = 0;
   scale.maximum = 1;
   scale.title = "KS statistic of parcel area (0: same distribution, 1: disjoint)";
-  renderMaps("Per-block difference in parcel area, observed and " + generatedName(request, r) + ": " +
-                 inputName(request),
-             {blocks}, scale, output);
+  renderMaps(
+      "Per-block difference in parcel area, observed and " + generatedName(request, r) + ": " + inputName(request),
+      {blocks}, scale, output);
 }
 
 std::vector<std::string> figureNames() {
@@ -269,8 +269,7 @@ const pipeline::FigureRenderer& compareFigureRenderer() {
   return renderer;
 }
 
-pipeline::JobOutcome runCompare(const CompareRequest& request, const std::string& outDir,
-                                const ProgressFn& progress) {
+pipeline::JobOutcome runCompare(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress) {
   return pipeline::runCompare(request, outDir, progress, &compareFigureRenderer());
 }
 

@@ -1,6 +1,5 @@
 #include "EarClip.h"
 
-
 namespace parcelscope::viz::detail {
 
 namespace {

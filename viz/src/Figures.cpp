@@ -7,7 +7,6 @@
 #include <vtkBrush.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
-#include <vtkPointData.h>
 #include <vtkChartLegend.h>
 #include <vtkChartXY.h>
 #include <vtkContextScene.h>
@@ -15,20 +14,21 @@
 #include <vtkContourTriangulator.h>
 #include <vtkDoubleArray.h>
 #include <vtkGL2PSExporter.h>
+#include <vtkIdList.h>
+#include <vtkIdTypeArray.h>
 #include <vtkLookupTable.h>
 #include <vtkNew.h>
+#include <vtkOpenGLPolyDataMapper.h>
+#include <vtkOpenGLVertexBufferObject.h>
 #include <vtkPNGWriter.h>
 #include <vtkPen.h>
 #include <vtkPlotArea.h>
 #include <vtkPlotLine.h>
+#include <vtkPointData.h>
 #include <vtkPoints.h>
-#include <vtkIdList.h>
-#include <vtkIdTypeArray.h>
 #include <vtkPolyData.h>
-#include <vtkPolygon.h>
-#include <vtkOpenGLPolyDataMapper.h>
-#include <vtkOpenGLVertexBufferObject.h>
 #include <vtkPolyDataMapper.h>
+#include <vtkPolygon.h>
 #include <vtkProperty.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
@@ -43,13 +43,13 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <unordered_map>
-#include <cmath>
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <unordered_map>
 
 #include "EarClip.h"
 #include "Simplify.h"
@@ -228,7 +228,7 @@ void writeFigure(vtkRenderWindow* window, const FigureOutput& out, const std::st
     throw usageError(out.vector + ": vector figures are .svg or .pdf");
   }
   exporter->SetFilePrefix((path.parent_path() / path.stem()).string().c_str());
-  exporter->CompressOff();  // compression would rename the file (.svgz)
+  exporter->CompressOff();   // compression would rename the file (.svgz)
   exporter->SetSortToOff();  // flat figures: drawing order is the stacking order
   exporter->SetTitle(title.c_str());
   exporter->SilentOn();
@@ -249,8 +249,8 @@ vtkSmartPointer<vtkLookupTable> lookupTable(const ColourScale& scale) {
     lut->Build();
   } else {
     // Pale yellow to dark purple, perceptually ordered (after ColorBrewer YlOrRd/RdPu).
-    const double stops[][3] = {{1.0, 0.97, 0.74}, {0.99, 0.73, 0.36}, {0.94, 0.40, 0.22},
-                               {0.74, 0.10, 0.28}, {0.35, 0.0, 0.38}};
+    const double stops[][3] = {
+        {1.0, 0.97, 0.74}, {0.99, 0.73, 0.36}, {0.94, 0.40, 0.22}, {0.74, 0.10, 0.28}, {0.35, 0.0, 0.38}};
     const int segments = 4;
     for (int i = 0; i < n; ++i) {
       const double t = static_cast<double>(i) / (n - 1) * segments;
@@ -300,9 +300,7 @@ using TriangleCache = std::unordered_map<std::uint64_t, std::vector<vtkIdType>>;
 
 std::uint64_t shapeHash(const Polygon& shape) {
   std::uint64_t h = 0xcbf29ce484222325ull;
-  auto mix = [&](std::uint64_t v) {
-    h ^= v + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
-  };
+  auto mix = [&](std::uint64_t v) { h ^= v + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2); };
   auto ring = [&](const Ring& r) {
     mix(r.size());
     for (const Point& p : r) {
@@ -565,8 +563,8 @@ void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, c
   bool anyValue = false, anyNaN = false;
   for (const MapPanel& p : panels) {
     if (p.values.size() != p.shapes.size()) {
-      throw usageError(out.png + ": panel '" + p.title + "' has " + std::to_string(p.shapes.size()) +
-                       " shapes but " + std::to_string(p.values.size()) + " values");
+      throw usageError(out.png + ": panel '" + p.title + "' has " + std::to_string(p.shapes.size()) + " shapes but " +
+                       std::to_string(p.values.size()) + " values");
     }
     for (const Polygon* s : p.shapes) {
       const Box b = bounds(*s);
@@ -585,8 +583,7 @@ void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, c
   const int n = static_cast<int>(panels.size());
   const double panelAspect = (out.width / static_cast<double>(n)) / (out.height * (titleBottom - barTop));
   const double margin = 0.03 * std::max(extent.width(), extent.height());
-  const double halfHeight =
-      std::max(0.5 * extent.height() + margin, (0.5 * extent.width() + margin) / panelAspect);
+  const double halfHeight = std::max(0.5 * extent.height() + margin, (0.5 * extent.width() + margin) / panelAspect);
   const double cx = 0.5 * (extent.minX + extent.maxX), cy = 0.5 * (extent.minY + extent.maxY);
 
   // Texts keep a margin of 2 % of the width on either side.
@@ -629,8 +626,7 @@ void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, c
     r->AddActor(rings);
 
     fitCamera(r, extent, panelAspect);
-    addScaleBar(r, cx - halfHeight * panelAspect, cy - halfHeight, 2 * halfHeight * panelAspect, 2 * halfHeight,
-                out);
+    addScaleBar(r, cx - halfHeight * panelAspect, cy - halfHeight, 2 * halfHeight * panelAspect, 2 * halfHeight, out);
     window->AddRenderer(r);
   }
 
@@ -746,8 +742,8 @@ void renderHistogram(const std::string& title, const std::string& xTitle, const 
   const std::size_t bins = edges.size() - 1;
   for (const HistogramSeries& s : series) {
     if (s.counts.size() != bins) {
-      throw usageError(out.png + ": series '" + s.label + "' has " + std::to_string(s.counts.size()) +
-                       " counts for " + std::to_string(bins) + " bins");
+      throw usageError(out.png + ": series '" + s.label + "' has " + std::to_string(s.counts.size()) + " counts for " +
+                       std::to_string(bins) + " bins");
     }
   }
   const auto window = offscreenWindow(out);
@@ -1104,8 +1100,8 @@ void OutlineLayer::addTo(vtkRenderer* renderer) { renderer->AddActor(impl_->acto
 
 void fitCamera(vtkRenderer* renderer, const Box& extent, double viewAspect) {
   const double margin = 0.03 * std::max(extent.width(), extent.height());
-  const double halfHeight = std::max(0.5 * extent.height() + margin,
-                                     (0.5 * extent.width() + margin) / std::max(1e-3, viewAspect));
+  const double halfHeight =
+      std::max(0.5 * extent.height() + margin, (0.5 * extent.width() + margin) / std::max(1e-3, viewAspect));
   const double cx = 0.5 * (extent.minX + extent.maxX), cy = 0.5 * (extent.minY + extent.maxY);
   vtkCamera* camera = renderer->GetActiveCamera();
   camera->ParallelProjectionOn();

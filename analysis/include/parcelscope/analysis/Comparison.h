@@ -30,8 +30,8 @@ double wasserstein1(const std::vector<double>& a, const std::vector<double>& b);
 
 /// Histogram of two samples on the same bins.
 struct SharedHistogram {
-  std::vector<double> edges;  ///< bins + 1 increasing edges; bin i is [edges[i], edges[i+1])
-  std::vector<int> a, b;      ///< counts per bin (not normalised)
+  std::vector<double> edges;         ///< bins + 1 increasing edges; bin i is [edges[i], edges[i+1])
+  std::vector<int> a, b;             ///< counts per bin (not normalised)
   int aOverflow = 0, bOverflow = 0;  ///< values above the last edge, counted in the last bin too
 };
 
@@ -64,7 +64,7 @@ struct SetSummary {
   double streetAccessShare = 0;       ///< fraction with street access, [0, 1]
   double meanPAngle = 0;              ///< degrees
   double meanPArea = 0;
-  double undesirableShare = 0;        ///< fraction with p_angle > 15 or p_area > 1.2, [0, 1]
+  double undesirableShare = 0;  ///< fraction with p_angle > 15 or p_area > 1.2, [0, 1]
 };
 /// NaN in every mean and share when `metrics` is empty.
 SetSummary summarizeSet(const std::vector<ParcelMetrics>& metrics);
@@ -97,11 +97,11 @@ struct ParcelQuantity {
   /// Measured from the parcel's surroundings (neighbours, block outline) rather
   /// than its own shape: see measureContext.
   bool context = false;
-  std::string unit;        ///< "m", "m2", "deg" or "" (dimensionless)
-  bool integer = false;    ///< a count or a flag, written as an integer
-  std::string formula;     ///< how it is computed
-  std::string range;       ///< values it takes, e.g. "[1, inf)"
-  std::string source;      ///< the paper or tool it follows
+  std::string unit;      ///< "m", "m2", "deg" or "" (dimensionless)
+  bool integer = false;  ///< a count or a flag, written as an integer
+  std::string formula;   ///< how it is computed
+  std::string range;     ///< values it takes, e.g. "[1, inf)"
+  std::string source;    ///< the paper or tool it follows
 };
 /// Every parcel metric in the order of the parcel tables' columns: area,
 /// perimeter, width, length, aspect_ratio, elongation, rectangularity,
@@ -142,7 +142,7 @@ Comparison compareSets(const PreparedSet& observed, const PreparedSet& generated
 
 struct BlockComparison {
   std::int64_t blockId = -1;
-  Key blockKey = 0;  ///< the observed block's stable key
+  Key blockKey = 0;      ///< the observed block's stable key
   double blockArea = 0;  ///< m²
   Comparison comparison;
 };

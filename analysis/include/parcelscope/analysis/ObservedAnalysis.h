@@ -35,9 +35,9 @@ const ParameterDescription& minFrontageParameter();
 AnalysisOptions analysisOptionsFrom(const ParameterValues& values);
 
 struct ParcelMetrics : ShapeMetrics {
-  int neighbours = 0;        ///< parcels sharing >= 1 m of boundary (edges within min(block tolerance, 1 m))
-  double frontage = 0;       ///< m of boundary on the block's outer contour (within tolerance/2, 5 cm..0.5 m)
-  bool streetAccess = false; ///< frontage >= minFrontage
+  int neighbours = 0;         ///< parcels sharing >= 1 m of boundary (edges within min(block tolerance, 1 m))
+  double frontage = 0;        ///< m of boundary on the block's outer contour (within tolerance/2, 5 cm..0.5 m)
+  bool streetAccess = false;  ///< frontage >= minFrontage
 };
 
 /// Why a parcel was judged to be a right-of-way (a street stored as a parcel).
@@ -50,31 +50,30 @@ enum class RightOfWay : std::uint8_t {
 struct BlockStatistics {
   int blockId = -1;
   int parcelCount = 0;
-  double blockArea = 0;       ///< m², area of the block polygon
-  double meanArea = 0;        ///< A-bar, m²
-  double sdArea = 0;          ///< s_A, m² (sample standard deviation; 0 for one parcel)
-  double meanWidth = 0;       ///< W-bar, m (MBR short side)
-  double sdWidth = 0;         ///< s_W, m
-  double aMin = 0, aMax = 0;  ///< A-bar -/+ k s_A, m² (aMin clamped, see aMinClamped)
-  double wMin = 0, wMax = 0;  ///< W-bar -/+ k s_W, m (wMin clamped, see wMinClamped)
-  bool aMinClamped = false;   ///< A-bar - k s_A was below max(0.1 A-bar, 1 m²) and was raised to it
-  bool wMinClamped = false;   ///< W-bar - k s_W was below max(0.1 W-bar, 0.5 m) and was raised to it
+  double blockArea = 0;          ///< m², area of the block polygon
+  double meanArea = 0;           ///< A-bar, m²
+  double sdArea = 0;             ///< s_A, m² (sample standard deviation; 0 for one parcel)
+  double meanWidth = 0;          ///< W-bar, m (MBR short side)
+  double sdWidth = 0;            ///< s_W, m
+  double aMin = 0, aMax = 0;     ///< A-bar -/+ k s_A, m² (aMin clamped, see aMinClamped)
+  double wMin = 0, wMax = 0;     ///< W-bar -/+ k s_W, m (wMin clamped, see wMinClamped)
+  bool aMinClamped = false;      ///< A-bar - k s_A was below max(0.1 A-bar, 1 m²) and was raised to it
+  bool wMinClamped = false;      ///< W-bar - k s_W was below max(0.1 W-bar, 0.5 m) and was raised to it
   double streetAccessShare = 0;  ///< fraction of the block's parcels with street access
 };
 
 /// Per-block statistics and the derived generator bounds; `widths` and `areas`
 /// are the block's parcels' values. Precondition: at least one value.
-BlockStatistics blockStatistics(const std::vector<double>& areas, const std::vector<double>& widths,
-                                double k);
+BlockStatistics blockStatistics(const std::vector<double>& areas, const std::vector<double>& widths, double k);
 
 struct ObservedAnalysis {
-  std::vector<ParcelMetrics> metrics;    ///< one per parcel
-  std::vector<RightOfWay> rightOfWay;    ///< one per parcel
-  std::vector<int> blockOf;              ///< block id per parcel; -1 for right-of-way parcels
-  std::vector<Block> blocks;             ///< ids 0..n-1, in order of their first parcel
+  std::vector<ParcelMetrics> metrics;       ///< one per parcel
+  std::vector<RightOfWay> rightOfWay;       ///< one per parcel
+  std::vector<int> blockOf;                 ///< block id per parcel; -1 for right-of-way parcels
+  std::vector<Block> blocks;                ///< ids 0..n-1, in order of their first parcel
   std::vector<BlockStatistics> statistics;  ///< one per block
   std::int64_t rightOfWayCount = 0;
-  std::int64_t multipartBlocks = 0;      ///< blocks whose closed union has several parts
+  std::int64_t multipartBlocks = 0;  ///< blocks whose closed union has several parts
   std::int64_t clampedAMin = 0, clampedWMin = 0;
   Timings timings;  ///< per analysis stage
 };

@@ -27,9 +27,7 @@ struct Box {
   double minX = 0, minY = 0, maxX = 0, maxY = 0;
   double width() const { return maxX - minX; }
   double height() const { return maxY - minY; }
-  bool intersects(const Box& o) const {
-    return minX <= o.maxX && o.minX <= maxX && minY <= o.maxY && o.minY <= maxY;
-  }
+  bool intersects(const Box& o) const { return minX <= o.maxX && o.minX <= maxX && minY <= o.maxY && o.minY <= maxY; }
   Box expanded(double d) const { return {minX - d, minY - d, maxX + d, maxY + d}; }
 };
 
@@ -92,9 +90,9 @@ void convexHullOfSimpleRing(const Ring& ring, Ring& hull);
 /// An oriented rectangle: centre, unit axis `u` along the long side, and side lengths.
 struct OrientedBox {
   Point center;
-  Point u{1, 0};       ///< unit vector along the long side
-  double length = 0;   ///< long side (m)
-  double width = 0;    ///< short side (m)
+  Point u{1, 0};      ///< unit vector along the long side
+  double length = 0;  ///< long side (m)
+  double width = 0;   ///< short side (m)
   double area() const { return length * width; }
 };
 

@@ -56,8 +56,7 @@ public:
 private:
   using Object = std::vector<std::pair<std::string, Json>>;
   using Array = std::vector<Json>;
-  std::variant<std::nullptr_t, bool, std::int64_t, double, std::string,
-               std::shared_ptr<Object>, std::shared_ptr<Array>>
+  std::variant<std::nullptr_t, bool, std::int64_t, double, std::string, std::shared_ptr<Object>, std::shared_ptr<Array>>
       value_;
   void write(std::string& out, int indent, int depth) const;
 };

@@ -22,11 +22,11 @@ enum class ParameterKind {
 };
 
 struct ParameterDescription {
-  std::string name;     ///< flag and JSON key, e.g. "block-tolerance"
-  std::string help;     ///< one sentence
-  std::string unit;     ///< "m", "m2", "" for dimensionless
-  double minimum = 0;   ///< inclusive
-  double maximum = 0;   ///< inclusive
+  std::string name;    ///< flag and JSON key, e.g. "block-tolerance"
+  std::string help;    ///< one sentence
+  std::string unit;    ///< "m", "m2", "" for dimensionless
+  double minimum = 0;  ///< inclusive
+  double maximum = 0;  ///< inclusive
   double defaultValue = 0;
   ParameterKind kind = ParameterKind::Real;
   /// Heading the parameter is listed under in --help and the GUI ("Blocks",
@@ -48,8 +48,8 @@ bool operator==(const ParameterDescription& a, const ParameterDescription& b);
 inline bool operator!=(const ParameterDescription& a, const ParameterDescription& b) { return !(a == b); }
 
 /// A real parameter in [minimum, maximum] (`unit`: "m", "m2", "deg", "" ...).
-ParameterDescription realParameter(std::string name, std::string help, std::string unit, double minimum,
-                                   double maximum, double defaultValue, std::string group);
+ParameterDescription realParameter(std::string name, std::string help, std::string unit, double minimum, double maximum,
+                                   double defaultValue, std::string group);
 /// A whole-number parameter in [minimum, maximum].
 ParameterDescription integerParameter(std::string name, std::string help, std::string unit, double minimum,
                                       double maximum, double defaultValue, std::string group);

@@ -29,8 +29,8 @@ inline Key parcelKey(const Parcel& parcel) { return partKey(parcel.featureKey, p
 /// A city block: a connected group of parcels and the union of their shapes.
 struct Block {
   int id = -1;
-  std::vector<Polygon> parts;   ///< usually one polygon; holes kept
-  std::vector<int> parcels;     ///< indices into the parcel list
+  std::vector<Polygon> parts;  ///< usually one polygon; holes kept
+  std::vector<int> parcels;    ///< indices into the parcel list
   /// Stable key: setKey of its member parcels' keys (see Keys.h), so neither
   /// the order of features nor any other block changes it.
   Key key = 0;

@@ -24,14 +24,14 @@
 namespace parcelscope::generation {
 
 struct ObbParameters {
-  double aMin = 200;         ///< m², smallest parcel area a split may create
-  double aMax = 800;         ///< m², parcels above this are split
-  double wMin = 8;           ///< m, smallest parcel width (OBB short side) a split may create
-  double wMax = 30;          ///< m, parcels wider than this are split
-  double omega = 0.3;        ///< split irregularity in [0, 1]: random shift of the split line
-  double xi = 1.0;           ///< street-access preference in [0, 1]
-  double snapDistance = 2.0; ///< m, split lines this close to a block contour vertex pass through it
-  double minFrontage = 1.0;  ///< m of block contour a parcel needs to count as having street access
+  double aMin = 200;          ///< m², smallest parcel area a split may create
+  double aMax = 800;          ///< m², parcels above this are split
+  double wMin = 8;            ///< m, smallest parcel width (OBB short side) a split may create
+  double wMax = 30;           ///< m, parcels wider than this are split
+  double omega = 0.3;         ///< split irregularity in [0, 1]: random shift of the split line
+  double xi = 1.0;            ///< street-access preference in [0, 1]
+  double snapDistance = 2.0;  ///< m, split lines this close to a block contour vertex pass through it
+  double minFrontage = 1.0;   ///< m of block contour a parcel needs to count as having street access
 };
 
 /// The descriptions of every OBB parameter (CLI flags, GUI controls, run record),
@@ -53,14 +53,14 @@ struct ObbSplits;
 struct SkeletonLayout;
 
 struct Subdivision {
-  std::vector<Polygon> parcels;   ///< tile the block (normalised, local metres)
-  int oversize = 0;               ///< parcels above A_max or W_max with no admissible split
-  int withoutAccess = 0;          ///< parcels without street access
-  bool failed = false;            ///< the block could not be split (invalid for exact geometry); parcels = {block}
-  std::string failure;            ///< why, when failed
-  bool fallback = false;          ///< another style could not subdivide the block; OBB did
-  std::string fallbackReason;     ///< why, when fallback
-  int patioParcels = 0;           ///< parcels that are (parts of) inner patios, without street access by design
+  std::vector<Polygon> parcels;  ///< tile the block (normalised, local metres)
+  int oversize = 0;              ///< parcels above A_max or W_max with no admissible split
+  int withoutAccess = 0;         ///< parcels without street access
+  bool failed = false;           ///< the block could not be split (invalid for exact geometry); parcels = {block}
+  std::string failure;           ///< why, when failed
+  bool fallback = false;         ///< another style could not subdivide the block; OBB did
+  std::string fallbackReason;    ///< why, when fallback
+  int patioParcels = 0;          ///< parcels that are (parts of) inner patios, without street access by design
   std::shared_ptr<const ObbSplits> obbSplits;  ///< OBB only, when asked to record them
   /// OBB only: 1 when the block has no holes and a strictly simple ring, 0
   /// when not, -1 when it was not tested (for ObbReuse::blockSimple).

@@ -57,9 +57,9 @@ namespace parcelscope::generation {
 enum class CornerRule { StreetWidth, StreetLength };
 
 struct SkeletonParameters {
-  ObbParameters bounds;       ///< A_min, A_max, W_min, W_max, omega; xi and snap apply to OBB patios
-  double offset = 0;          ///< d_offset in m; 0 means infinite (no patio)
-  double streetAngle = 30;    ///< degrees; contour corners turning less continue the same logical street
+  ObbParameters bounds;     ///< A_min, A_max, W_min, W_max, omega; xi and snap apply to OBB patios
+  double offset = 0;        ///< d_offset in m; 0 means infinite (no patio)
+  double streetAngle = 30;  ///< degrees; contour corners turning less continue the same logical street
   CornerRule corner = CornerRule::StreetWidth;
   bool subdividePatios = false;  ///< patios subdivided with the OBB style instead of one parcel each
 };

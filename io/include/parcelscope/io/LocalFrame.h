@@ -26,8 +26,8 @@ public:
   /// Transverse Mercator centred on (lon0, lat0) in degrees, on the ellipsoid
   /// with semi-major axis `a` (m) and flattening `f`. Input coordinates are in
   /// units of `degreesPerUnit` degrees (0.9 for grads).
-  static LocalFrame geographic(double lon0, double lat0, double a = 6378137.0,
-                               double f = 1.0 / 298.257223563, double degreesPerUnit = 1.0);
+  static LocalFrame geographic(double lon0, double lat0, double a = 6378137.0, double f = 1.0 / 298.257223563,
+                               double degreesPerUnit = 1.0);
   /// Projected coordinates in a unit of `metresPerUnit` metres, origin moved to (x0, y0).
   static LocalFrame projected(double metresPerUnit, double x0, double y0);
 
@@ -41,9 +41,9 @@ public:
 
 private:
   std::shared_ptr<const GeographicLib::TransverseMercator> tm_;
-  double lon0_ = 0, lat0_ = 0;   // geographic: centre in degrees
-  double x0_ = 0, y0_ = 0;       // geographic: projected centre (m); projected: origin (units)
-  double unit_ = 1.0;            // projected: metres per unit; geographic: degrees per unit
+  double lon0_ = 0, lat0_ = 0;  // geographic: centre in degrees
+  double x0_ = 0, y0_ = 0;      // geographic: projected centre (m); projected: origin (units)
+  double unit_ = 1.0;           // projected: metres per unit; geographic: degrees per unit
 };
 
 }  // namespace parcelscope::io

@@ -32,25 +32,25 @@ struct ReadOptions {
 };
 
 struct CleaningReport {
-  std::int64_t features = 0;            ///< features read (after --where)
-  std::int64_t nullOrEmpty = 0;         ///< skipped: null or empty geometry
-  std::int64_t nonPolygonal = 0;        ///< skipped: points or lines only
-  std::int64_t nonPolygonalParts = 0;   ///< point or line members dropped from mixed collections
-  std::int64_t nonFiniteSkipped = 0;    ///< skipped: a NaN or infinite coordinate (any vertex), or beyond 1e12
-  std::int64_t multipartFeatures = 0;   ///< multipolygon features with more than one part
-  std::int64_t partsFromMultipart = 0;  ///< parcels those features were split into (after repair)
-  std::int64_t withHoles = 0;           ///< parcels that keep one or more holes
-  std::int64_t invalidRepaired = 0;     ///< invalid polygons repaired by make-valid
-  std::int64_t invalidSkipped = 0;      ///< invalid polygons make-valid could not save
-  std::int64_t degenerateSkipped = 0;   ///< parts under 0.001 m² or with fewer than 3 vertices
-  std::int64_t duplicatesCollapsed = 0; ///< features dropped as exact copies of another
-  std::int64_t duplicateStacks = 0;     ///< distinct geometries that had copies
-  std::int64_t parcels = 0;             ///< parcels kept
+  std::int64_t features = 0;             ///< features read (after --where)
+  std::int64_t nullOrEmpty = 0;          ///< skipped: null or empty geometry
+  std::int64_t nonPolygonal = 0;         ///< skipped: points or lines only
+  std::int64_t nonPolygonalParts = 0;    ///< point or line members dropped from mixed collections
+  std::int64_t nonFiniteSkipped = 0;     ///< skipped: a NaN or infinite coordinate (any vertex), or beyond 1e12
+  std::int64_t multipartFeatures = 0;    ///< multipolygon features with more than one part
+  std::int64_t partsFromMultipart = 0;   ///< parcels those features were split into (after repair)
+  std::int64_t withHoles = 0;            ///< parcels that keep one or more holes
+  std::int64_t invalidRepaired = 0;      ///< invalid polygons repaired by make-valid
+  std::int64_t invalidSkipped = 0;       ///< invalid polygons make-valid could not save
+  std::int64_t degenerateSkipped = 0;    ///< parts under 0.001 m² or with fewer than 3 vertices
+  std::int64_t duplicatesCollapsed = 0;  ///< features dropped as exact copies of another
+  std::int64_t duplicateStacks = 0;      ///< distinct geometries that had copies
+  std::int64_t parcels = 0;              ///< parcels kept
 };
 
 struct CrsInfo {
-  std::string wkt;          ///< CRS of the input (or of --crs); empty when none was declared
-  std::string name;         ///< human-readable name, e.g. "WGS 84" or "assumed OGC:CRS84"
+  std::string wkt;             ///< CRS of the input (or of --crs); empty when none was declared
+  std::string name;            ///< human-readable name, e.g. "WGS 84" or "assumed OGC:CRS84"
   bool assumedLonLat = false;  ///< no CRS declared; coordinates look like degrees
   bool overridden = false;     ///< came from --crs
 };

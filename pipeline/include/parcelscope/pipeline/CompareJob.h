@@ -20,8 +20,8 @@
 namespace parcelscope::pipeline {
 
 struct CompareRequest {
-  io::ReadOptions input;         ///< observed parcels
-  std::string style = "obb";     ///< generator style, passed to pipeline::GenerateRequest::style
+  io::ReadOptions input;      ///< observed parcels
+  std::string style = "obb";  ///< generator style, passed to pipeline::GenerateRequest::style
   /// Values named as in compareParameters() (analysis, generator and comparison).
   ParameterValues parameters;
   /// Names the user set explicitly: a generator bound given here overrides the per-block ones.

@@ -29,7 +29,7 @@ public:
 
   struct Update {
     std::shared_ptr<const CompareResult> result;
-    bool reloaded = false;            ///< the input was read and analysed again
+    bool reloaded = false;              ///< the input was read and analysed again
     std::size_t blocksRegenerated = 0;  ///< block entries subdivided by this update
     std::size_t blocksTotal = 0;
     double seconds = 0;

@@ -11,12 +11,12 @@
 #include <vector>
 
 #include "parcelscope/analysis/ObservedAnalysis.h"
-#include "parcelscope/pipeline/StatsJob.h"
 #include "parcelscope/core/Json.h"
 #include "parcelscope/generation/ObbSubdivision.h"
 #include "parcelscope/generation/SkeletonSubdivision.h"
 #include "parcelscope/generation/Styles.h"
 #include "parcelscope/io/ParcelReader.h"
+#include "parcelscope/pipeline/StatsJob.h"
 
 namespace parcelscope::pipeline {
 
@@ -66,23 +66,23 @@ struct GenerateRequest {
 struct GeneratedParcels {
   /// The input as read (frame, CRS, cleaning report), shared with the BlockInputs it came from.
   std::shared_ptr<const io::ParcelLayer> source;
-  std::vector<Block> blocks;              ///< block outlines; `parcels` index `parcels` below
-  std::vector<std::int64_t> blockIds;     ///< id of each entry of `blocks` (ids repeat for multipart blocks)
-  std::vector<Key> blockKeys;             ///< stable key of each entry of `blocks` (repeats as ids do)
-  std::vector<Polygon> parcels;           ///< generated parcels, local metres
+  std::vector<Block> blocks;           ///< block outlines; `parcels` index `parcels` below
+  std::vector<std::int64_t> blockIds;  ///< id of each entry of `blocks` (ids repeat for multipart blocks)
+  std::vector<Key> blockKeys;          ///< stable key of each entry of `blocks` (repeats as ids do)
+  std::vector<Polygon> parcels;        ///< generated parcels, local metres
   std::vector<analysis::ParcelMetrics> metrics;
   /// Entries of `blocks` whose outcome was measured by shape only (see
   /// BlockReuse::shapesOnly): neighbours, frontage and street access of their
   /// parcels are not known yet (left at 0). Empty: every parcel fully measured.
   std::vector<std::size_t> contextPending;
   std::int64_t failedBlocks = 0, oversize = 0, withoutAccess = 0;
-  std::int64_t clampedBounds = 0;         ///< per-block bounds moved into the parameter ranges
-  std::int64_t fallbackBlocks = 0;        ///< skeleton blocks subdivided with OBB instead
-  std::int64_t patioParcels = 0;          ///< parcels that are (parts of) patios
-  std::vector<std::string> blockStyles;   ///< style each entry of `blocks` was subdivided with
-  std::vector<std::string> failures;      ///< one line per failed or fallen-back block
+  std::int64_t clampedBounds = 0;        ///< per-block bounds moved into the parameter ranges
+  std::int64_t fallbackBlocks = 0;       ///< skeleton blocks subdivided with OBB instead
+  std::int64_t patioParcels = 0;         ///< parcels that are (parts of) patios
+  std::vector<std::string> blockStyles;  ///< style each entry of `blocks` was subdivided with
+  std::vector<std::string> failures;     ///< one line per failed or fallen-back block
   std::uint64_t seed = 0;
-  Timings timings;                        ///< "subdivide" and "measure"
+  Timings timings;  ///< "subdivide" and "measure"
 };
 
 /// The blocks of a run before any style or parameter is chosen: each block
@@ -173,8 +173,8 @@ GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<Bl
                                  const std::vector<const BlockOutcome*>& outcomes, std::uint64_t seed);
 
 /// Reads the input and subdivides every block (in parallel) with the request's
-/// style: prepareBlocks, planBlocks, runBlock on every entry, assembleParcels. Throws Error on bad input or parameters (A_min > A_max, W_min > W_max,
-/// unknown style).
+/// style: prepareBlocks, planBlocks, runBlock on every entry, assembleParcels. Throws Error on bad input or parameters
+/// (A_min > A_max, W_min > W_max, unknown style).
 GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& progress = {});
 
 /// The generated parcels as parcels.gpkg and parcels.csv hold them: one row per

@@ -36,8 +36,7 @@ struct QuantityHistogram {
 /// out, so one new text per redraw soon made it draw every label again).
 enum class HistogramTexts { WithNumbers, Steady };
 QuantityHistogram quantityHistogram(const CompareResult& result, const CompareRequest& request,
-                                    const std::string& quantity,
-                                    HistogramTexts texts = HistogramTexts::WithNumbers);
+                                    const std::string& quantity, HistogramTexts texts = HistogramTexts::WithNumbers);
 
 /// The figures of `compare`, one at a time (the GUI exports what it shows with
 /// these): observed and procedural parcels side by side coloured by
@@ -45,8 +44,8 @@ QuantityHistogram quantityHistogram(const CompareResult& result, const CompareRe
 /// blue); the blocks coloured by the KS statistic of area. Throw as renderMaps.
 void renderQuantityMap(const CompareResult& result, const CompareRequest& request, const std::string& quantity,
                        const FigureOutput& output);
-void renderQuantityHistogram(const CompareResult& result, const CompareRequest& request,
-                             const std::string& quantity, const FigureOutput& output);
+void renderQuantityHistogram(const CompareResult& result, const CompareRequest& request, const std::string& quantity,
+                             const FigureOutput& output);
 void renderBlocksMap(const CompareResult& result, const CompareRequest& request, const FigureOutput& output);
 
 /// The figures a result can be exported as: map_<quantity> and hist_<quantity>
