@@ -439,6 +439,9 @@ void MainWindow::buildMenus() {
   recentMenu_->setToolTipsVisible(true);
   refreshRecent();
   setCrsAction_ = file->addAction("Set input &CRS...", this, [this] { askForCrs(); });
+  filterAction_ = file->addAction("&Filter features...", this, [this] { askForFilter(); });
+  filterAction_->setObjectName("filterAction");
+  filterAction_->setToolTip("Keep only the features whose attributes match a filter (the command line's --where)");
   file->addSeparator();
   file->addAction("Open session...", this, [this] {
     const QString path = QFileDialog::getOpenFileName(this, "Open session", {}, "ParcelScope session (*.json)");
@@ -485,6 +488,23 @@ void MainWindow::askForCrs() {
   if (const pipeline::CompareRequest* failed = controller_.failedRequest()) return askForCrs(failed->input);
   if (!controller_.loaded()) return showError("open a dataset first");
   askForCrs(controller_.request().input);
+}
+
+void MainWindow::askForFilter() {
+  if (!controller_.loaded()) return showError("open a dataset first");
+  bool ok = false;
+  const QString where = QInputDialog::getText(
+      this, "Filter features",
+      "Keep the features whose attributes match (OGR SQL, e.g. use <> 'ROW'); empty: every feature", QLineEdit::Normal,
+      QString::fromStdString(controller_.request().input.where), &ok);
+  if (ok) setFilter(where.trimmed());
+}
+
+void MainWindow::setFilter(const QString& where) {
+  if (!controller_.loaded()) return showError("open a dataset first");
+  const io::ReadOptions& input = controller_.request().input;
+  openFile(QString::fromStdString(input.path), QString::fromStdString(input.layer), where,
+           QString::fromStdString(input.crsOverride));
 }
 
 void MainWindow::askForCrs(const io::ReadOptions& input) {
@@ -1065,6 +1085,7 @@ void MainWindow::updateActions() {
   for (QAction* a : exportMenu_->actions()) a->setEnabled(result);
   zoomToExtentAction_->setEnabled(extent_.has_value() && controller_.shownResult() != nullptr);
   setCrsAction_->setEnabled(controller_.loaded() || controller_.failedRequest());
+  filterAction_->setEnabled(controller_.loaded());
   const bool shown = controller_.shownResult() != nullptr;
   overrideBlock_->setEnabled(shown);
   clearOverride_->setEnabled(shown);

@@ -55,6 +55,9 @@ public:
   void openFile(const QString& path, const QString& layer = {}, const QString& where = {}, const QString& crs = {});
   /// Opens the bundled sample.
   void openSample();
+  /// Reads the open input again keeping only the features that match `where`
+  /// (an OGR SQL attribute filter, as the command line's --where; empty: all).
+  void setFilter(const QString& where);
   /// Restores input, parameters, overrides and seed from a session file.
   void openSession(const QString& path);
   void saveSession(const QString& path);
@@ -168,6 +171,8 @@ private:
   void askForCrs();
   /// Asks for a CRS and opens `input` again with it.
   void askForCrs(const io::ReadOptions& input);
+  /// File > Filter features: asks for an attribute filter for the open input.
+  void askForFilter();
 
   QThread thread_;
   SessionWorker* worker_;
@@ -214,6 +219,7 @@ private:
   std::map<std::string, std::pair<QCheckBox*, QDoubleSpinBox*>> blockParameters_;
   QMenu* recentMenu_;
   QAction* setCrsAction_;
+  QAction* filterAction_;
   QAction* saveSessionAction_;
   QMenu* exportMenu_;
   QAction* zoomToExtentAction_;

@@ -308,6 +308,31 @@ private slots:
     QVERIFY(settle());
   }
 
+  // File > Filter features does what --where does: the sample without its
+  // filter holds its right-of-way parcel too; a filter that fails leaves the
+  // last good state usable.
+  void aFilterKeepsTheMatchingFeaturesAsWhereDoes() {
+    window_->openSample();
+    QVERIFY(settle());
+    const auto filtered = window_->result();
+    window_->setFilter("");
+    QVERIFY(settle());
+    QVERIFY2(window_->lastError().isEmpty(), qPrintable(window_->lastError()));
+    QCOMPARE(window_->request().input.where, std::string());
+    QCOMPARE(window_->result()->observed->layer.parcels.size(), filtered->observed->layer.parcels.size() + 1);
+    window_->setFilter("use = 'residential'");
+    QVERIFY(settle());
+    QVERIFY2(window_->lastError().isEmpty(), qPrintable(window_->lastError()));
+    QCOMPARE(window_->result()->observed->layer.report.features, std::int64_t(146));
+    window_->setFilter("no_such_field = 2");
+    QVERIFY(settle());
+    QTRY_VERIFY_WITH_TIMEOUT(!window_->lastError().isEmpty(), 10000);
+    window_->setFilter("use <> 'ROW'");
+    QVERIFY(settle());
+    QVERIFY2(window_->lastError().isEmpty(), qPrintable(window_->lastError()));
+    QCOMPARE(window_->result()->observed->layer.parcels.size(), filtered->observed->layer.parcels.size());
+  }
+
   // The main window with the sample at seed 1 against a baseline screenshot;
   // PARCELSCOPE_UPDATE_BASELINES=1 makes the screenshot the baseline.
   void screenshotMatchesItsBaseline() {
