@@ -47,6 +47,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <tuple>
 #include <utility>
 
 #include "MapView.h"
@@ -354,6 +355,7 @@ QWidget* MainWindow::buildControls() {
   connect(colourBy_, &QComboBox::currentTextChanged, this, [this](const QString& q) { setColourBy(q); });
   form->addRow("colour by", colourBy_);
   perBlockBounds_ = new QCheckBox("per-block bounds (A-bar -/+ k s_A, W-bar -/+ k s_W)");
+  perBlockBounds_->setObjectName("perBlockBounds");
   perBlockBounds_->setChecked(true);
   perBlockBounds_->setToolTip(
       "Each block's A_min, A_max, W_min, W_max come from its observed parcels; "
@@ -401,17 +403,38 @@ QWidget* MainWindow::buildControls() {
     spin->setValue(d.defaultValue);
     spin->setEnabled(false);
     connect(check, &QCheckBox::toggled, spin, &QWidget::setEnabled);
+    check->setObjectName(QString("block-check-") + name);
+    spin->setObjectName(QString("block-spin-") + name);
     overrides->addRow(check, spin);
     blockParameters_[name] = {check, spin};
   }
   b->addLayout(overrides);
   auto* buttons = new QHBoxLayout;
   auto* apply = overrideBlock_ = new QPushButton("Override block");
+  apply->setObjectName("overrideBlock");
   auto* clear = clearOverride_ = new QPushButton("Clear override");
   connect(apply, &QPushButton::clicked, this, [this] {
     ParameterValues values;
     for (const auto& [name, widgets] : blockParameters_) {
       if (widgets.first->isChecked()) values[name] = widgets.second->value();
+    }
+    // A bound given below the block's other bound would silently move that one.
+    if (controller_.shownResult() && selected_ >= 0) {
+      auto value = [&](const std::string& name) {
+        const auto it = values.find(name);
+        return it != values.end() ? it->second : blockValue(*controller_.shownResult(), selected_, name);
+      };
+      for (const auto& [low, high, unit] :
+           {std::tuple{"a-min", "a-max", "m\u00b2"}, std::tuple{"w-min", "w-max", "m"}}) {
+        if ((values.count(low) || values.count(high)) && value(high) < value(low)) {
+          return showError(QString("%1 (%2 %3) is below the block's %4 (%5 %3): give both, or a larger %1")
+                               .arg(high)
+                               .arg(value(high))
+                               .arg(QString::fromUtf8(unit))
+                               .arg(low)
+                               .arg(value(low)));
+        }
+      }
     }
     overrideSelectedBlock(blockStyle_->currentIndex() == 0 ? QString() : blockStyle_->currentText(), values);
   });
@@ -1020,16 +1043,67 @@ void MainWindow::fillNumbers() {
   if (resized || longer) numbers_->resizeColumnsToContents();
 }
 
+double MainWindow::blockValue(const pipeline::CompareResult& r, int block, const std::string& name) const {
+  const pipeline::CompareRequest& request = controller_.request();
+  const Block& b = r.observed->analysis.blocks[block];
+  if (const auto o = request.overrides.find(b.key); o != request.overrides.end()) {
+    if (const auto v = o->second.parameters.find(name); v != o->second.parameters.end()) return v->second;
+  }
+  const analysis::BlockStatistics& s = r.observed->analysis.statistics[block];
+  const std::map<std::string, double> own = {
+      {"a-min", s.aMin}, {"a-max", s.aMax}, {"w-min", s.wMin}, {"w-max", s.wMax}};
+  const auto derived = own.find(name);
+  if (derived != own.end() && controller_.perBlockBounds() && !request.explicitParameters.count(name) &&
+      std::isfinite(derived->second)) {
+    const ParameterDescription& d = describe(name);
+    return std::clamp(derived->second, d.minimum, d.maximum);
+  }
+  const auto it = request.parameters.find(name);
+  return it != request.parameters.end() ? it->second : describe(name).defaultValue;
+}
+
+void MainWindow::fillOverridePanel(const pipeline::CompareResult& r) {
+  const Block& block = r.observed->analysis.blocks[selected_];
+  const auto o = controller_.request().overrides.find(block.key);
+  const bool overridden = o != controller_.request().overrides.end();
+  for (const auto& [name, widgets] : blockParameters_) {
+    const QSignalBlocker a(widgets.first), b(widgets.second);
+    const bool own = overridden && o->second.parameters.count(name);
+    widgets.first->setChecked(own);
+    widgets.second->setEnabled(own);
+    widgets.second->setValue(blockValue(r, selected_, name));
+  }
+  const QSignalBlocker c(blockStyle_);
+  const int style =
+      overridden && !o->second.style.empty() ? blockStyle_->findText(QString::fromStdString(o->second.style)) : 0;
+  blockStyle_->setCurrentIndex(std::max(0, style));
+  panelBlock_ = block.key;
+}
+
 void MainWindow::showBlock() {
   std::vector<const Polygon*> outline;
   if (!controller_.shownResult() || selected_ < 0) {
     observedView_->outline().setShapes(outline);
     proceduralView_->outline().setShapes(outline);
     setBlockInfo("Click a block in either view.");
+    if (panelBlock_ != 0) {  // no block: the panel shows the run's values again
+      for (const auto& [name, widgets] : blockParameters_) {
+        const QSignalBlocker x(widgets.first), y(widgets.second);
+        widgets.first->setChecked(false);
+        widgets.second->setEnabled(false);
+        const auto it = controller_.request().parameters.find(name);
+        widgets.second->setValue(it != controller_.request().parameters.end() ? it->second
+                                                                              : describe(name).defaultValue);
+      }
+      const QSignalBlocker z(blockStyle_);
+      blockStyle_->setCurrentIndex(0);
+      panelBlock_ = 0;
+    }
     return;
   }
   const pipeline::CompareResult& r = *controller_.shownResult();
   const Block& block = r.observed->analysis.blocks[selected_];
+  if (block.key != panelBlock_) fillOverridePanel(r);  // a new selection; edits in the panel stay otherwise
   for (const Polygon& part : block.parts) outline.push_back(&part);
   observedView_->outline().setShapes(outline);
   proceduralView_->outline().setShapes(outline);

@@ -217,6 +217,14 @@ private:
   QPushButton* overrideBlock_;
   QPushButton* clearOverride_;
   std::map<std::string, std::pair<QCheckBox*, QDoubleSpinBox*>> blockParameters_;
+  /// The block whose values the override panel shows (0: none yet).
+  Key panelBlock_ = 0;
+  /// The value block `block` (an index into the observed blocks) is subdivided
+  /// with for parameter `name`: its override's, else its own derived bound
+  /// (with per-block bounds, for a bound the user did not set), else the run's.
+  double blockValue(const pipeline::CompareResult& result, int block, const std::string& name) const;
+  /// Fills the override panel with the selected block's values.
+  void fillOverridePanel(const pipeline::CompareResult& result);
   QMenu* recentMenu_;
   QAction* setCrsAction_;
   QAction* filterAction_;

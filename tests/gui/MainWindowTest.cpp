@@ -333,6 +333,50 @@ private slots:
     QCOMPARE(window_->result()->observed->layer.parcels.size(), filtered->observed->layer.parcels.size());
   }
 
+  // The block panel shows the selected block's own values (its derived bounds
+  // under per-block bounds), follows the selection, and refuses a W_max below
+  // the block's W_min instead of moving W_min without a word.
+  void theOverridePanelFollowsTheBlockAndRefusesCrossedBounds() {
+    window_->openSample();
+    QVERIFY(settle());
+    auto* perBlock = window_->findChild<QCheckBox*>("perBlockBounds");
+    QVERIFY(perBlock);
+    const bool wasPerBlock = perBlock->isChecked();
+    if (!perBlock->isChecked()) {
+      perBlock->setChecked(true);
+      QVERIFY(settle());
+    }
+    QVERIFY(window_->controller().perBlockBounds());
+    const auto r = window_->result();
+    auto* wMin = window_->findChild<QDoubleSpinBox*>("block-spin-w-min");
+    auto* wMax = window_->findChild<QDoubleSpinBox*>("block-spin-w-max");
+    auto* wMaxCheck = window_->findChild<QCheckBox*>("block-check-w-max");
+    auto* apply = window_->findChild<QPushButton*>("overrideBlock");
+    QVERIFY(wMin && wMax && wMaxCheck && apply);
+    for (int b : {2, 5}) {
+      window_->selectBlock(b);
+      QVERIFY(settle());
+      const auto& s = r->observed->analysis.statistics[b];
+      QCOMPARE(wMin->value(), std::round(s.wMin * 100) / 100);  // the spin box shows two decimals
+      QCOMPARE(wMax->value(), std::round(s.wMax * 100) / 100);
+    }
+    const auto overridesBefore = window_->request().overrides.size();
+    wMaxCheck->setChecked(true);
+    wMax->setValue(wMin->value() / 2);
+    apply->click();
+    QTRY_VERIFY_WITH_TIMEOUT(window_->lastError().contains("w-max"), 5000);
+    QVERIFY2(window_->lastError().contains("below the block's w-min"), qPrintable(window_->lastError()));
+    QCOMPARE(window_->request().overrides.size(), overridesBefore);
+    wMaxCheck->setChecked(false);
+    window_->selectBlock(-1);
+    QVERIFY(settle());
+    QCOMPARE(wMax->value(), std::round(window_->request().parameters.at("w-max") * 100) / 100);
+    if (!wasPerBlock) {
+      perBlock->setChecked(false);
+      QVERIFY(settle());
+    }
+  }
+
   // The main window with the sample at seed 1 against a baseline screenshot;
   // PARCELSCOPE_UPDATE_BASELINES=1 makes the screenshot the baseline.
   void screenshotMatchesItsBaseline() {
