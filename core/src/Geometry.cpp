@@ -90,6 +90,14 @@ void dedupe(Ring& r) {
 }
 }  // namespace
 
+bool sameVertices(const Polygon& a, const Polygon& b) {
+  auto same = [](const Ring& x, const Ring& y) {
+    return std::equal(x.begin(), x.end(), y.begin(), y.end(),
+                      [](const Point& p, const Point& q) { return p.x == q.x && p.y == q.y; });
+  };
+  return same(a.outer, b.outer) && std::equal(a.holes.begin(), a.holes.end(), b.holes.begin(), b.holes.end(), same);
+}
+
 bool normalise(Polygon& polygon) {
   dedupe(polygon.outer);
   if (polygon.outer.size() < 3 || signedArea(polygon.outer) == 0.0) return false;

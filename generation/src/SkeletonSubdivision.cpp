@@ -1136,12 +1136,13 @@ bool sameBlock(const Polygon& a, const Polygon& b) {
          std::equal(a.holes.begin(), a.holes.end(), b.holes.begin(), b.holes.end(), sameRingBits);
 }
 
-bool sameWidths(const StreetWidths& a, const StreetWidths& b) {
+}  // namespace
+
+bool sameStreetWidths(const StreetWidths& a, const StreetWidths& b) {
   return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const auto& x, const auto& y) {
     return std::equal(x.begin(), x.end(), y.begin(), y.end(), sameBits);
   });
 }
-}  // namespace
 
 bool skeletonLayoutReusable(const SkeletonParameters& recorded, const SkeletonParameters& wanted) {
   return sameBits(recorded.offset, wanted.offset) && sameBits(recorded.streetAngle, wanted.streetAngle) &&
@@ -1155,7 +1156,7 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
   p.bounds.wMax = std::max(p.bounds.wMax, p.bounds.wMin);
   auto layout = std::make_shared<SkeletonLayout>();
   const SkeletonLayout* previous = reuse.previous;
-  if (previous && sameBlock(previous->block, block) && sameWidths(previous->widths, streetWidths)) {
+  if (previous && sameBlock(previous->block, block) && sameStreetWidths(previous->widths, streetWidths)) {
     layout->attempts = previous->attempts;
     // The skeleton (step 1) depends on the block and widths alone; the strips
     // also on d_offset, the street angle and the corner rule.

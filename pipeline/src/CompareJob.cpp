@@ -136,8 +136,7 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
   // Generated entries go to the observed block of their key; a block of the
   // source that no observed block matches (no observed parcels) is compared
   // as such, after the observed ones, with an empty observed side.
-  std::map<Key, std::size_t> observedBlock;
-  for (std::size_t b = 0; b < a.blocks.size(); ++b) observedBlock.emplace(a.blocks[b].key, b);
+  std::map<Key, std::size_t> observedBlock;  // made on first need: blocks from the observed parcels match by id
   std::vector<std::vector<int>> generatedIn(a.blocks.size());
   std::vector<std::size_t> blockOfEntry(r.generated.blocks.size());
   struct Unmatched {
@@ -154,8 +153,11 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
     std::size_t b = a.blocks.size();
     if (id >= 0 && id < static_cast<std::int64_t>(a.blocks.size()) && a.blocks[id].key == key) {
       b = static_cast<std::size_t>(id);  // blocks made from the observed parcels themselves
-    } else if (const auto found = observedBlock.find(key); found != observedBlock.end()) {
-      b = found->second;
+    } else {
+      if (observedBlock.empty()) {
+        for (std::size_t o = 0; o < a.blocks.size(); ++o) observedBlock.emplace(a.blocks[o].key, o);
+      }
+      if (const auto found = observedBlock.find(key); found != observedBlock.end()) b = found->second;
     }
     if (b < a.blocks.size()) {
       blockOfEntry[k] = b;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <cmath>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -73,24 +72,6 @@ void measureDeferred(const pipeline::BlockInputs& inputs,
                : std::function<void(std::size_t)>());
 }
 
-bool sameRing(const Ring& a, const Ring& b) {
-  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
-                    [](const Point& p, const Point& q) { return p.x == q.x && p.y == q.y; });
-}
-
-bool sameShape(const Polygon& a, const Polygon& b) {
-  return sameRing(a.outer, b.outer) &&
-         std::equal(a.holes.begin(), a.holes.end(), b.holes.begin(), b.holes.end(), sameRing);
-}
-
-// Street widths equal value for value, unknown (NaN) ones included.
-bool sameWidths(const generation::StreetWidths& a, const generation::StreetWidths& b) {
-  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const auto& x, const auto& y) {
-    return std::equal(x.begin(), x.end(), y.begin(), y.end(),
-                      [](double u, double v) { return u == v || (std::isnan(u) && std::isnan(v)); });
-  });
-}
-
 // Fills `outcomes` and `done` of the new entries from the old ones that hold
 // the same block part (key and part), shape and plan.
 void carryOver(const pipeline::BlockInputs& oldInputs, const std::vector<pipeline::BlockPlan>& oldPlans,
@@ -106,11 +87,11 @@ void carryOver(const pipeline::BlockInputs& oldInputs, const std::vector<pipelin
     const auto it = old.find({e.blockKey, e.part});
     if (it == old.end()) continue;
     const std::size_t j = it->second;
-    if (!oldOutcomes[j] || oldPlans[j] != plans[k] || !sameShape(oldInputs.entries[j].shape, e.shape)) continue;
+    if (!oldOutcomes[j] || oldPlans[j] != plans[k] || !sameVertices(oldInputs.entries[j].shape, e.shape)) continue;
     if (generation::style(plans[k].style).usesStreetWidths()) {
       const bool widths = inputs.widths.size() == inputs.entries.size() &&
                           oldInputs.widths.size() == oldInputs.entries.size() &&
-                          sameWidths(inputs.widths[k], oldInputs.widths[j]);
+                          generation::sameStreetWidths(inputs.widths[k], oldInputs.widths[j]);
       if (!widths) continue;
     }
     outcomes[k] = oldOutcomes[j];

@@ -220,16 +220,8 @@ std::vector<analysis::ParcelMetrics> measureEntry(const BlockInputs& inputs, std
 }  // namespace
 
 namespace {
-bool sameRing(const Ring& a, const Ring& b) {
-  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
-                    [](const Point& p, const Point& q) { return p.x == q.x && p.y == q.y; });
-}
-
 bool sameParcels(const std::vector<Polygon>& a, const std::vector<Polygon>& b) {
-  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const Polygon& p, const Polygon& q) {
-    return sameRing(p.outer, q.outer) &&
-           std::equal(p.holes.begin(), p.holes.end(), q.holes.begin(), q.holes.end(), sameRing);
-  });
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(), sameVertices);
 }
 }  // namespace
 

@@ -54,6 +54,10 @@ Point centroid(const Polygon& polygon);
 /// (fewer than 3 distinct vertices or zero area).
 bool normalise(Polygon& polygon);
 
+/// True when `a` and `b` have the same rings with the same coordinates, vertex
+/// for vertex (exact comparison: a result that may be reused for the other).
+bool sameVertices(const Polygon& a, const Polygon& b);
+
 /// Even-odd point-in-ring test; points on the boundary may go either way.
 bool pointInRing(const Point& p, const Ring& ring);
 /// True when `p` is inside the outer ring and outside every hole.

@@ -75,6 +75,8 @@ SkeletonParameters skeletonParametersFrom(const ParameterValues& values);
 /// for the edge from vertex i to i+1 of ring r (0 the outer ring, then the
 /// holes, as in the normalised block); NaN or missing entries are unknown.
 using StreetWidths = std::vector<std::vector<double>>;
+/// True when `a` and `b` hold the same widths, bit for bit (unknown ones included).
+bool sameStreetWidths(const StreetWidths& a, const StreetWidths& b);
 
 /// Steps 1 to 3 (the skeleton, the strips and their corner transfers) depend
 /// on the block, its street widths, d_offset, the street angle and the corner
