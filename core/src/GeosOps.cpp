@@ -223,6 +223,42 @@ std::vector<Polygon> validParts(const Polygon& polygon) {
   return out;
 }
 
+std::optional<Polygon> unionIfOne(const Polygon& a, const Polygon& b) {
+  Geom ga = toGeos(a), gb = toGeos(b);
+  if (!ga || !gb) return std::nullopt;
+  Geom u(GEOSUnion_r(context(), ga.get(), gb.get()));
+  if (!valid(u.get())) return std::nullopt;
+  std::vector<Polygon> parts;
+  collectPolygons(u.get(), parts);
+  if (parts.size() != 1) return std::nullopt;
+  return std::move(parts.front());
+}
+
+std::vector<Polygon> validMultiPolygon(std::vector<Polygon> parts, bool& repaired, double minShare) {
+  repaired = false;
+  GEOSContextHandle_t ctx = context();
+  std::vector<const Polygon*> pointers;
+  for (const Polygon& p : parts) pointers.push_back(&p);
+  Geom geometry = parts.size() == 1 ? toGeos(parts.front()) : toGeos(pointers);
+  if (valid(geometry.get())) return parts;
+  repaired = true;
+  std::vector<Polygon> out;
+  if (!geometry) return out;
+  GEOSMakeValidParams* params = GEOSMakeValidParams_create_r(ctx);
+  GEOSMakeValidParams_setMethod_r(ctx, params, GEOS_MAKE_VALID_STRUCTURE);
+  GEOSMakeValidParams_setKeepCollapsed_r(ctx, params, 0);
+  Geom fixed(GEOSMakeValidWithParams_r(ctx, geometry.get(), params));
+  GEOSMakeValidParams_destroy_r(ctx, params);
+  if (fixed) collectPolygons(fixed.get(), out);
+  double total = 0;
+  for (const Polygon& p : out) total += area(p);
+  std::vector<Polygon> kept;
+  for (Polygon& p : out) {
+    if (area(p) >= minShare * total) kept.push_back(std::move(p));
+  }
+  return kept;
+}
+
 double intersectionArea(const Polygon& a, const Polygon& b) {
   // Snap-rounded overlay on a 1e-6 m grid: floating overlay (GEOS 3.11) can
   // return a whole polygon as the intersection of two polygons whose shared

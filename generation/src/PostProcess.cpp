@@ -1,6 +1,9 @@
 #include "PostProcess.h"
 
 #include <cmath>
+#include <optional>
+
+#include "parcelscope/analysis/Metrics.h"
 
 #include "parcelscope/core/GeosOps.h"
 
@@ -14,6 +17,59 @@ void checkTiling(const Polygon& block, const Subdivision& out) {
   }
   const double a = area(block);
   if (std::fabs(sum - a) > 1e-9 * a) throw StyleFailure("the parcels do not sum to the block's area");
+}
+
+namespace {
+bool isSliver(const Polygon& p) {
+  const double perim = perimeter(p);
+  return perim > 0 && 2 * area(p) / perim < kMinParcelWidth;
+}
+
+}  // namespace
+
+int mergeSlivers(const Polygon& block, Subdivision& out, double minFrontage) {
+  int left = 0;
+  const Polygon outline{block.outer, {}};
+  for (std::size_t i = 0; i < out.parcels.size();) {
+    const Polygon& sliver = out.parcels[i];
+    if (!isSliver(sliver)) {
+      ++i;
+      continue;
+    }
+    // The neighbour sharing the most boundary: the union's perimeter is the
+    // two perimeters less twice the shared length.
+    const Box box = bounds(sliver).expanded(kMinParcelWidth);
+    const double sliverPerimeter = perimeter(sliver);
+    std::size_t best = out.parcels.size();
+    double bestShared = 0;
+    std::optional<Polygon> bestUnion;
+    for (std::size_t j = 0; j < out.parcels.size(); ++j) {
+      if (j == i || !box.intersects(bounds(out.parcels[j]))) continue;
+      std::optional<Polygon> u = geos::unionIfOne(out.parcels[j], sliver);
+      if (!u) continue;
+      const double shared = 0.5 * (perimeter(out.parcels[j]) + sliverPerimeter - perimeter(*u));
+      if (shared > bestShared) {
+        best = j;
+        bestShared = shared;
+        bestUnion = std::move(u);
+      }
+    }
+    if (!bestUnion) {
+      ++left;
+      ++i;
+      continue;
+    }
+    const std::size_t firstPatio = out.parcels.size() - static_cast<std::size_t>(out.patioParcels);
+    if (i >= firstPatio) {
+      --out.patioParcels;
+    } else if (out.withoutAccess > 0 &&
+               analysis::sharedBoundaryLength(sliver, outline, kMinParcelWidth) < minFrontage) {
+      --out.withoutAccess;
+    }
+    out.parcels[best] = std::move(*bestUnion);
+    out.parcels.erase(out.parcels.begin() + static_cast<long>(i));
+  }
+  return left;
 }
 
 Subdivision fallBackToObb(const Polygon& block, const ObbParameters& bounds, std::uint64_t seed,

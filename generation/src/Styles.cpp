@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "PostProcess.h"
 #include "parcelscope/analysis/ObservedAnalysis.h"
 #include "parcelscope/core/Error.h"
 
@@ -47,11 +48,21 @@ ParameterValues styleValues(const Style& s, const ParameterValues& values) {
   return out;
 }
 
+Subdivision Style::subdivide(const StyleRun& r) const {
+  Subdivision out = run(r);
+  const ObbParameters bounds = obbParametersFrom(r.values);
+  if (detail::mergeSlivers(r.block, out, bounds.minFrontage) > 0 && name() != obbStyle().name()) {
+    out = detail::fallBackToObb(r.block, bounds, r.seed, "a sliver parcel no neighbour could take");
+    detail::mergeSlivers(r.block, out, bounds.minFrontage);
+  }
+  return out;
+}
+
 Subdivision subdivideBlock(const Polygon& block, const std::string& name, const ParameterValues& values,
                            std::uint64_t seed, const StreetWidths& streetWidths) {
   const Style& s = style(name);
   if (&s.resolve({std::nan("")}) != &s) throw usageError("style " + name + " chooses per block; name a concrete one");
-  return s.run({block, values, seed, streetWidths});
+  return s.subdivide({block, values, seed, streetWidths});
 }
 
 namespace {

@@ -12,6 +12,7 @@
 
 #include "OgrConvert.h"
 #include "parcelscope/core/Error.h"
+#include "parcelscope/core/GeosOps.h"
 #include "parcelscope/core/Parallel.h"
 
 namespace parcelscope::io {
@@ -118,9 +119,9 @@ Json readJson(const std::string& path) {
   return fromCpl(doc.GetRoot());
 }
 
-void writePolygonLayer(const std::string& path, const std::string& layerName,
-                       const std::vector<std::vector<Polygon>>& geometries, const Table& attributes,
-                       const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex) {
+LayerWrite writePolygonLayer(const std::string& path, const std::string& layerName,
+                             const std::vector<std::vector<Polygon>>& geometries, const Table& attributes,
+                             const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex) {
   detail::ensureGdalRegistered();
   detail::QuietErrors quiet;
   CPLErrorReset();
@@ -157,9 +158,12 @@ void writePolygonLayer(const std::string& path, const std::string& layerName,
     if (layer->CreateField(&field) != OGRERR_NONE) throw fail("cannot create field " + c.name);
   }
   if (!geojson && ds->StartTransaction() != OGRERR_NONE) throw fail("cannot start transaction");
-  // Geometries are converted and taken back to the source CRS in batches on a
-  // second thread while this one inserts the batch before.
+  // Geometries are taken back to the source CRS, checked and repaired there,
+  // and converted in batches on a second thread while this one inserts the
+  // batch before.
   constexpr std::size_t kBatch = 4096;
+  LayerWrite report;
+  report.features = static_cast<std::int64_t>(geometries.size());
   using Batch = std::vector<std::unique_ptr<OGRMultiPolygon>>;
   auto prepare = [&](std::size_t from) {
     Batch batch;
@@ -171,6 +175,12 @@ void writePolygonLayer(const std::string& path, const std::string& layerName,
         for (Point& q : p.outer) q = frame.toSource(q);
         for (Ring& h : p.holes)
           for (Point& q : h) q = frame.toSource(q);
+      }
+      bool repaired = false;
+      parts = geos::validMultiPolygon(std::move(parts), repaired);
+      if (repaired) {
+        ++report.repaired;
+        report.emptied += parts.empty();
       }
       batch.push_back(detail::toOgr(parts));
     }
@@ -203,6 +213,7 @@ void writePolygonLayer(const std::string& path, const std::string& layerName,
   if (!geojson && ds->CommitTransaction() != OGRERR_NONE) throw fail("cannot commit");
   ds.reset();  // flush and close before the caller renames the file
   if (CPLGetLastErrorType() == CE_Failure) throw fail("closing failed");
+  return report;
 }
 
 std::string gdalVersion() { return GDALVersionInfo("RELEASE_NAME"); }

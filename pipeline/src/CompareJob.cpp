@@ -354,22 +354,22 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
   std::vector<std::vector<Polygon>> outlines;
   for (const Block& b : a.blocks) outlines.push_back(b.parts);
   const std::string blocksCsv = out.stage("blocks.csv"), blocksGpkg = out.stage("blocks.gpkg");
-  std::future<void> blockWriting = std::async(std::launch::async, [&] {
-    io::writePolygonLayer(blocksGpkg, "blocks", outlines, blocks, r.observed->layer.frame, r.observed->layer.crs,
-                          spatialIndex);
+  std::future<io::LayerWrite> blockWriting = std::async(std::launch::async, [&] {
+    return io::writePolygonLayer(blocksGpkg, "blocks", outlines, blocks, r.observed->layer.frame, r.observed->layer.crs,
+                                 spatialIndex);
   });
   std::vector<std::vector<Polygon>> geometries;
   const Table generatedTable = generatedTableOf(r, &geometries);
   const std::string parcelsGpkg = out.stage(parcelsFile);
-  std::future<void> parcelWriting = std::async(std::launch::async, [&] {
-    io::writePolygonLayer(parcelsGpkg, "parcels", geometries, generatedTable, r.observed->layer.frame,
-                          r.observed->layer.crs, spatialIndex);
+  std::future<io::LayerWrite> parcelWriting = std::async(std::launch::async, [&] {
+    return io::writePolygonLayer(parcelsGpkg, "parcels", geometries, generatedTable, r.observed->layer.frame,
+                                 r.observed->layer.crs, spatialIndex);
   });
   io::writeCsv(blocksCsv, blocks);
   io::writeCsv(out.stage("generated_parcels.csv"), generatedTable);
   io::writeCsv(out.stage("observed_parcels.csv"), observedTableOf(r));
-  parcelWriting.get();
-  blockWriting.get();
+  const io::LayerWrite parcelsWritten = parcelWriting.get();
+  const io::LayerWrite blocksWritten = blockWriting.get();
   io::writeCsv(out.stage("summary.csv"), analysis::summaryTable(r.city));
   io::writeCsv(out.stage("distances.csv"), analysis::distanceTable(r.city));
   const double writeSeconds = secondsSince(writeStart);
@@ -440,6 +440,7 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
                            .set("parcels_without_street_access", r.generated.withoutAccess)
                            .set("per_block_bounds_clamped", r.generated.clampedBounds)
                            .set("failures", failures));
+  run.set("written", writtenLayersJson({{parcelsFile, parcelsWritten}, {"blocks.gpkg", blocksWritten}}));
   run.set("timing_s", timing);
   Json outputList = Json::array();
   for (const auto& o : outputs) outputList.push(o);

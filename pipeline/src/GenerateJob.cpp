@@ -201,7 +201,7 @@ Subdivision subdivideEntry(const BlockInputs& inputs, std::size_t entry, const B
     run.previousSeed = previousPlan->seed;
   }
   run.record = record;
-  return s.run(run);
+  return s.subdivide(run);
 }
 
 Block entryBlock(const BlockInputs& inputs, std::size_t entry, std::size_t parcels) {
@@ -373,7 +373,8 @@ JobOutcome writeGenerate(io::OutputDirectory& out, const GenerateRequest& reques
   reportProgress(progress, 0.9, "writing");
   std::vector<std::vector<Polygon>> geometries;
   const Table table = generatedParcelTable(g, &geometries);
-  io::writePolygonLayer(out.stage("parcels.gpkg"), "parcels", geometries, table, g.source->frame, g.source->crs);
+  const io::LayerWrite written =
+      io::writePolygonLayer(out.stage("parcels.gpkg"), "parcels", geometries, table, g.source->frame, g.source->crs);
   io::writeCsv(out.stage("parcels.csv"), table);
 
   Json perBlock = Json::array();
@@ -412,6 +413,7 @@ JobOutcome writeGenerate(io::OutputDirectory& out, const GenerateRequest& reques
   }
   run.set("blocks_by_style", styleCounts);
   run.set("failures", failures);
+  run.set("written", writtenLayersJson({{"parcels.gpkg", written}}));
   run.set("outputs", Json::array().push("parcels.gpkg").push("parcels.csv").push("run.json"));
   io::writeJson(out.stage("run.json"), run);
   out.commit();

@@ -96,6 +96,14 @@ std::string summarize(const ObservedData& data) {
   return s.str();
 }
 
+Json writtenLayersJson(const std::vector<std::pair<std::string, io::LayerWrite>>& layers) {
+  Json written = Json::object();
+  for (const auto& [file, w] : layers) {
+    written.set(file, Json::object().set("features", w.features).set("repaired", w.repaired).set("emptied", w.emptied));
+  }
+  return written;
+}
+
 namespace {
 JobOutcome writeStats(io::OutputDirectory& out, const io::ReadOptions& input, const ParameterValues& parameters,
                       const ProgressFn& progress) {
@@ -107,10 +115,12 @@ JobOutcome writeStats(io::OutputDirectory& out, const io::ReadOptions& input, co
   io::writeCsv(out.stage("blocks.csv"), blocks);
   std::vector<std::vector<Polygon>> outlines;
   for (const Block& b : data.analysis.blocks) outlines.push_back(b.parts);
-  io::writePolygonLayer(out.stage("blocks.gpkg"), "blocks", outlines, blocks, data.layer.frame, data.layer.crs);
+  const io::LayerWrite written =
+      io::writePolygonLayer(out.stage("blocks.gpkg"), "blocks", outlines, blocks, data.layer.frame, data.layer.crs);
 
   Json run = runRecord("stats", parameters);
   addObservedRecord(run, data);
+  run.set("written", writtenLayersJson({{"blocks.gpkg", written}}));
   run.set("outputs", Json::array().push("parcels.csv").push("blocks.csv").push("blocks.gpkg").push("run.json"));
   io::writeJson(out.stage("run.json"), run);
   out.commit();

@@ -19,6 +19,7 @@
 #include "OgrTestUtil.h"
 #include "TestUtil.h"
 #include "parcelscope/core/Error.h"
+#include "parcelscope/core/GeosOps.h"
 #include "parcelscope/io/OutputDirectory.h"
 #include "parcelscope/io/Writers.h"
 
@@ -564,6 +565,74 @@ TEST(Writers, PolygonLayerGoesBackToTheInputCrs) {
   EXPECT_NEAR(e.MaxX - e.MinX, lon2 - 2.35, 1e-9);  // 0.07 mm
   ASSERT_NE(layer->GetSpatialRef(), nullptr);
   EXPECT_TRUE(layer->GetSpatialRef()->IsGeographic());
+}
+
+// Polygons valid in local metres that are not once mapped back to lon/lat:
+// edges straight in metres are not straight in degrees (a 200 m east-west
+// edge is off by about 0.7 mm in the middle), and points closer than about
+// 1e-9 m merge in degrees. The file holds what users read: every feature
+// valid there, with its area.
+TEST(Writers, PolygonLayerIsValidInTheCrsWritten) {
+  TempDir dir;
+  const LocalFrame frame = LocalFrame::geographic(-71.1, 42.38);
+  auto mapped = [&](Polygon p) {
+    for (Point& q : p.outer) q = frame.toSource(q);
+    for (Ring& h : p.holes)
+      for (Point& q : h) q = frame.toSource(q);
+    return p;
+  };
+  // A notch from below reaching 10 micrometres under a long east-west edge,
+  // and the same mirrored: one of the two crosses that edge once mapped.
+  auto notched = [](double side) {
+    Polygon p{{{-100, 0},
+               {-100, -50 * side},
+               {-1, -50 * side},
+               {0, -1e-5 * side},
+               {1, -50 * side},
+               {100, -50 * side},
+               {100, 0}},
+              {}};
+    normalise(p);
+    return p;
+  };
+  // A ring that comes back 1e-11 m from one of its vertices (a lobe in the
+  // notch): apart in metres, the same point in degrees.
+  Polygon pinched{{{0, 0}, {40, 0}, {40, 30}, {20, 10}, {25, 30}, {15, 30}, {20, 10 + 1e-11}, {0, 30}}, {}};
+  normalise(pinched);
+  const std::vector<std::vector<Polygon>> geometries = {{notched(1)}, {notched(-1)}, {pinched}};
+  int invalidOnceMapped = 0;
+  for (const auto& g : geometries) {
+    ASSERT_TRUE(geos::isValid(g.front()));
+    invalidOnceMapped += !geos::isValid(mapped(g.front()));
+  }
+  ASSERT_EQ(invalidOnceMapped, 2) << "the cases no longer test what they should";
+
+  Table attrs;
+  attrs.columns = {{"id", Column::Type::Integer, ""}};
+  attrs.rows = {{std::int64_t(0)}, {std::int64_t(1)}, {std::int64_t(2)}};
+  CrsInfo crs;
+  crs.assumedLonLat = true;
+  const std::string path = dir.file("parcels.gpkg");
+  const LayerWrite written = writePolygonLayer(path, "parcels", geometries, attrs, frame, crs);
+  EXPECT_EQ(written.features, 3);
+  EXPECT_EQ(written.repaired, 2);
+  EXPECT_EQ(written.emptied, 0);
+
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR));
+  ASSERT_TRUE(ds);
+  OGRLayer* layer = ds->GetLayer(0);
+  ASSERT_EQ(layer->GetFeatureCount(), 3);
+  for (auto& f : *layer) {
+    const OGRGeometry* g = f->GetGeometryRef();
+    ASSERT_NE(g, nullptr);
+    EXPECT_TRUE(g->IsValid()) << "feature " << f->GetFieldAsInteger64("id");
+    // The area is that of the polygon mapped as it is (both in square
+    // degrees): the repair moved nothing of substance.
+    const Polygon original = mapped(geometries[static_cast<std::size_t>(f->GetFieldAsInteger64("id"))].front());
+    const double expected = std::fabs(signedArea(original.outer));
+    EXPECT_NEAR(g->toMultiPolygon()->get_Area(), expected, 1e-6 * expected)
+        << "feature " << f->GetFieldAsInteger64("id");
+  }
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // Robust polygon operations through the GEOS C API, on ParcelScope's plain
 // types. A target of its own (parcelscope_geos) so that the algorithms
 // (analysis/, generation/) reach GEOS without linking GDAL.
+#include <optional>
 #include <vector>
 
 #include "parcelscope/core/Geometry.h"
@@ -26,6 +27,18 @@ bool isValid(const Polygon& polygon);
 /// that pinch or fold split into their parts; zero-width corridors vanish).
 /// A valid polygon comes back as it is. Parts are normalised.
 std::vector<Polygon> validParts(const Polygon& polygon);
+
+/// The union of two polygons (GEOS overlay) when it is one valid polygon;
+/// nothing when it is not (they touch at a point or not at all) or GEOS fails.
+std::optional<Polygon> unionIfOne(const Polygon& a, const Polygon& b);
+
+/// `parts` as one valid multipolygon, for a file: unchanged (and `repaired`
+/// false) when GEOS finds their multipolygon valid; otherwise GEOS make-valid
+/// (structure method, collapsed parts dropped), whose polygons come back with
+/// `repaired` true. Parts of the repaired result below `minShare` of its area
+/// (the crumbs of a crossing a few nanometres wide) are dropped, unless that
+/// would leave nothing. May return nothing when every part collapses.
+std::vector<Polygon> validMultiPolygon(std::vector<Polygon> parts, bool& repaired, double minShare = 1e-9);
 
 /// Area in m² of the intersection of two polygons (GEOS, snap-rounded to a
 /// 1e-6 m grid, so the result is within about perimeter x 1e-6 m² of exact).

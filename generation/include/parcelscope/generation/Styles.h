@@ -58,6 +58,12 @@ public:
   /// the same parcels. Geometric failures come back in the Subdivision (failed,
   /// or fallback to obb with the reason); memory, a stop or a usage error throw.
   virtual Subdivision run(const StyleRun& run) const = 0;
+
+  /// run() followed by the post-processing every style shares: slivers
+  /// (parcels narrower than 1 mm, numerical crumbs of a cut) merged into a
+  /// neighbour; a style other than obb that leaves one falls back to obb.
+  /// What callers use.
+  Subdivision subdivide(const StyleRun& run) const;
 };
 
 /// Every registered style, in the order of --help and the GUI: obb, skeleton, offset, auto.

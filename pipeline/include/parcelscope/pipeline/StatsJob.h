@@ -2,10 +2,13 @@
 // The `stats` job: read observed parcels, analyse them, write the tables, the
 // block layer and the run record. The command line and the GUI both call this.
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "parcelscope/analysis/ObservedAnalysis.h"
 #include "parcelscope/core/Json.h"
 #include "parcelscope/io/ParcelReader.h"
+#include "parcelscope/io/Writers.h"
 
 namespace parcelscope::pipeline {
 
@@ -44,5 +47,10 @@ std::string version();
 /// The opening of every run record: tool, version, command, GDAL version and the
 /// parameter values.
 Json runRecord(const std::string& command, const ParameterValues& parameters);
+
+/// The run record's "written" entry for the polygon layers written: per file,
+/// its features and how many were repaired in the CRS written (see
+/// io::writePolygonLayer).
+Json writtenLayersJson(const std::vector<std::pair<std::string, io::LayerWrite>>& layers);
 
 }  // namespace parcelscope::pipeline
