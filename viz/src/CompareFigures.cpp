@@ -186,8 +186,8 @@ void exportFigure(const CompareResult& r, const CompareRequest& request, const s
   }
   const std::string extension = std::filesystem::path(path).extension().string();
   const bool histogram = name.rfind("hist_", 0) == 0;
-  if (extension != ".png" && !(histogram && (extension == ".svg" || extension == ".pdf"))) {
-    throw usageError(path + ": " + name + " is written as " + (histogram ? ".png, .svg or .pdf" : ".png"));
+  if (extension != ".png" && extension != ".svg" && extension != ".pdf") {
+    throw usageError(path + ": " + name + " is written as .png, .svg or .pdf");
   }
   const std::vector<std::string> inputs = {request.input.path};
   io::StagedFile file(path, inputs);
@@ -200,7 +200,11 @@ void exportFigure(const CompareResult& r, const CompareRequest& request, const s
   } else {
     bitmap.emplace(path + ".png", inputs);
     o.png = bitmap->path();
-    o.vector = file.path();
+    if (histogram) {
+      o.vector = file.path();
+    } else {
+      o.mapVectors.push_back(file.path());
+    }
   }
   if (name == "map_blocks") {
     renderBlocksMap(r, request, o);
@@ -221,15 +225,20 @@ struct FigureSet {
   std::vector<std::string> written;
 
   FigureOutput output(const std::string& name) {
-    // Charts also go to SVG. Maps are PNG only: VTK 9.1's GL2PS export
-    // rasterises 3D props, Debian's GL2PS cannot embed images in SVG, and a PDF
-    // would hold an uncompressed bitmap of the PNG (about 5 MB) and nothing more.
+    // Charts also go to SVG (or PDF) through VTK; maps to both SVG and PDF,
+    // written as paths by writeVectorMaps (VTK 9.1's GL2PS export would
+    // rasterise their polygons).
     FigureOutput o;
     written.push_back("figures/" + name + ".png");
     o.png = stage(written.back());
     if (name.rfind("map_", 0) != 0) {
       written.push_back("figures/" + name + "." + request.vectorFormat);
       o.vector = stage(written.back());
+    } else {
+      for (const char* extension : {".svg", ".pdf"}) {
+        written.push_back("figures/" + name + extension);
+        o.mapVectors.push_back(stage(written.back()));
+      }
     }
     o.width = static_cast<int>(value(request, "figure-width"));
     o.height = static_cast<int>(value(request, "figure-height"));

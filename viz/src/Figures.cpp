@@ -548,6 +548,18 @@ void addScaleBar(vtkRenderer* r, double left, double bottom, double visibleWidth
 
 }  // namespace
 
+std::vector<Rgb> scaleColours(const ColourScale& scale, const std::vector<double>& values) {
+  const auto lut = lookupTable(scale);
+  std::vector<Rgb> out;
+  out.reserve(values.size());
+  for (double v : values) {
+    double rgb[3];
+    lut->GetColor(v, rgb);
+    out.push_back({rgb[0], rgb[1], rgb[2]});
+  }
+  return out;
+}
+
 std::string vtkVersionString() { return std::string("VTK ") + vtkVersion::GetVTKVersion(); }
 
 double outlineSize(const Polygon& shape) {
@@ -657,6 +669,7 @@ void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, c
   window->AddRenderer(legend);
 
   writeFigure(window, out, title);
+  for (const std::string& path : out.mapVectors) writeVectorMaps(title, panels, scale, out.width, out.height, path);
 }
 
 void fillHistogramChart(vtkChartXY* chart, const std::string& title, const std::string& xTitle,

@@ -23,9 +23,11 @@ struct Rgb {
 /// Where and how large a figure is written.
 struct FigureOutput {
   std::string png;     ///< PNG path (written exactly `width` x `height` pixels)
-  std::string vector;  ///< optional vector copy: a path ending in .svg or .pdf; empty = none
-  int width = 1800;    ///< pixels
-  int height = 900;    ///< pixels
+  std::string vector;  ///< optional vector copy: a path ending in .svg or .pdf; empty = none (not maps)
+  /// Maps only: vector copies (.svg, .pdf) whose shapes are paths (writeVectorMaps).
+  std::vector<std::string> mapVectors;
+  int width = 1800;  ///< pixels
+  int height = 900;  ///< pixels
 };
 
 /// Makes sure an X server is there to render on, once per process: the one on
@@ -76,6 +78,18 @@ double outlineSize(const Polygon& shape);
 /// shape, Error(IO) when there is no display or a file cannot be written.
 void renderMaps(const std::string& title, const std::vector<MapPanel>& panels, const ColourScale& scale,
                 const FigureOutput& output);
+
+/// The maps of renderMaps as a vector figure of `width` x `height` (px; a PDF
+/// page is half as many points): every shape a filled path (holes even-odd),
+/// outlined where the PNG outlines it, with the same layout, colours, titles,
+/// scale bars and colour bar; SVG or PDF by the extension of `path`. Needs no
+/// display. Throws Error(Usage) as renderMaps, or for another extension;
+/// Error(IO) when the file cannot be written.
+void writeVectorMaps(const std::string& title, const std::vector<MapPanel>& panels, const ColourScale& scale, int width,
+                     int height, const std::string& path);
+
+/// The colours `scale` gives `values` on the maps (NaN: the no-value grey).
+std::vector<Rgb> scaleColours(const ColourScale& scale, const std::vector<double>& values);
 
 /// One series of an overlaid histogram.
 struct HistogramSeries {
