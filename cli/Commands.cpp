@@ -1,5 +1,6 @@
 #include "Commands.h"
 
+#include <cmath>
 #include <cstdio>
 #include <set>
 
@@ -10,6 +11,7 @@
 #include "parcelscope/pipeline/CompareJob.h"
 #include "parcelscope/pipeline/CompareSession.h"
 #include "parcelscope/pipeline/GenerateJob.h"
+#include "parcelscope/pipeline/Inspect.h"
 #include "parcelscope/pipeline/StatsJob.h"
 #include "parcelscope/viz/CompareFigures.h"
 
@@ -27,6 +29,7 @@ const char* kOverview =
     "  generate  subdivide blocks into procedural parcels (OBB, skeleton or offset style)\n"
     "  compare   generate parcels in the blocks of observed ones and compare the two sets:\n"
     "            per-block and city-wide tables, distances, layers and figures\n"
+    "  inspect   print one observed parcel's attributes, metrics and block statistics\n"
     "  metrics   print the table of parcel metrics (Markdown, as in docs/user/metrics.md)\n"
     "  version   print the version\n"
     "\n"
@@ -97,7 +100,8 @@ int dispatch(const std::vector<std::string>& args) {
   if (args[0] == "stats") return statsCommand(rest);
   if (args[0] == "generate") return generateCommand(rest);
   if (args[0] == "compare") return compareCommand(rest);
-  throw usageError("unknown command '" + args[0] + "' (commands: stats, generate, compare, metrics, version)");
+  if (args[0] == "inspect") return inspectCommand(rest);
+  throw usageError("unknown command '" + args[0] + "' (commands: stats, generate, compare, inspect, metrics, version)");
 }
 
 int metricsCommand(const std::vector<std::string>& args) {
@@ -229,6 +233,52 @@ int compareCommand(const std::vector<std::string>& args) {
   if (auto v = a.value("vector")) request.vectorFormat = *v;
   if (auto v = a.value("parcels-format")) request.parcelsFormat = *v;
   return reportOutcome(viz::runCompare(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
+}
+
+int inspectCommand(const std::vector<std::string>& args) {
+  auto flags = inputFlags();
+  flags.push_back({"at",
+                   "the point X,Y in the input's coordinates: LON,LAT for a geographic CRS, else the\n"
+                   "      projected CRS's easting and northing (that of --crs when given)"});
+  flags.push_back({"json", "print JSON instead of 'name: value' lines", false});
+  const auto& params = analysis::analysisParameters();
+  if (wantsHelp(args)) {
+    std::fputs(usageText("parcelscope inspect INPUT --at X,Y [--json] [options]", flags, params).c_str(), stdout);
+    std::fputs(
+        "\nReads and measures INPUT as 'stats' does and prints the parcel at the point: its ids and\n"
+        "key, every parcel metric and its block's statistics (block.*), one 'name: value' per line.\n",
+        stdout);
+    return 0;
+  }
+  const Args a(args, flags, params);
+  if (a.positional().size() != 1) throw usageError("expected exactly one INPUT file");
+  const auto at = a.value("at");
+  if (!at) throw usageError("--at X,Y is required");
+  pipeline::InspectRequest request;
+  {
+    const std::size_t comma = at->find(',');
+    std::size_t xEnd = 0, yEnd = 0;
+    bool ok = comma != std::string::npos;
+    try {
+      if (ok) request.x = std::stod(at->substr(0, comma), &xEnd);
+      if (ok) request.y = std::stod(at->substr(comma + 1), &yEnd);
+    } catch (const std::exception&) {
+      ok = false;
+    }
+    ok = ok && xEnd == comma && yEnd == at->size() - comma - 1 && std::isfinite(request.x) && std::isfinite(request.y);
+    if (!ok) throw usageError("--at " + *at + " is not X,Y (two decimal numbers separated by a comma)");
+  }
+  request.input.path = a.positional()[0];
+  request.input.layer = a.value("layer").value_or("");
+  request.input.where = a.value("where").value_or("");
+  request.input.crsOverride = a.value("crs").value_or("");
+  request.input.keyField = a.value("key-field").value_or("");
+  request.parameters = a.parameters();
+  const pipeline::ParcelInspection inspection = pipeline::inspect(request);
+  const std::string text =
+      a.has("json") ? pipeline::inspectionJson(inspection).dump() + "\n" : pipeline::inspectionText(inspection);
+  std::fputs(text.c_str(), stdout);
+  return 0;
 }
 
 }  // namespace parcelscope::cli

@@ -11,5 +11,6 @@ int metricsCommand(const std::vector<std::string>& args);
 int statsCommand(const std::vector<std::string>& args);
 int generateCommand(const std::vector<std::string>& args);
 int compareCommand(const std::vector<std::string>& args);
+int inspectCommand(const std::vector<std::string>& args);
 
 }  // namespace parcelscope::cli

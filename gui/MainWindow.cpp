@@ -4,6 +4,7 @@
 #include <QAction>
 #include <QApplication>
 #include <QCheckBox>
+#include <QCloseEvent>
 #include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QDragEnterEvent>
@@ -17,12 +18,15 @@
 #include <QInputDialog>
 #include <QLabel>
 #include <QMenuBar>
+#include <QMessageBox>
 #include <QMimeData>
 #include <QPainter>
 #include <QProgressBar>
 #include <QPushButton>
 #include <QRegularExpression>
+#include <QScreen>
 #include <QScrollArea>
+#include <QScrollBar>
 #include <QSettings>
 #include <QSplitter>
 #include <QStandardPaths>
@@ -43,6 +47,7 @@
 #include <vtkPlot.h>
 #include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
+#include <vtkVersionMacros.h>
 
 #include <algorithm>
 #include <cmath>
@@ -57,6 +62,7 @@
 #include "parcelscope/core/Parallel.h"
 #include "parcelscope/io/ParcelReader.h"
 #include "parcelscope/pipeline/GenerateJob.h"
+#include "parcelscope/pipeline/Inspect.h"
 #include "parcelscope/viz/CompareFigures.h"
 #include "parcelscope/viz/Scenes.h"
 
@@ -230,6 +236,16 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
       progress_->setVisible(false);
       cancel_->setVisible(false);
       status_->setText("cancelled");
+      // A result in between stays on screen: say what it holds, and that
+      // what it did not measure will not come.
+      if (shownPartial_ && controller_.shownResult()) {
+        partialCancelled_ = true;
+        titleProcedural();
+        fillNumbers();
+        status_->setText(QString("cancelled: %1 of %2 block parts were updated, the others are shown as before")
+                             .arg(partialDone_)
+                             .arg(partialTotal_));
+      }
     }
   });
   connect(worker_, &SessionWorker::progress, this, [this](double fraction, const QString& stage) {
@@ -252,8 +268,12 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
   maps->addWidget(observedView_);
   maps->addWidget(proceduralView_);
   for (MapView* v : {observedView_, proceduralView_}) {
-    connect(v, &MapView::clicked, this, [this](double x, double y) {
-      if (controller_.shownResult()) selectBlock(pipeline::blockAt(*controller_.shownResult(), {x, y}));
+    const bool procedural = v == proceduralView_;
+    connect(v, &MapView::clicked, this, [this, procedural](double x, double y) { inspectAt(procedural, x, y); });
+    connect(v, &MapView::pointerMoved, this, [this](double x, double y) {
+      const QString text = coordinateText(x, y);
+      observedView_->setReadout(text);
+      proceduralView_->setReadout(text);
     });
   }
 
@@ -263,7 +283,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
   // chart several milliseconds longer (its text is drawn from textures anyway).
   histogramWindow_->SetMultiSamples(0);
   histogramWidget_->setRenderWindow(histogramWindow_);
-  histogramWidget_->setMinimumSize(300, 220);
+  histogramWidget_->setMinimumSize(160, 100);
   histogramView_->SetRenderWindow(histogramWindow_);
   histogramView_->SetInteractor(histogramWidget_->interactor());
   histogramView_->GetRenderer()->SetBackground(1, 1, 1);
@@ -279,7 +299,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
   numbers_ = new QTableWidget;
   numbers_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   numbers_->verticalHeader()->setVisible(false);
-  numbers_->setMinimumWidth(320);
+  numbers_->setMinimumWidth(160);
   auto* lower = new QSplitter(Qt::Horizontal);
   lower->addWidget(histogramWidget_);
   lower->addWidget(numbers_);
@@ -297,6 +317,13 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
   errorBar_->setVisible(false);
   errorBar_->setTextInteractionFlags(Qt::TextSelectableByMouse);
   layout->addWidget(errorBar_);
+  noticeBar_ = new QLabel;
+  noticeBar_->setObjectName("noticeBar");
+  noticeBar_->setWordWrap(true);
+  noticeBar_->setStyleSheet("QLabel { background: #e3eefc; color: #123a6b; padding: 6px; border: 1px solid #9dbbe3; }");
+  noticeBar_->setVisible(false);
+  noticeBar_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  layout->addWidget(noticeBar_);
   auto* vertical = new QSplitter(Qt::Vertical);
   vertical->addWidget(maps);
   vertical->addWidget(lower);
@@ -306,16 +333,32 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
 
   auto* outer = new QSplitter(Qt::Horizontal);
   outer->addWidget(central);
-  outer->addWidget(buildControls());
+  // Every control reachable on small screens and at 1.5x or 2x scaling: the
+  // whole column scrolls, and the splitter gives the views or the controls room.
+  controlsScroll_ = new QScrollArea;
+  controlsScroll_->setObjectName("controlsScroll");
+  controlsScroll_->setWidget(buildControls());
+  controlsScroll_->setWidgetResizable(true);
+  // As wide as the controls need, so that nothing is cut at the side; the rest goes to the views.
+  controlsScroll_->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+  controlsScroll_->setMinimumWidth(controlsScroll_->widget()->minimumSizeHint().width() +
+                                   controlsScroll_->verticalScrollBar()->sizeHint().width() +
+                                   2 * controlsScroll_->frameWidth());
+  outer->addWidget(controlsScroll_);
   outer->setStretchFactor(0, 1);
   outer->setStretchFactor(1, 0);
   setCentralWidget(outer);
+  outer->setCollapsible(0, false);
+  outer->setCollapsible(1, false);
+  // The controls at about 420 px where there is room (longer sliders), the views the rest.
+  outer->setSizes({1180, 420});
 
   status_ = new QLabel("Open a parcel dataset (File > Open, drag and drop, or File > Open sample)");
   progress_ = new QProgressBar;
   progress_->setMaximumWidth(260);
   progress_->setVisible(false);
   cancel_ = new QPushButton("Cancel");
+  cancel_->setObjectName("cancelButton");
   cancel_->setVisible(false);
   connect(cancel_, &QPushButton::clicked, this, [this] { worker_->cancel(); });
   statusBar()->addWidget(status_, 1);
@@ -323,7 +366,11 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
   statusBar()->addPermanentWidget(cancel_);
   buildMenus();
   updateActions();
-  resize(1600, 1000);
+  markOverridesSaved();
+  // At most the screen's free area (1280 x 720 at 1.5x scaling is 853 x 480).
+  QSize size(1600, 1000);
+  if (const QScreen* screen = QGuiApplication::primaryScreen()) size = size.boundedTo(screen->availableSize());
+  resize(size);
 }
 
 MainWindow::~MainWindow() {
@@ -354,14 +401,19 @@ QWidget* MainWindow::buildControls() {
   }
   connect(colourBy_, &QComboBox::currentTextChanged, this, [this](const QString& q) { setColourBy(q); });
   form->addRow("colour by", colourBy_);
-  perBlockBounds_ = new QCheckBox("per-block bounds (A-bar -/+ k s_A, W-bar -/+ k s_W)");
+  perBlockBounds_ = new QCheckBox("per-block bounds");
   perBlockBounds_->setObjectName("perBlockBounds");
   perBlockBounds_->setChecked(true);
   perBlockBounds_->setToolTip(
-      "Each block's A_min, A_max, W_min, W_max come from its observed parcels; "
+      "Each block's A_min, A_max, W_min, W_max come from its observed parcels (A-bar -/+ k s_A, "
+      "W-bar -/+ k s_W); "
       "moving one of those sliders sets it for every block instead");
   connect(perBlockBounds_, &QCheckBox::toggled, this, [this](bool on) {
     controller_.setPerBlockBounds(on);
+    if (on) {
+      boundsNoticeBefore_.reset();
+      showNotice({});
+    }
     submit();
   });
   form->addRow(perBlockBounds_);
@@ -371,13 +423,9 @@ QWidget* MainWindow::buildControls() {
   panel_->setValues(controller_.request().parameters);
   connect(panel_, &ParameterPanel::changed, this,
           [this](const QString& name, double value) { setParameter(name.toStdString(), value); });
-  auto* scroll = new QScrollArea;
-  scroll->setWidget(panel_);
-  scroll->setWidgetResizable(true);
-  scroll->setMinimumWidth(440);
-  v->addWidget(scroll, 1);
+  v->addWidget(panel_);
 
-  auto* block = new QGroupBox("Block");
+  auto* block = new QGroupBox("Parcel and block");
   auto* b = new QVBoxLayout(block);
   // A text view of a fixed height, not a label: a label whose text changes
   // makes Qt lay out the whole window again (each label's rich text several
@@ -387,7 +435,15 @@ QWidget* MainWindow::buildControls() {
   blockInfo_->setFrameShape(QFrame::NoFrame);
   blockInfo_->viewport()->setAutoFillBackground(false);
   blockInfo_->setFixedHeight(blockInfo_->fontMetrics().lineSpacing() * 10);
-  blockInfo_->setPlainText("Click a block in either view.");
+  blockInfo_->setPlainText("Click a parcel or a block in either view.");
+  // The inspector: the parcel clicked, its attributes and metrics (its block is below).
+  parcelInfo_ = new QTextBrowser;
+  parcelInfo_->setObjectName("parcelInfo");
+  parcelInfo_->setFrameShape(QFrame::NoFrame);
+  parcelInfo_->viewport()->setAutoFillBackground(false);
+  parcelInfo_->setFixedHeight(parcelInfo_->fontMetrics().lineSpacing() * 9);
+  parcelInfo_->setPlainText("No parcel selected.");
+  b->addWidget(parcelInfo_);
   b->addWidget(blockInfo_);
   auto* overrides = new QFormLayout;
   blockStyle_ = new QComboBox;
@@ -475,6 +531,7 @@ void MainWindow::buildMenus() {
         QFileDialog::getSaveFileName(this, "Save session", "session.json", "ParcelScope session (*.json)");
     if (!path.isEmpty()) saveSession(path);
   });
+  saveSessionAction_->setObjectName("saveSessionAction");
   file->addSeparator();
   // Disabled until there is a result to export (updateActions).
   QMenu* exports = exportMenu_ = file->addMenu("&Export");
@@ -502,6 +559,14 @@ void MainWindow::buildMenus() {
   zoomToExtentAction_ = view->addAction(
       "Zoom to &extent", this, [this] { zoomToExtent(); }, Qt::Key_Home);
   zoomToExtentAction_->setToolTip("Fit both views to the data");
+  QMenu* help = menuBar()->addMenu("&Help");
+  help->addAction("&About ParcelScope...", this, [this] {
+    auto* box = new QMessageBox(QMessageBox::Information, "About ParcelScope", aboutText(), QMessageBox::Ok, this);
+    box->setObjectName("aboutBox");
+    box->setTextFormat(Qt::RichText);
+    box->setAttribute(Qt::WA_DeleteOnClose);
+    box->open();
+  });
   QToolBar* bar = addToolBar("Main");
   bar->setObjectName("mainToolBar");
   bar->addAction("Open sample", this, [this] { openSample(); });
@@ -565,7 +630,9 @@ void MainWindow::openFile(const QString& path, const QString& layer, const QStri
     }
   }
   controller_.openInput(input);
+  markOverridesSaved();
   selected_ = -1;
+  selectedParcel_ = -1;
   // A recent file once a result of it is drawn (drawReport).
   openedInput_ = input;
   updateActions();
@@ -583,6 +650,8 @@ void MainWindow::openSession(const QString& path) {
     return;
   }
   selected_ = -1;
+  selectedParcel_ = -1;
+  markOverridesSaved();
   openedInput_.reset();  // a session's input is not a recent file
   showRequest();
   updateActions();
@@ -606,6 +675,7 @@ void MainWindow::showRequest() {
 void MainWindow::saveSession(const QString& path) {
   try {
     controller_.saveSession(path.toStdString());
+    markOverridesSaved();
     status_->setText("session saved to " + path);
   } catch (const std::exception& e) {
     showError(e.what());
@@ -658,7 +728,24 @@ void MainWindow::exportFigureDialog() {
 }
 
 void MainWindow::setParameter(const std::string& name, double value) {
+  const bool wasPerBlock = controller_.perBlockBounds();
   controller_.setParameter(name, value);
+  if (wasPerBlock && !controller_.perBlockBounds()) {
+    // Every block leaves its own bounds for the four shown: say so, with what it does to the count.
+    const ParameterValues& p = controller_.request().parameters;
+    boundsNotice_ =
+        QString(
+            "Per-block bounds are off: %1 now holds for every block, with A_min %2, A_max %3 "
+            "m\u00b2, W_min %4, W_max %5 m (each block had its own, from its observed parcels). "
+            "Tick \"per-block bounds\" to go back.")
+            .arg(QString::fromStdString(name))
+            .arg(number(p.at("a-min")), number(p.at("a-max")), number(p.at("w-min")), number(p.at("w-max")));
+    boundsNoticeBefore_.reset();
+    if (controller_.shownResult()) boundsNoticeBefore_ = controller_.shownResult()->generated.parcels.size();
+    showNotice(boundsNotice_ + (boundsNoticeBefore_
+                                    ? QString(" Procedural parcels before: %1.").arg(*boundsNoticeBefore_)
+                                    : QString()));
+  }
   if (perBlockBounds_->isChecked() != controller_.perBlockBounds()) {
     const QSignalBlocker block(perBlockBounds_);
     perBlockBounds_->setChecked(controller_.perBlockBounds());
@@ -718,6 +805,108 @@ void MainWindow::setOutlinesVisible(bool visible) {
   proceduralView_->layer().setOutlinesVisible(visible);
   observedView_->render();
   proceduralView_->render();
+}
+
+void MainWindow::inspectAt(bool procedural, double x, double y) {
+  if (!controller_.shownResult()) return;
+  const pipeline::CompareResult& r = *controller_.shownResult();
+  selectedProcedural_ = procedural;
+  selectedParcel_ =
+      procedural ? pipeline::generatedParcelAt(r.generated, {x, y}) : pipeline::parcelAt(*r.observed, {x, y});
+  int block = pipeline::blockAt(r, {x, y});
+  if (block < 0 && selectedParcel_ >= 0 && !procedural) block = r.observed->analysis.blockOf[selectedParcel_];
+  selectBlock(block);
+}
+
+QString MainWindow::parcelInfoText() const { return parcelInfo_->toPlainText(); }
+
+void MainWindow::showParcel() {
+  QString html;
+  const auto& shown = controller_.shownResult();
+  if (!shown || selectedParcel_ < 0) {
+    html = "No parcel selected.";
+  } else {
+    const pipeline::ParcelInspection p = selectedProcedural_
+                                             ? pipeline::inspectGeneratedParcel(shown->generated, selectedParcel_)
+                                             : pipeline::inspectParcel(*shown->observed, selectedParcel_);
+    html = QString("<b>%1 parcel %2</b><table cellspacing=2>")
+               .arg(selectedProcedural_ ? "Procedural" : "Observed")
+               .arg(selectedParcel_);
+    const auto add = [&html](const pipeline::NamedValues& values) {
+      for (const auto& [name, v] : values) {
+        html += QString("<tr><td>%1</td><td>%2</td></tr>")
+                    .arg(QString::fromStdString(name), QString::fromStdString(pipeline::valueText(v)).toHtmlEscaped());
+      }
+    };
+    add(p.attributes);
+    add(p.metrics);
+    html += "</table>";
+  }
+  if (html == parcelInfoHtml_) return;
+  parcelInfoHtml_ = html;
+  parcelInfo_->setHtml(html);
+}
+
+QString MainWindow::coordinateText(double x, double y) const {
+  const auto& shown = controller_.shownResult();
+  if (!shown) return {};
+  const io::ParcelLayer& layer = shown->observed->layer;
+  const Point p = layer.frame.toSource({x, y});
+  if (layer.frame.isGeographic()) return QString("lon %1, lat %2").arg(p.x, 0, 'f', 6).arg(p.y, 0, 'f', 6);
+  return QString("x %1, y %2 (%3)").arg(p.x, 0, 'f', 2).arg(p.y, 0, 'f', 2).arg(QString::fromStdString(layer.crs.name));
+}
+
+QString MainWindow::aboutText() {
+  return QString(
+             "<h3>ParcelScope %1</h3>"
+             "<p>Observed and procedural parcels, measured side by side (Vanegas et al. 2012; parcel "
+             "metrics after Yang et al. 2013). The command line <tt>parcelscope</tt> does to data what this "
+             "window does.</p>"
+             "<p><b>Libraries</b>: Qt %2 (LGPL 3), VTK %3 (BSD 3-clause), GDAL (MIT), CGAL (GPL 3 and LGPL 3), "
+             "GEOS (LGPL 2.1), GeographicLib (MIT), OpenSSL (Apache 2.0).</p>"
+             "<p><b>Data</b>: the bundled sample <tt>datasets/sample/sample_town.geojson</tt> is synthetic, "
+             "public domain (CC0 1.0). The real datasets of the tests and benchmarks, kept outside the "
+             "project: Cambridge MA (PDDL 1.0); Paris and Rh\u00f4ne cadastre (Licence Ouverte 2.0); Malibu, "
+             "Eatonville, Seoul (no licence stated).</p>")
+      .arg(QString::fromStdString(pipeline::version()), QString::fromLatin1(qVersion()),
+           QString::fromLatin1(VTK_VERSION));
+}
+
+std::string MainWindow::overridesText() const {
+  const Json session = pipeline::sessionJson(controller_.request());
+  const Json* overrides = session.find("overrides");
+  return overrides ? overrides->dump(0) : std::string();
+}
+
+void MainWindow::markOverridesSaved() { savedOverrides_ = overridesText(); }
+
+bool MainWindow::unsavedOverrides() const { return overridesText() != savedOverrides_; }
+
+QString MainWindow::notice() const { return noticeBar_->isVisible() ? noticeBar_->text() : QString(); }
+
+void MainWindow::showNotice(const QString& text) {
+  noticeBar_->setText(text);
+  noticeBar_->setVisible(!text.isEmpty());
+}
+
+void MainWindow::closeEvent(QCloseEvent* event) {
+  if (!unsavedOverrides()) return event->accept();
+  QMessageBox box(QMessageBox::Question, "Unsaved block overrides",
+                  "The block overrides have changed since they were last saved. Save them in a session file?",
+                  QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel, this);
+  box.setObjectName("quitPrompt");
+  box.setDefaultButton(QMessageBox::Save);
+  const int answer = box.exec();
+  if (answer == QMessageBox::Discard) return event->accept();
+  if (answer == QMessageBox::Save) {
+    const QString path =
+        QFileDialog::getSaveFileName(this, "Save session", "session.json", "ParcelScope session (*.json)");
+    if (!path.isEmpty()) {
+      saveSession(path);
+      if (!unsavedOverrides()) return event->accept();
+    }
+  }
+  event->ignore();
 }
 
 void MainWindow::selectBlock(int block) {
@@ -795,7 +984,15 @@ void MainWindow::drawReport(const UpdateReport& report) {
     cancel_->setVisible(false);
   }
   const pipeline::CompareResult& r = *controller_.shownResult();
-  if (first) selected_ = -1;
+  if (first) {
+    selected_ = -1;
+    selectedParcel_ = -1;
+  }
+  shownPartial_ = report.partial;
+  partialCancelled_ = false;
+  partialDone_ = report.blocksRegenerated;
+  partialTotal_ = report.blocksTotal;
+  if (selectedProcedural_ && selectedParcel_ >= static_cast<int>(r.generated.parcels.size())) selectedParcel_ = -1;
 
   // Geometry: the observed parcels only when the input was read again.
   const analysis::ObservedAnalysis& a = r.observed->analysis;
@@ -880,6 +1077,12 @@ void MainWindow::drawReport(const UpdateReport& report) {
   }
   if (report.completesContext) noteContextCompleted(report.serial);
   firstViewMs_ = -1;
+  if (boundsNoticeBefore_ && !controller_.perBlockBounds()) {
+    showNotice(
+        boundsNotice_ +
+        QString(" Procedural parcels: %1 before, %2 now.").arg(*boundsNoticeBefore_).arg(r.generated.parcels.size()));
+    boundsNoticeBefore_.reset();
+  }
   status_->setText(QString("%1 blocks, %2 observed and %3 procedural parcels; %4 of %5 block parts regenerated; %6 ms")
                        .arg(a.blocks.size())
                        .arg(r.observedLots.size())
@@ -933,11 +1136,32 @@ bool MainWindow::recolour(bool observedChanged) {
     observedChanged = true;
   }
   observedView_->setTitle(QString("Observed: %1 parcels").arg(r.observedLots.size()));
-  proceduralView_->setTitle(QString("Procedural (%1, seed %2): %3 parcels")
-                                .arg(QString::fromStdString(shown.style))
-                                .arg(r.generated.seed)
-                                .arg(generated.size()));
+  titleProcedural();
   return observedChanged;
+}
+
+void MainWindow::titleProcedural() {
+  if (!controller_.shownResult()) return;
+  const pipeline::CompareResult& r = *controller_.shownResult();
+  if (!partialCancelled_) {
+    proceduralView_->setTitle(QString("Procedural (%1, seed %2): %3 parcels")
+                                  .arg(QString::fromStdString(controller_.shownRequest().style))
+                                  .arg(r.generated.seed)
+                                  .arg(r.generated.parcels.size()));
+    return;
+  }
+  // A cancelled update left a result in between: some blocks new, the others as before.
+  QStringList styles;
+  for (const std::string& s : r.generated.blockStyles) {
+    if (!styles.contains(QString::fromStdString(s))) styles << QString::fromStdString(s);
+  }
+  styles.sort();
+  proceduralView_->setTitle(QString("Procedural, partly updated (cancelled: %1 of %2 block parts new), styles shown: "
+                                    "%3: %4 parcels")
+                                .arg(partialDone_)
+                                .arg(partialTotal_)
+                                .arg(styles.join(", "))
+                                .arg(r.generated.parcels.size()));
 }
 
 void MainWindow::drawHistogram() {
@@ -1028,7 +1252,11 @@ void MainWindow::fillNumbers() {
     const bool measuring = pending && std::get<std::string>(r.front()) == "street_access_share";
     for (std::size_t c = 0; c < r.size(); ++c) {
       const bool unknown = measuring && std::holds_alternative<double>(r[c]) && std::isnan(std::get<double>(r[c]));
-      put(row, static_cast<int>(c), unknown ? QStringLiteral("measuring...") : text(r[c]), false);
+      // After a cancel, what was not measured will not be: say so rather than "measuring...".
+      put(row, static_cast<int>(c),
+          unknown ? (partialCancelled_ ? QStringLiteral("not measured (cancelled)") : QStringLiteral("measuring..."))
+                  : text(r[c]),
+          false);
     }
     ++row;
   }
@@ -1081,11 +1309,12 @@ void MainWindow::fillOverridePanel(const pipeline::CompareResult& r) {
 }
 
 void MainWindow::showBlock() {
+  showParcel();
   std::vector<const Polygon*> outline;
   if (!controller_.shownResult() || selected_ < 0) {
     observedView_->outline().setShapes(outline);
     proceduralView_->outline().setShapes(outline);
-    setBlockInfo("Click a block in either view.");
+    setBlockInfo("Click a parcel or a block in either view.");
     if (panelBlock_ != 0) {  // no block: the panel shows the run's values again
       for (const auto& [name, widgets] : blockParameters_) {
         const QSignalBlocker x(widgets.first), y(widgets.second);

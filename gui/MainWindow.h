@@ -26,6 +26,8 @@
 #include "parcelscope/viz/Figures.h"
 
 class QCheckBox;
+class QCloseEvent;
+class QScrollArea;
 class QComboBox;
 class QDoubleSpinBox;
 class QLabel;
@@ -77,6 +79,26 @@ public:
   void zoomToExtent();
   /// Selects the observed block with this index (-1: none).
   void selectBlock(int block);
+  /// A click at (x, y) (local metres) in the observed or the procedural view:
+  /// selects the parcel there and its block (the inspector shows both);
+  /// outside every parcel, the block there (or none).
+  void inspectAt(bool procedural, double x, double y);
+  /// The parcel the inspector shows: an index into the observed parcels or the
+  /// generated ones (`procedural`), -1 when none.
+  int selectedParcel() const { return selectedParcel_; }
+  bool selectedParcelIsProcedural() const { return selectedProcedural_; }
+  /// The inspector's text (the selected parcel's attributes and metrics).
+  QString parcelInfoText() const;
+  /// Input coordinates of local point (x, y) as the views' readout shows them:
+  /// "lon -71.10245, lat 42.36849" for a geographic input, else "x ..., y ... (CRS)".
+  QString coordinateText(double x, double y) const;
+  /// Help > About: version, licences of ParcelScope, its libraries and the bundled data.
+  static QString aboutText();
+  /// Block overrides differ from those last saved or opened (quitting asks first).
+  bool unsavedOverrides() const;
+  /// The notice bar (blue, above the views): what an edit did besides its own
+  /// change (e.g. per-block bounds turned off); empty when hidden.
+  QString notice() const;
   /// Overrides the selected block's style and parameters, or clears its override.
   void overrideSelectedBlock(const QString& style, const ParameterValues& parameters);
   void clearSelectedOverride();
@@ -134,6 +156,8 @@ signals:
   void contextCompleted(qint64 serial);
 
 protected:
+  /// With unsaved block overrides, asks Save / Discard / Cancel first.
+  void closeEvent(QCloseEvent* event) override;
   void dragEnterEvent(QDragEnterEvent* event) override;
   void dropEvent(QDropEvent* event) override;
 
@@ -154,6 +178,14 @@ private:
   /// to extent) or an input (set input CRS) once there is one.
   void updateActions();
   void setBlockInfo(const QString& html);
+  void showParcel();
+  void showNotice(const QString& text);
+  /// The procedural view's title: the style and seed of the request shown, or,
+  /// for a result in between left by a cancelled update, what it holds.
+  void titleProcedural();
+  /// The overrides as a session file holds them (to compare with the saved ones).
+  std::string overridesText() const;
+  void markOverridesSaved();
   /// Recolours the views; returns whether the observed view changed (it is
   /// drawn again only then). `observedChanged`: its data changed.
   bool recolour(bool observedChanged);
@@ -204,6 +236,20 @@ private:
   vtkSmartPointer<ChartStyle> histogramStyle_;
   QTableWidget* numbers_;
   QLabel* errorBar_;
+  QLabel* noticeBar_;
+  QScrollArea* controlsScroll_;
+  QTextBrowser* parcelInfo_;
+  QString parcelInfoHtml_;
+  int selectedParcel_ = -1;
+  bool selectedProcedural_ = false;
+  /// The result shown is one in between (blocks done of total), and whether its update was cancelled.
+  bool shownPartial_ = false, partialCancelled_ = false;
+  int partialDone_ = 0, partialTotal_ = 0;
+  /// Per-block bounds were turned off by a bound's slider: the parcel count before, for the notice.
+  std::optional<std::size_t> boundsNoticeBefore_;
+  QString boundsNotice_;
+  /// The overrides when last saved or opened (overridesText()).
+  std::string savedOverrides_;
   QLabel* status_;
   QProgressBar* progress_;
   QPushButton* cancel_;

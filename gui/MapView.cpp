@@ -1,7 +1,9 @@
 #include "MapView.h"
 
 #include <QVTKOpenGLStereoWidget.h>
+#include <QHBoxLayout>
 #include <QLabel>
+#include <QPainter>
 #include <QTimer>
 #include <QVBoxLayout>
 
@@ -32,10 +34,44 @@ constexpr double kLegendBand = 0.14;  // of the view's height
 // keys ('w' wireframe, 's' surface, '3' stereo, 'r' reset the camera, 'e'/'q'
 // quit, ...) are not the window's: keys do nothing here, and the window's
 // shortcuts (View > Zoom to extent) reach the window.
+// The scale bar under a map: a bar of MapView::scaleBarPixels() with its length in metres.
+class ScaleBarWidget : public QWidget {
+public:
+  ScaleBarWidget(MapView* view, QWidget* parent) : QWidget(parent), view_(view) {
+    setMinimumSize(100, fontMetrics().height() + 6);
+    setObjectName("scaleBar");
+  }
+
+  QSize sizeHint() const override { return {200, minimumHeight()}; }
+
+protected:
+  void paintEvent(QPaintEvent*) override {
+    if (view_->scaleBarPixels() <= 0) return;
+    QPainter p(this);
+    p.setRenderHint(QPainter::Antialiasing, false);
+    const int h = height(), x0 = 4, x1 = x0 + view_->scaleBarPixels(), y = h - 4;
+    p.setPen(QPen(Qt::black, 2));
+    p.drawLine(x0, y, x1, y);
+    p.drawLine(x0, y, x0, y - 5);
+    p.drawLine(x1, y, x1, y - 5);
+    p.drawText(QRect(x1 + 6, 0, width() - x1 - 6, h), Qt::AlignLeft | Qt::AlignVCenter, view_->scaleBarText());
+  }
+
+private:
+  MapView* view_;
+};
+
 class PanZoomStyle : public vtkInteractorStyleTrackballCamera {
 public:
   static PanZoomStyle* New();
   vtkTypeMacro(PanZoomStyle, vtkInteractorStyleTrackballCamera) std::function<void(int, int)> onClick;
+  std::function<void(int, int)> onMove;
+
+  void OnMouseMove() override {
+    vtkInteractorStyleTrackballCamera::OnMouseMove();
+    const int* p = GetInteractor()->GetEventPosition();
+    if (onMove) onMove(p[0], p[1]);
+  }
 
   void OnChar() override {}
   void OnKeyPress() override {}
@@ -119,6 +155,7 @@ MapView::MapView(const QString& title, bool withColourBar, QWidget* parent) : QW
   layout->setSpacing(2);
   title_ = new QLabel(title, this);
   title_->setAlignment(Qt::AlignCenter);
+  title_->setWordWrap(true);  // a long title takes two lines rather than widening the window
   QFont f = title_->font();
   f.setBold(true);
   title_->setFont(f);
@@ -128,12 +165,24 @@ MapView::MapView(const QString& title, bool withColourBar, QWidget* parent) : QW
   // whole window through OpenGL after every frame instead, which with a
   // software OpenGL costs about 30 ms per change.
   widget_ = new QVTKOpenGLStereoWidget(this);
-  widget_->setMinimumSize(240, 200);
+  widget_->setMinimumSize(160, 120);
   // No multisampling: with a software OpenGL (Xvfb, remote desktops) it makes
   // every frame several times slower; the maps are flat fills and thin lines.
   window_->SetMultiSamples(0);
   widget_->setRenderWindow(window_);
   layout->addWidget(widget_, 1);
+  auto* below = new QHBoxLayout;
+  below->setContentsMargins(2, 0, 2, 0);
+  scaleBar_ = new ScaleBarWidget(this, this);
+  readout_ = new QLabel(this);
+  readout_->setObjectName("readout");
+  readout_->setAlignment(Qt::AlignRight | Qt::AlignVCenter);
+  readout_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  readout_->setMinimumWidth(60);
+  readout_->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Preferred);
+  below->addWidget(scaleBar_, 0);
+  below->addWidget(readout_, 1);
+  layout->addLayout(below);
 
   // The map above, a legend band below (the same in both views, so that
   // linked views show the same extent).
@@ -180,6 +229,13 @@ MapView::MapView(const QString& title, bool withColourBar, QWidget* parent) : QW
     legend_->AddActor2D(hint);
   }
   vtkNew<PanZoomStyle> style;
+  style->onMove = [this](int x, int y) {
+    renderer_->SetDisplayPoint(x, y, 0);
+    renderer_->DisplayToWorld();
+    double w[4];
+    renderer_->GetWorldPoint(w);
+    if (w[3] != 0) emit pointerMoved(w[0] / w[3], w[1] / w[3]);
+  };
   style->onClick = [this](int x, int y) {
     renderer_->SetDisplayPoint(x, y, 0);
     renderer_->DisplayToWorld();
@@ -233,7 +289,47 @@ QPoint MapView::widgetPoint(const Point& p) {
 void MapView::render() {
   renderPending_ = false;
   window_->Render();
+  updateScaleBar();
 }
+
+double MapView::metresPerPixel() {
+  const double mapHeight = widget_->height() * (1 - kLegendBand);
+  if (mapHeight <= 0 || !camera_) return 0;
+  return 2 * camera_->GetParallelScale() / mapHeight;
+}
+
+void MapView::updateScaleBar() {
+  const double perPixel = metresPerPixel();
+  double metres = 0;
+  int pixels = 0;
+  if (perPixel > 0 && std::isfinite(perPixel)) {
+    // The longest bar, in metres: 120 px, or less in a narrow view.
+    const double most = std::min(120, std::max(20, scaleBar_->width() - 70)) * perPixel;
+    const double decade = std::pow(10.0, std::floor(std::log10(most)));
+    for (double step : {5.0, 2.0, 1.0}) {
+      if (step * decade <= most) {
+        metres = step * decade;
+        break;
+      }
+    }
+    pixels = static_cast<int>(std::lround(metres / perPixel));
+  }
+  if (metres == barMetres_ && pixels == barPixels_) return;
+  barMetres_ = metres;
+  barPixels_ = pixels;
+  scaleBar_->update();
+}
+
+QString MapView::scaleBarText() const {
+  if (barMetres_ <= 0) return {};
+  if (barMetres_ >= 1000) return QString::number(barMetres_ / 1000, 'g', 6) + " km";
+  return QString::number(barMetres_, 'g', 6) + " m";
+}
+
+void MapView::setReadout(const QString& text) {
+  if (readout_->text() != text) readout_->setText(text);
+}
+QString MapView::readout() const { return readout_->text(); }
 
 void MapView::scheduleRender() {
   if (renderPending_) return;

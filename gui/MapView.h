@@ -3,6 +3,7 @@
 // selected block's outline and, optionally, the shared colour bar. Drag pans,
 // the wheel zooms about the point under the cursor, a click reports the world
 // point under the cursor; VTK's own keys (wireframe, stereo, quit, ...) are off.
+// Below the map: a scale bar and the coordinates of the point under the cursor.
 #include <QWidget>
 
 #include <vtkNew.h>
@@ -37,13 +38,29 @@ public:
   QVTKOpenGLStereoWidget* vtkWidget() { return widget_; }
   /// Where the world point `p` (local metres) appears in vtkWidget(), in widget coordinates.
   QPoint widgetPoint(const Point& p);
+  /// Metres per (logical) pixel of the map at the current zoom; 0 before it has a size.
+  double metresPerPixel();
+  /// The scale bar: its length in metres, in logical pixels, and its label ("50 m").
+  double scaleBarMetres() const { return barMetres_; }
+  int scaleBarPixels() const { return barPixels_; }
+  QString scaleBarText() const;
+  /// The coordinate readout under the map (set by the window from pointerMoved).
+  void setReadout(const QString& text);
+  QString readout() const;
 
 signals:
-  void clicked(double x, double y);  ///< local metres
+  void clicked(double x, double y);       ///< local metres
+  void pointerMoved(double x, double y);  ///< local metres of the point under the cursor
 
 private:
   void scheduleRender();
+  /// Chooses the scale bar's length (1, 2 or 5 times a power of ten metres, at most 120 px).
+  void updateScaleBar();
   QLabel* title_;
+  QWidget* scaleBar_;
+  QLabel* readout_;
+  double barMetres_ = 0;
+  int barPixels_ = 0;
   QVTKOpenGLStereoWidget* widget_;
   vtkNew<vtkGenericOpenGLRenderWindow> window_;
   vtkNew<vtkRenderer> renderer_;

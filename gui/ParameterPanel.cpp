@@ -67,6 +67,16 @@ void ParameterPanel::addRow(QGridLayout* grid, int line, const ParameterDescript
     return;
   }
   row.logarithmic = d.minimum >= 0 && d.maximum - d.minimum > 1000 && !d.integer();
+  if (row.logarithmic) {
+    // A slider some 250 px long over six decades moved a bound several-fold
+    // per few pixels (W_max from 30 m to over 1,000 m in 40 px). It spans the
+    // values that matter instead, default / 10 to default x 10 (W_max: 3 to
+    // 300 m, about 2 % a pixel), logarithmically; the spin box takes the
+    // whole range, and the slider rests at its end beyond it.
+    const double centre = d.defaultValue > 0 ? d.defaultValue : std::max(1.0, d.maximum / 1e4);
+    row.low = std::max(d.minimum > 0 ? d.minimum : 0.0, centre / 10);
+    row.high = std::min(d.maximum, centre * 10);
+  }
   row.slider = new QSlider(Qt::Horizontal, box);
   row.slider->setObjectName(QString::fromStdString("slider-" + d.name));
   row.slider->setToolTip(help);
@@ -113,7 +123,7 @@ void ParameterPanel::emitChanged(const std::string& name, double value) {
 int ParameterPanel::toSlider(const Row& row, double v) const {
   const ParameterDescription& d = row.description;
   if (row.slider->maximum() != kSteps || row.slider->minimum() != 0) return static_cast<int>(std::lround(v));
-  double t = row.logarithmic ? std::log1p(v - d.minimum) / std::log1p(d.maximum - d.minimum)
+  double t = row.logarithmic ? std::log(std::max(v, row.low) / row.low) / std::log(row.high / row.low)
                              : (v - d.minimum) / (d.maximum - d.minimum);
   return static_cast<int>(std::lround(std::clamp(t, 0.0, 1.0) * kSteps));
 }
@@ -122,8 +132,13 @@ double ParameterPanel::fromSlider(const Row& row, int position) const {
   const ParameterDescription& d = row.description;
   if (row.slider->maximum() != kSteps || row.slider->minimum() != 0) return position;
   const double t = static_cast<double>(position) / kSteps;
-  double v = row.logarithmic ? d.minimum + std::expm1(t * std::log1p(d.maximum - d.minimum))
-                             : d.minimum + t * (d.maximum - d.minimum);
+  double v =
+      row.logarithmic ? row.low * std::exp(t * std::log(row.high / row.low)) : d.minimum + t * (d.maximum - d.minimum);
+  // Three significant digits: a slider position names a round value.
+  if (row.logarithmic && v > 0) {
+    const double unit = std::pow(10.0, std::floor(std::log10(v)) - 2);
+    v = std::round(v / unit) * unit;
+  }
   if (d.integer()) v = std::round(v);
   return std::clamp(v, d.minimum, d.maximum);
 }
@@ -139,7 +154,11 @@ void ParameterPanel::setValues(const ParameterValues& values) {
       row.check->setChecked(it->second != 0);
     } else {
       row.spin->setValue(it->second);
-      row.slider->setValue(toSlider(row, it->second));
+      // A slider that already names this value stays put: a rounded value may
+      // map back to the next position, which would move a slider being dragged.
+      const double shown = fromSlider(row, row.slider->value());
+      if (std::abs(shown - row.spin->value()) > 0.5 * std::pow(10.0, -row.spin->decimals()) + 1e-12)
+        row.slider->setValue(toSlider(row, it->second));
     }
   }
   quiet_ = false;

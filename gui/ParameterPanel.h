@@ -2,7 +2,8 @@
 // The parameters' controls, built from their descriptions (name, help, unit,
 // range, default, group, kind), so the GUI offers exactly what the command
 // line takes: one box per group, and in it a slider and a spin box per real or
-// integer parameter (wide ranges get a logarithmic slider), a combo box of the
+// integer parameter (wide ranges get a logarithmic slider over the values that
+// matter, default / 10 to default x 10; the spin box takes the whole range), a combo box of the
 // labels per enum, a check box per boolean.
 #include <QString>
 #include <QWidget>
@@ -55,6 +56,8 @@ private:
     QComboBox* combo = nullptr;
     QCheckBox* check = nullptr;
     bool logarithmic = false;
+    /// The values a logarithmic slider spans (the spin box takes the whole range).
+    double low = 0, high = 0;
   };
   void addRow(QGridLayout* grid, int line, const ParameterDescription& d);
   void emitChanged(const std::string& name, double value);

@@ -1,5 +1,5 @@
 // parcelscope-gui [INPUT] [--layer L] [--where SQL] [--crs EPSG:N] [--session FILE] [--sample]
-//                 [--subdivision-style STYLE] [--screenshot PNG]
+//                 [--subdivision-style STYLE] [--screenshot PNG] [--window-size WxH]
 #include <QVTKOpenGLStereoWidget.h>
 #include <QApplication>
 #include <QCommandLineParser>
@@ -28,10 +28,26 @@ int main(int argc, char** argv) {
       "STYLE");
   const QCommandLineOption screenshot("screenshot", "save the window as PNG once it shows its first result, then quit",
                                       "PNG");
-  parser.addOptions({layer, where, crs, session, sample, style, screenshot});
+  const QCommandLineOption size("window-size",
+                                "size of the window in screen pixels (e.g. 1366x768; at QT_SCALE_FACTOR=1.5 "
+                                "that is 911 x 512 of the window's own)",
+                                "WxH");
+  parser.addOptions({layer, where, crs, session, sample, style, screenshot, size});
   parser.process(app);
 
   parcelscope::gui::MainWindow window;
+  if (parser.isSet(size)) {
+    const QStringList wh = parser.value(size).split('x');
+    bool okW = false, okH = false;
+    const int w = wh.value(0).toInt(&okW), h = wh.value(1).toInt(&okH);
+    if (wh.size() != 2 || !okW || !okH || w <= 0 || h <= 0) {
+      std::fprintf(stderr, "parcelscope-gui: --window-size %s is not WxH\n",
+                   parser.value(size).toLocal8Bit().constData());
+      return 2;
+    }
+    const double ratio = window.devicePixelRatioF();
+    window.resize(static_cast<int>(w / ratio), static_cast<int>(h / ratio));
+  }
   window.show();
   if (parser.isSet(style)) window.setStyle(parser.value(style));
   if (parser.isSet(screenshot)) {

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <stdexcept>
+#include <string>
 
 #include "BlockFailure.h"
 #include "LocalShift.h"
@@ -95,7 +97,20 @@ using NodePtr = std::shared_ptr<const Node>;
 // given the ring's convex hull.
 OrientedBox edgeAlignedBox(const Ring& ring, const Ring& hull) { return smallestBoxAlongEdges(hull, ring); }
 
+// The work budget of a block (docs/algorithms/obb.md#work-budget): parcels
+// made, and vertices visited by the split lines tried (the pieces' rings and
+// the contour vertices a line may snap to). Counted, not timed, so that a
+// block's outcome does not depend on the machine. A block beyond either comes
+// back whole, failed, with the reason; real blocks stay far below (the largest
+// of the shared datasets' blocks use about 1 % of each).
 constexpr std::size_t kMaxParcelsPerBlock = 200000;
+constexpr std::uint64_t kMaxSplitWork = 400000000;
+constexpr std::uint64_t kMaxAccessWork = 4000000000;
+
+// Thrown when a block exceeds its work budget; the message is the failure.
+struct OverBudget : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 class Subdivider {
 public:
@@ -125,8 +140,14 @@ private:
     double offset;  // shift of the pivot from the OBB centre (m)
   };
 
-  bool hasAccess(const Polygon& piece) const {
-    return holdsOutlineEdge(piece.outer) || outlineEdges_->sharesAtLeast(piece, p_.minFrontage);
+  bool hasAccess(const Polygon& piece) {
+    if (holdsOutlineEdge(piece.outer)) return true;
+    // The measure pairs the piece's edges with the outline's near them: at
+    // most their product, counted against the budget.
+    std::size_t pieceVertices = piece.outer.size();
+    for (const Ring& h : piece.holes) pieceVertices += h.size();
+    chargeAccess(static_cast<std::uint64_t>(pieceVertices) * block_.outer.size());
+    return outlineEdges_->sharesAtLeast(piece, p_.minFrontage);
   }
 
   struct Vertex {
@@ -137,22 +158,30 @@ private:
     return a.p.x < b.p.x || (a.p.x == b.p.x && a.p.y < b.p.y);
   }
 
-  // A shortcut of the access test: the ring has a whole edge of the block's
+  // A shortcut of the access test: the ring has whole edges of the block's
   // outer ring (the same two vertices, in the same order, as counter-clockwise
-  // rings keep them) clearly longer than the frontage needed. That edge alone
-  // gives the measured shared length, so the test would pass too.
+  // rings keep them) clearly longer together than the frontage needed. Those
+  // edges alone give the measured shared length, so the test would pass too.
+  // (Edges of a few centimetres, as on outlines of many thousand vertices,
+  // add up here; the full measure pairs edges and costs their product.)
   bool holdsOutlineEdge(const Ring& ring) const {
     const Ring& outline = block_.outer;
     const std::size_t n = ring.size(), m = outline.size();
     const double needed = p_.minFrontage * (1 + 1e-9);
+    double held = 0;
     for (std::size_t i = 0; i < n; ++i) {
       const Point& a = ring[i];
       const Point& b = ring[(i + 1) % n];
-      if (!(norm(b.x - a.x, b.y - a.y) > needed)) continue;
+      const double length = norm(b.x - a.x, b.y - a.y);
+      if (!(length > 0)) continue;
       const auto at = std::lower_bound(outlineVertices_.begin(), outlineVertices_.end(), Vertex{a, 0}, byPosition);
       for (auto v = at; v != outlineVertices_.end() && v->p.x == a.x && v->p.y == a.y; ++v) {
         const Point& next = outline[(v->index + 1) % m];
-        if (next.x == b.x && next.y == b.y) return true;
+        if (next.x == b.x && next.y == b.y) {
+          held += length;
+          if (held > needed) return true;
+          break;
+        }
       }
     }
     return false;
@@ -312,7 +341,7 @@ private:
   // the OBB axes, so seeds follow position) with their access; no parts when
   // no candidate is admissible.
   ObbSplits::Split split(const Polygon& piece, double pieceArea, const Ring& hull, bool pieceSimple, bool access,
-                         bool wantAccess, double shiftAcross, double shiftAlong) const {
+                         bool wantAccess, double shiftAcross, double shiftAlong) {
     const OrientedBox box = edgeAlignedBox(piece.outer, hull);
     const Point u = box.u, v{-box.u.y, box.u.x};
     // Scratch kept across calls on this thread (split does not recurse).
@@ -330,6 +359,8 @@ private:
       for (double f : {0.25 * shiftAlong, 0.0, 0.15, -0.15, 0.3, -0.3}) candidates.push_back({true, f * box.width});
     };
     const Box near = bounds(piece);
+    std::size_t pieceVertices = piece.outer.size();
+    for (const Ring& h : piece.holes) pieceVertices += h.size();
     for (std::size_t c = 0; c < candidates.size(); ++c) {
       const Candidate cand = candidates[c];
       const Point dir = cand.rotated ? u : v;
@@ -339,6 +370,7 @@ private:
       // sliver along a contour edge parallel to it), the line as drawn.
       std::vector<Polygon> parts;
       bool admissible = false;
+      charge(2 * pieceVertices + (p_.snapDistance > 0 ? contour_.size() : 0));
       const Point snapped = snap(pivot, dir, near);
       for (const Point& through : {snapped, pivot}) {
         parts = admissibleSplit(piece, pieceArea, through, dir, pieceSimple, areas, partSimple);
@@ -417,9 +449,12 @@ private:
       if (std::isnan(width)) width = minimumAreaBoxOfHull(hullOf()).width;
       fits = width <= p_.wMax;
     }
-    // Safety nets against pathological bounds: recursion depth and a budget of
-    // parcels per block.
-    if (fits || depth > 60 || out_.parcels.size() >= kMaxParcelsPerBlock) {
+    // A safety net against pathological bounds: the recursion depth (the
+    // parcels' count is in the work budget).
+    if (!fits && depth <= 60 && out_.parcels.size() >= kMaxParcelsPerBlock) {
+      throw OverBudget("work budget: more than " + std::to_string(kMaxParcelsPerBlock) + " parcels");
+    }
+    if (fits || depth > 60) {
       emit(piece, access, !fits);
       return record_ ? previous : nullptr;  // what is known below stays for smaller bounds
     }
@@ -453,6 +488,23 @@ private:
     return record_ ? NodePtr(std::move(node)) : nullptr;
   }
 
+  // Counts edge pairs the access measure may compare against the budget.
+  void chargeAccess(std::uint64_t pairs) {
+    accessWork_ += pairs;
+    if (accessWork_ > kMaxAccessWork) {
+      throw OverBudget("work budget: street-access tests paired more than " + std::to_string(kMaxAccessWork) +
+                       " edges");
+    }
+  }
+
+  // Counts `vertices` visited against the block's work budget.
+  void charge(std::size_t vertices) {
+    work_ += vertices;
+    if (work_ > kMaxSplitWork) {
+      throw OverBudget("work budget: split lines visited more than " + std::to_string(kMaxSplitWork) + " vertices");
+    }
+  }
+
   // Whether the block has no holes and a strictly simple ring, tested once
   // (when first needed, unless known) and kept in out_.blockSimple.
   bool blockSimple() {
@@ -470,6 +522,8 @@ private:
   std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;  // outline_, for the access test
   bool record_ = false;
   int blockSimple_ = -1;
+  std::uint64_t work_ = 0;               // vertices visited by split lines (see kMaxSplitWork)
+  std::uint64_t accessWork_ = 0;         // edge pairs of access tests (see kMaxAccessWork)
   Ring hull_;                            // the hull of the piece recurse() is deciding on
   std::vector<Vertex> outlineVertices_;  // of block_.outer, by position
 };
@@ -499,6 +553,12 @@ Subdivision subdivideObb(const Polygon& block, const ObbParameters& parameters, 
     if (!normalised || (!reuse.blockChecked && simple != 1 && !detail::isValidForSplit(local))) {
       out.failed = true;
       out.failure = "block is not a valid polygon with holes for exact splitting";
+    } else if (const double least = area(local) / p.aMax; least > kMaxParcelsPerBlock) {
+      // Parcels are at most A_max wherever a split is admissible: the block
+      // would make about this many, without a split line drawn.
+      out.failed = true;
+      out.failure = "work budget: area / A_max = " + std::to_string(static_cast<long long>(std::min(least, 1e18))) +
+                    " parcels, more than " + std::to_string(kMaxParcelsPerBlock);
     } else {
       out.blockSimple = static_cast<signed char>(simple);
       const NodePtr previous = reuse.previous ? reuse.previous->root : nullptr;

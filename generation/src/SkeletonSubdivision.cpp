@@ -75,12 +75,24 @@ using Skeleton = CGAL::Straight_skeleton_2<Kc>;
 // until memory runs out or crashes. Before the tidying starts, every face cycle
 // is walked here with a bound; a broken one stops the construction (CGAL turns
 // the exception into a null skeleton).
+// It also counts the events the construction creates (each holds a few
+// hundred bytes until the construction ends) against the block's work budget
+// (kMaxSkeletonEvents), and stops it beyond.
 struct GuardVisitor : CGAL::Dummy_straight_skeleton_builder_2_visitor<Skeleton> {
   using Halfedge = Skeleton::Halfedge_const_handle;
+  using Vertex = Skeleton::Vertex_const_handle;
   mutable std::vector<Halfedge> contour;
   mutable bool broken = false;
+  mutable bool overBudget = false;
+  mutable std::size_t events = 0;
+  std::size_t maxEvents = 0;
+
+  explicit GuardVisitor(std::size_t budget) : maxEvents(budget) {}
 
   void on_contour_edge_entered(const Halfedge& h) const { contour.push_back(h); }
+  void on_edge_event_created(const Vertex&, const Vertex&) const { count(); }
+  void on_split_event_created(const Vertex&) const { count(); }
+  void on_pseudo_split_event_created(const Vertex&, const Vertex&) const { count(); }
 
   void on_cleanup_started() const {
     const std::size_t limit = 64 * contour.size() + 1024;
@@ -102,6 +114,11 @@ private:
     broken = true;
     throw std::runtime_error("broken skeleton face");
   }
+  void count() const {
+    if (++events <= maxEvents) return;
+    overBudget = true;
+    throw std::runtime_error("skeleton events over budget");
+  }
 };
 using SkeletonTraits = CGAL::Straight_skeleton_builder_traits_2<Kc>;
 using SkeletonMaker = CGAL::Straight_skeleton_builder_2<SkeletonTraits, Skeleton, GuardVisitor>;
@@ -111,6 +128,11 @@ using SkeletonMaker = CGAL::Straight_skeleton_builder_2<SkeletonTraits, Skeleton
 using Fallback = detail::StyleFailure;
 struct SkeletonFolds : Fallback {
   SkeletonFolds() : Fallback("a skeleton face is not simple once rounded") {}
+};
+// The block exceeds its work budget (docs/algorithms/skeleton.md#work-budget):
+// no other try can do better, it goes to the OBB style at once.
+struct OverBudget : Fallback {
+  explicit OverBudget(const std::string& what) : Fallback("work budget: " + what) {}
 };
 
 K::Point_2 exact(const Point& p) { return {p.x, p.y}; }
@@ -135,6 +157,16 @@ struct Edge {
 // kMaxFullVertices vertices.
 constexpr double kChordTolerances[] = {0.5, 1.0, 0.25, 0.0};  // m
 constexpr std::size_t kMaxFullVertices = 1500;
+
+// The work budget of a block, counted rather than timed so that the outcome
+// does not depend on the machine (docs/algorithms/skeleton.md#work-budget).
+// The skeleton's events grow with the square of its contour vertices in the
+// worst case: a try whose kept vertices exceed kMaxSkeletonVertices doubles
+// its chord tolerance, up to half of W_min, until they fit. Beyond any of
+// these, the block goes to the OBB style with the reason.
+constexpr std::size_t kMaxSkeletonVertices = 2000;
+constexpr std::size_t kMaxSkeletonEvents = 500000;
+constexpr double kMaxStripParcels = 10000;  // street length / mean parcel width
 
 // Largest move of a contour vertex in the skeleton's input (m); see buildSkeleton.
 constexpr double kJitter = 1e-6;
@@ -331,22 +363,40 @@ private:
     const double chordTolerance = chordTolerance_;
     std::vector<const Ring*> rings{&block.outer};
     for (const Ring& h : block.holes) rings.push_back(&h);
-    // The kept vertices, unless dropping the others makes the polygon invalid.
+    // The kept vertices, unless dropping the others makes the polygon invalid;
+    // a coarser tolerance while they exceed the budget (see kMaxSkeletonVertices).
     std::vector<std::vector<std::size_t>> kept;
-    Polygon simplified;
-    for (const Ring* ring : rings) {
-      kept.push_back(simplifiedRing(*ring, chordTolerance));
-      Ring r;
-      for (std::size_t i : kept.back()) r.push_back((*ring)[i]);
-      (simplified.outer.empty() ? simplified.outer : simplified.holes.emplace_back()) = r;
-    }
-    bool usable = true;
-    for (const auto& k : kept) usable = usable && k.size() >= 3;
-    if (!usable || !detail::isValidForSplit(simplified)) {
-      for (std::size_t r = 0; r < rings.size(); ++r) {
-        kept[r].resize(rings[r]->size());
-        for (std::size_t i = 0; i < kept[r].size(); ++i) kept[r][i] = i;
+    for (double tolerance = chordTolerance;; tolerance *= 2) {
+      kept.clear();
+      Polygon simplified;
+      for (const Ring* ring : rings) {
+        kept.push_back(simplifiedRing(*ring, tolerance));
+        Ring r;
+        for (std::size_t i : kept.back()) r.push_back((*ring)[i]);
+        (simplified.outer.empty() ? simplified.outer : simplified.holes.emplace_back()) = r;
       }
+      std::size_t count = 0;
+      for (const auto& k : kept) count += k.size();
+      if (count > kMaxSkeletonVertices) {
+        if (tolerance > 0 && 2 * tolerance <= 0.5 * p_.bounds.wMin) continue;
+        throw OverBudget(std::to_string(count) + " skeleton contour vertices at a chord tolerance of " +
+                         std::to_string(tolerance) + " m, more than " + std::to_string(kMaxSkeletonVertices));
+      }
+      bool usable = true;
+      for (const auto& k : kept) usable = usable && k.size() >= 3;
+      if (!usable || !detail::isValidForSplit(simplified)) {
+        std::size_t all = 0;
+        for (const Ring* ring : rings) all += ring->size();
+        if (all > kMaxSkeletonVertices) {
+          throw OverBudget(std::to_string(all) + " skeleton contour vertices (simplified, the block is not valid), " +
+                           "more than " + std::to_string(kMaxSkeletonVertices));
+        }
+        for (std::size_t r = 0; r < rings.size(); ++r) {
+          kept[r].resize(rings[r]->size());
+          for (std::size_t i = 0; i < kept[r].size(); ++i) kept[r][i] = i;
+        }
+      }
+      break;
     }
     for (std::size_t r = 0; r < rings.size(); ++r) {
       const Ring& ring = *rings[r];
@@ -374,6 +424,15 @@ private:
       }
     }
     ringStart_.push_back(static_cast<int>(edges_.size()));
+    // Step 4 cuts the streets into parcels of the mean width: their count is
+    // known now, before any exact construction.
+    double street = 0;
+    for (int g = ringStart_[0]; g < ringStart_[1]; ++g) street += edges_[g].length;
+    if (!(street / target_ <= kMaxStripParcels)) {
+      throw OverBudget("about " + std::to_string(static_cast<long long>(std::min(street / target_, 1e18))) +
+                       " parcels along the streets, more than " +
+                       std::to_string(static_cast<long long>(kMaxStripParcels)));
+    }
   }
 
   // Computes the exact value of every constructed vertex of the regions and
@@ -438,11 +497,14 @@ private:
       for (int g = ringStart_[r]; g < ringStart_[r + 1]; ++g) hole.push_back(Kc::Point_2(input[g].x, input[g].y));
       holes.push_back(std::move(hole));
     }
-    GuardVisitor guard;
+    GuardVisitor guard(kMaxSkeletonEvents);
     SkeletonMaker maker(boost::none, SkeletonTraits(), guard);
     maker.enter_contour(outer.begin(), outer.end());
     for (const auto& hole : holes) maker.enter_contour(hole.vertices_begin(), hole.vertices_end());
     const auto ss = maker.construct_skeleton();
+    if (guard.overBudget) {
+      throw OverBudget("the straight skeleton made more than " + std::to_string(kMaxSkeletonEvents) + " events");
+    }
     if (!ss)
       throw Fallback(guard.broken ? "the straight skeleton came out broken" : "no straight skeleton could be built");
 

@@ -90,7 +90,7 @@ TEST(SharedHistogram, UpperQuantileSendsTheTailToTheLastBin) {
 // when that equals the smallest), every finite value is counted once, and
 // those above the last edge are the overflow.
 TEST(SharedHistogram, LastEdgeIsThePooledNearestRankQuantileOnRandomSamples) {
-  const unsigned seed = std::random_device{}();
+  const unsigned seed = 290101;  // fixed: a failure replays with the same seed
   std::mt19937 rng(seed);
   SCOPED_TRACE("seed " + std::to_string(seed));
   const double quantiles[] = {1.0, 0.99, 0.75, 0.5, 0.01};

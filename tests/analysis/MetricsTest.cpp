@@ -65,7 +65,7 @@ TEST(Metrics, CollinearVerticesAreNotCorners) {
 // (a block and its parcels): the prepared outline gives exactly what
 // sharedBoundaryLength gives, lot by lot.
 TEST(Metrics, PreparedBoundaryMeasuresAsSharedBoundaryLength) {
-  const unsigned seed = std::random_device{}();
+  const unsigned seed = 290102;  // fixed: a failure replays with the same seed
   SCOPED_TRACE("seed " + std::to_string(seed));
   std::mt19937 rng(seed);
   int withFrontage = 0;

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "OgrTestUtil.h"
 #include "TestUtil.h"
 #include "cli/CliRun.h"
 
@@ -25,6 +26,24 @@ CliRun run(const std::string& args) { return test::runCli(args); }
 
 const std::string kSample = std::string(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_town.geojson";
 
+// Rows of a CSV table, its header left out.
+std::int64_t csvRows(const std::string& path) {
+  const std::string csv = slurp(path);
+  const auto lines = std::count(csv.begin(), csv.end(), '\n');
+  return lines > 0 ? lines - 1 : 0;
+}
+
+// The parcels a generate run wrote to `out`, read back with GDAL: one feature
+// per row of parcels.csv, each a valid polygon of positive area, with the
+// documented fields, in the input's CRS.
+test::ReadLayer writtenParcels(const std::string& out) {
+  const OGRSpatialReference crs = test::layerCrs(kSample);
+  EXPECT_FALSE(crs.IsEmpty());
+  return test::expectValidPolygonLayer(
+      out + "/parcels.gpkg", csvRows(out + "/parcels.csv"),
+      {"parcels", {"parcel_id", "parcel_key", "block_id", "block_key", "area", "width", "aspect_ratio"}, &crs});
+}
+
 TEST(StatsCommand, WritesAllOutputsForTheBundledSample) {
   TempDir dir;
   const std::string out = dir.file("out");
@@ -40,6 +59,26 @@ TEST(StatsCommand, WritesAllOutputsForTheBundledSample) {
   int rows = 0;
   while (std::getline(blocks, line)) ++rows;
   EXPECT_EQ(rows, 10);  // the sample town has ten blocks (datasets/README.md)
+  // The block outlines read back: one valid polygon of positive area per row,
+  // in the input's CRS, each of the area blocks.csv gives it (in m2, the
+  // layer's degrees are not comparable: compared by share of the total).
+  const OGRSpatialReference crs = test::layerCrs(kSample);
+  const test::ReadLayer layer = test::expectValidPolygonLayer(
+      out + "/blocks.gpkg", rows, {"blocks", {"block_id", "block_key", "parcel_count", "block_area"}, &crs});
+  double total = 0;
+  for (const auto& f : layer.features) total += f->GetFieldAsDouble("block_area");
+  double totalDeg = 0;
+  std::vector<double> deg;
+  for (const auto& parts : layer.geometries) {
+    double a = 0;
+    for (const Polygon& p : parts) a += area(p);
+    deg.push_back(a);
+    totalDeg += a;
+  }
+  for (std::size_t i = 0; i < deg.size(); ++i) {
+    EXPECT_NEAR(deg[i] / totalDeg, layer.features[i]->GetFieldAsDouble("block_area") / total, 1e-3)
+        << "block feature " << layer.features[i]->GetFID();
+  }
   std::stringstream json;
   json << std::ifstream(out + "/run.json").rdbuf();
   for (const char* key : {"\"version\"", "\"duplicates_collapsed\": 3", "\"invalid_repaired\": 1",
@@ -52,9 +91,11 @@ TEST(StatsCommand, UsageErrorsExitTwo) {
   EXPECT_EQ(run("").code, 2);
   EXPECT_EQ(run("frobnicate").code, 2);
   EXPECT_EQ(run("stats '" + kSample + "'").code, 2);  // no --out
-  const CliRun r = run("stats '" + kSample + "' --out /tmp/x --k -1");
+  TempDir dir;
+  const CliRun r = run("stats '" + kSample + "' --out '" + dir.file("x") + "' --k -1");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("--k"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir.file("x")));
   EXPECT_EQ(run("stats --help").code, 0);
 }
 
@@ -170,10 +211,16 @@ TEST(GenerateCommand, FromParcelsWritesParcelsAndIsReproducibleFromTheSeed) {
   EXPECT_NE(json.find("\"blocks_failed\": 0"), std::string::npos) << json;
   EXPECT_NE(json.find("\"seed\": 7"), std::string::npos) << json;
 
+  const test::ReadLayer a7 = writtenParcels(dir.file("a"));
+  ASSERT_GT(a7.geometries.size(), 100u);
+
+  // The same seed: the same parcels, vertex for vertex; another seed: others.
   ASSERT_EQ(run(base + " --seed 7 --out '" + dir.file("b") + "'").code, 0);
   EXPECT_EQ(slurp(dir.file("b") + "/parcels.csv"), csv);
+  EXPECT_TRUE(test::sameGeometries(writtenParcels(dir.file("b")), a7));
   ASSERT_EQ(run(base + " --seed 8 --out '" + dir.file("c") + "'").code, 0);
   EXPECT_NE(slurp(dir.file("c") + "/parcels.csv"), csv);
+  EXPECT_FALSE(test::sameGeometries(writtenParcels(dir.file("c")), a7));
 }
 
 TEST(GenerateCommand, SubdividesTheBlocksThatStatsWrote) {
@@ -183,6 +230,7 @@ TEST(GenerateCommand, SubdividesTheBlocksThatStatsWrote) {
   ASSERT_EQ(g.code, 0) << g.output;
   const std::string json = slurp(dir.file("g") + "/run.json");
   EXPECT_NE(json.find("\"blocks\": 10"), std::string::npos) << json;
+  EXPECT_GT(writtenParcels(dir.file("g")).features.size(), 10u);
 }
 
 TEST(GenerateCommand, SkeletonOffsetAndAutoStylesRunOnTheSample) {
@@ -197,6 +245,7 @@ TEST(GenerateCommand, SkeletonOffsetAndAutoStylesRunOnTheSample) {
     EXPECT_NE(json.find("\"blocks\": 10"), std::string::npos) << json;
     EXPECT_NE(json.find("\"parcels_without_street_access\": 0"), std::string::npos) << json;
     EXPECT_NE(json.find("\"blocks_by_style\""), std::string::npos) << json;
+    writtenParcels(out);
     if (std::string(style) == "offset") {
       EXPECT_EQ(json.find("\"patio_parcels\": 0,"), std::string::npos)
           << "the sample's big blocks get patios: " << json;
@@ -204,9 +253,12 @@ TEST(GenerateCommand, SkeletonOffsetAndAutoStylesRunOnTheSample) {
       EXPECT_NE(json.find("\"patio_parcels\": 0"), std::string::npos) << json;
     }
   }
-  // Reproducible from the seed.
+  // Reproducible from the seed, vertex for vertex.
   ASSERT_EQ(run(base + " --style skeleton --out '" + dir.file("again") + "'").code, 0);
   EXPECT_EQ(slurp(dir.file("again") + "/parcels.csv"), slurp(dir.file("skeleton") + "/parcels.csv"));
+  const test::ReadLayer again = writtenParcels(dir.file("again"));
+  ASSERT_FALSE(again.geometries.empty());
+  EXPECT_TRUE(test::sameGeometries(again, writtenParcels(dir.file("skeleton"))));
 }
 
 TEST(GenerateCommand, BadStyleAndConflictingBoundsAreUsageErrors) {
@@ -229,6 +281,9 @@ TEST(GenerateCommand, EnumAndBooleanParametersTakeTheirLabelsAndRecordNumbers) {
                             dir.file("labels") + "'");
   ASSERT_EQ(labels.code, 0) << labels.output;
   EXPECT_EQ(slurp(dir.file("labels") + "/parcels.csv"), slurp(dir.file("numbers") + "/parcels.csv"));
+  const test::ReadLayer byLabels = writtenParcels(dir.file("labels"));
+  ASSERT_FALSE(byLabels.geometries.empty());
+  EXPECT_TRUE(test::sameGeometries(byLabels, writtenParcels(dir.file("numbers"))));
   const std::string json = slurp(dir.file("labels") + "/run.json");
   for (const char* value : {"\"corner-rule\": 1", "\"patio-obb\": 1", "\"detect-right-of-way\": 0"}) {
     EXPECT_NE(json.find(value), std::string::npos) << value << " in " << json;
@@ -237,6 +292,9 @@ TEST(GenerateCommand, EnumAndBooleanParametersTakeTheirLabelsAndRecordNumbers) {
   ASSERT_EQ(run(base + " --corner-rule street-width --patio-obb no --out '" + dir.file("defaults") + "'").code, 0);
   ASSERT_EQ(run(base + " --out '" + dir.file("plain") + "'").code, 0);
   EXPECT_EQ(slurp(dir.file("defaults") + "/parcels.csv"), slurp(dir.file("plain") + "/parcels.csv"));
+  const test::ReadLayer plain = writtenParcels(dir.file("plain"));
+  ASSERT_FALSE(plain.geometries.empty());
+  EXPECT_TRUE(test::sameGeometries(writtenParcels(dir.file("defaults")), plain));
 }
 
 TEST(GenerateCommand, AnUnknownLabelIsAUsageErrorNamingTheLabels) {

@@ -24,6 +24,7 @@
 #include <set>
 #include <thread>
 
+#include "OgrTestUtil.h"
 #include "TestUtil.h"
 #include "cli/CliRun.h"
 #include "parcelscope/io/FileHash.h"
@@ -166,16 +167,6 @@ void expectCompareOutputs(const std::string& out, const Expected& e) {
   EXPECT_EQ(observedInBlocks, observed);
   EXPECT_EQ(generatedInBlocks, generated);
 
-  // The generated layer: its name, field, count and the input's CRS.
-  auto gpkg = openVector(out + "/parcels.gpkg");
-  ASSERT_TRUE(gpkg);
-  OGRLayer* layer = gpkg->GetLayerByName("parcels");
-  ASSERT_NE(layer, nullptr);
-  EXPECT_GE(layer->GetLayerDefn()->GetFieldIndex("block_id"), 0);
-  EXPECT_GE(layer->GetLayerDefn()->GetFieldIndex("aspect_ratio"), 0);
-  EXPECT_EQ(layer->GetFeatureCount(), generated);
-  EXPECT_TRUE(layer->TestCapability(OLCFastSpatialFilter)) << "no spatial index";
-  ASSERT_NE(layer->GetSpatialRef(), nullptr);
   // The input's own CRS, or the one given with --crs.
   OGRSpatialReference expected;
   if (e.epsg > 0) {
@@ -185,7 +176,28 @@ void expectCompareOutputs(const std::string& out, const Expected& e) {
     ASSERT_TRUE(input && input->GetLayer(0)->GetSpatialRef());
     expected = *input->GetLayer(0)->GetSpatialRef();
   }
-  EXPECT_TRUE(layer->GetSpatialRef()->IsSame(&expected)) << layer->GetSpatialRef()->GetName();
+  // The written layers read back with GDAL: as many features as the tables
+  // count, each a valid polygon of positive area in the file as written, with
+  // the documented fields, in that CRS.
+  const test::ReadLayer parcels = test::expectValidPolygonLayer(
+      out + "/parcels.gpkg", generated,
+      {"parcels", {"parcel_id", "parcel_key", "block_id", "block_key", "area", "width", "aspect_ratio"}, &expected});
+  test::expectValidPolygonLayer(
+      out + "/blocks.gpkg", blocks,
+      {"blocks", {"block_id", "block_key", "block_area", "observed_parcels", "generated_parcels"}, &expected});
+  // Every generated parcel belongs to a compared block.
+  std::set<std::int64_t> blockIds;
+  for (std::size_t r = 1; r < blockRows.size(); ++r) {
+    blockIds.insert(std::stoll(blockRows[r][columnOf(blockRows[0], "block_id")]));
+  }
+  for (const auto& f : parcels.features) {
+    EXPECT_EQ(blockIds.count(f->GetFieldAsInteger64("block_id")), 1u) << "parcel feature " << f->GetFID();
+  }
+  auto gpkg = openVector(out + "/parcels.gpkg");
+  ASSERT_TRUE(gpkg);
+  OGRLayer* layer = gpkg->GetLayerByName("parcels");
+  ASSERT_NE(layer, nullptr);
+  EXPECT_TRUE(layer->TestCapability(OLCFastSpatialFilter)) << "no spatial index";
   expectTiling(out);
 
   // Figures: requested size, not blank; the charts also as SVG.
@@ -439,15 +451,25 @@ TEST(CompareCommand, SessionFileRerunsWithItsOverrides) {
   ASSERT_TRUE(run.Load(a + "/run.json"));
   EXPECT_EQ(run.GetRoot().GetLong("seed"), 5);
   EXPECT_EQ(run.GetRoot().GetObj("session").GetArray("overrides").Size(), 1);
-  // The run record is itself a session: the same parcels again.
+  // The run record is itself a session: the same parcels again, vertex for vertex.
   r = runCli("compare --session '" + a + "/run.json' --figures 0 --out '" + b + "' --quiet");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(test::slurp(a + "/generated_parcels.csv"), test::slurp(b + "/generated_parcels.csv"));
+  auto written = [](const std::string& out) {
+    CPLJSONDocument summary;
+    EXPECT_TRUE(summary.Load(out + "/summary.json")) << out;
+    return test::expectValidPolygonLayer(out + "/parcels.gpkg", summary.GetRoot().GetLong("generated/parcels", -1),
+                                         {"parcels", {"block_id"}, nullptr});
+  };
+  const test::ReadLayer withOverride = written(a);
+  ASSERT_FALSE(withOverride.geometries.empty());
+  EXPECT_TRUE(test::sameGeometries(withOverride, written(b)));
   // Without the override, block 3 differs.
   const std::string c = dir.file("c");
   r = compareSample(c, "--seed 5 --figures 0");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(test::slurp(a + "/generated_parcels.csv"), test::slurp(c + "/generated_parcels.csv"));
+  EXPECT_FALSE(test::sameGeometries(withOverride, written(c)));
 }
 
 TEST(CompareCommand, MetricDrawsItsMapAndHistogram) {
@@ -486,6 +508,12 @@ TEST(CompareCommand, PdfHistogramsAndGeoJsonParcels) {
   EXPECT_FALSE(fs::exists(out + "/figures/hist_area.svg"));
   EXPECT_NE(test::slurp(out + "/parcels.geojson").find("\"FeatureCollection\""), std::string::npos);
   EXPECT_FALSE(fs::exists(out + "/parcels.gpkg"));
+  // The GeoJSON read back: every generated parcel, valid, in the input's CRS.
+  CPLJSONDocument summary;
+  ASSERT_TRUE(summary.Load(out + "/summary.json"));
+  const OGRSpatialReference crs = test::layerCrs(kSample);
+  test::expectValidPolygonLayer(out + "/parcels.geojson", summary.GetRoot().GetLong("generated/parcels", -1),
+                                {"", {"parcel_id", "block_id", "aspect_ratio"}, &crs});
   const CliRun bad = compareSample(dir.file("bad"), "--parcels-format shp --figures 0");
   EXPECT_EQ(bad.code, 2) << bad.output;
   EXPECT_NE(bad.output.find("--parcels-format shp"), std::string::npos) << bad.output;

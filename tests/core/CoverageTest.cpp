@@ -110,7 +110,7 @@ TEST(DissolveCoverage, RingsTouchingAtAVertexStayApart) {
 // (holes and separate parts). The outline's area is the lots' area, and it
 // does not depend on the order of the lots.
 TEST(DissolveCoverage, RandomJitteredGrids) {
-  const unsigned seed = std::random_device{}();
+  const unsigned seed = 290104;  // fixed: a failure replays with the same seed
   SCOPED_TRACE("seed " + std::to_string(seed));
   std::mt19937 rng(seed);
   for (int round = 0; round < 50; ++round) {

@@ -49,7 +49,7 @@ std::vector<Polygon> mergedRows(std::mt19937& rng, int nx, int ny) {
 // only two cells meet) and rows of merged cells (T-junctions): the union
 // equals GEOS's general union of the same lots.
 TEST(GeosOps, UnionOfRandomGridsMatchesGeosUnion) {
-  const unsigned seed = std::random_device{}();
+  const unsigned seed = 290103;  // fixed: a failure replays with the same seed
   SCOPED_TRACE("seed " + std::to_string(seed));
   std::mt19937 rng(seed);
   for (int round = 0; round < 30; ++round) {

@@ -7,6 +7,7 @@
 
 #include "TestUtil.h"
 #include "generation/RandomShapes.h"
+#include "generation/StreetFrontage.h"
 #include "generation/TilingCheck.h"
 #include "parcelscope/analysis/Metrics.h"
 
@@ -160,7 +161,7 @@ TEST(SkeletonSubdivision, StreetWidthAndStreetLengthFlipTheCornerParcel) {
   const Subdivision unknown = subdivideSkeleton(block, p, 1);
   ASSERT_EQ(unknown.parcels.size(), byLength.parcels.size());
   for (std::size_t k = 0; k < unknown.parcels.size(); ++k) {
-    EXPECT_EQ(area(unknown.parcels[k]), area(byLength.parcels[k]));
+    EXPECT_TRUE(sameVertices(unknown.parcels[k], byLength.parcels[k])) << k;
   }
 }
 
@@ -222,12 +223,9 @@ TEST(SkeletonSubdivision, SameSeedSameParcelsOtherSeedOtherParcels) {
                     c = subdivideSkeleton(block, p, 43);
   ASSERT_FALSE(a.fallback) << a.fallbackReason;
   ASSERT_EQ(a.parcels.size(), b.parcels.size());
-  for (std::size_t k = 0; k < a.parcels.size(); ++k) {
-    EXPECT_EQ(a.parcels[k].outer.size(), b.parcels[k].outer.size());
-    EXPECT_EQ(area(a.parcels[k]), area(b.parcels[k]));
-  }
+  for (std::size_t k = 0; k < a.parcels.size(); ++k) EXPECT_TRUE(sameVertices(a.parcels[k], b.parcels[k])) << k;
   bool differs = a.parcels.size() != c.parcels.size();
-  for (std::size_t k = 0; !differs && k < a.parcels.size(); ++k) differs = area(a.parcels[k]) != area(c.parcels[k]);
+  for (std::size_t k = 0; !differs && k < a.parcels.size(); ++k) differs = !sameVertices(a.parcels[k], c.parcels[k]);
   EXPECT_TRUE(differs);
 }
 
@@ -270,16 +268,29 @@ TEST(SkeletonSubdivision, RandomShapesAreTiledValidlyWithStreetAccess) {
                              (sub.fallback ? " (fallback: " + sub.fallbackReason + ")" : "");
     ASSERT_FALSE(sub.failed) << what << ": " << sub.failure;
     EXPECT_TILES(block, sub.parcels, what);
-    if (!sub.fallback) {
-      withoutAccess += sub.withoutAccess;
-      patios += sub.patioParcels;
+    // Street access measured with GEOS, fallback blocks included: every
+    // parcel outside a patio has at least min-frontage on the block's outer
+    // ring (skeleton.md; a fallback block is OBB's at xi = 1, whose parcels
+    // all touch the street, obb.md), so at most the patios lack it.
+    ASSERT_EQ(p.bounds.xi, 1.0);  // randomBounds leaves the street-access preference at its default
+    const int measuredWithout = test::geosWithoutAccess(block, sub.parcels, p.bounds.minFrontage);
+    EXPECT_GE(measuredWithout, 0) << what << ": GEOS failed";
+    EXPECT_LE(measuredWithout, sub.patioParcels)
+        << what << ": " << measuredWithout << " parcels without street access, " << sub.patioParcels << " patios";
+    withoutAccess += std::max(0, measuredWithout - sub.patioParcels);
+    patios += sub.patioParcels;
+    if (sub.fallback) {
+      // The fallback is the OBB style with the same bounds: once it splits
+      // the block, no parcel is narrower than W_min (obb.md, stopping rule).
+      EXPECT_EQ(sub.patioParcels, 0) << what;
+      if (sub.parcels.size() > 1) EXPECT_EQ(test::narrowerThan(sub.parcels, p.bounds.wMin), 0) << what;
     }
     fallbacks += sub.fallback;
-    if (i % 25 == 0) {
+    if (i % 25 == 0) {  // reproducible from the seed, vertex for vertex
       const Subdivision again = subdivideSkeleton(block, p, s);
       ASSERT_EQ(again.parcels.size(), sub.parcels.size()) << what;
       for (std::size_t k = 0; k < sub.parcels.size(); ++k) {
-        EXPECT_EQ(area(again.parcels[k]), area(sub.parcels[k])) << what;
+        EXPECT_TRUE(sameVertices(again.parcels[k], sub.parcels[k])) << what << " parcel " << k;
       }
     }
     parcels += static_cast<int>(sub.parcels.size());
@@ -316,7 +327,7 @@ void expectSameSubdivision(const Subdivision& a, const Subdivision& b, const std
 // street angle or corner rule (the skeleton alone reused); a layout recorded
 // for another block is ignored.
 TEST(SkeletonSubdivision, ReusedLayoutGivesWhatAFreshRunGives) {
-  const std::uint64_t seed = std::random_device{}();
+  const std::uint64_t seed = 290107;  // fixed: a failure replays with the same seed
   SCOPED_TRACE("seed " + std::to_string(seed));
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);

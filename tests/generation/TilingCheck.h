@@ -56,6 +56,14 @@ inline int measuredWithoutAccess(const Polygon& block, const std::vector<Polygon
   return without;
 }
 
+/// Parcels narrower than `wMin`, width as the OBB style measures it (the short
+/// side of the minimum-area box of the outer ring), to a relative 1e-9.
+inline int narrowerThan(const std::vector<Polygon>& parcels, double wMin) {
+  int narrow = 0;
+  for (const Polygon& q : parcels) narrow += minimumAreaBox(q.outer).width < wMin * (1 - 1e-9);
+  return narrow;
+}
+
 #define EXPECT_TILES(block, parcels, what)                                 \
   do {                                                                     \
     const auto report_ = ::parcelscope::test::checkTiling(block, parcels); \

@@ -15,9 +15,12 @@
 #include <QGroupBox>
 #include <QLabel>
 #include <QMenu>
+#include <QMessageBox>
 #include <QMimeData>
 #include <QPushButton>
 #include <QRegularExpression>
+#include <QScrollArea>
+#include <QScrollBar>
 #include <QSignalSpy>
 #include <QSlider>
 #include <QStandardPaths>
@@ -26,6 +29,7 @@
 #include <QTemporaryDir>
 #include <QTest>
 #include <QTextBrowser>
+#include <QTimer>
 #include <QUrl>
 #include <QWheelEvent>
 #include <QWindow>
@@ -48,6 +52,8 @@
 #include "MainWindow.h"
 #include "MapView.h"
 #include "ParameterPanel.h"
+#include "parcelscope/analysis/Comparison.h"
+#include "parcelscope/core/Keys.h"
 #include "parcelscope/io/Writers.h"
 #include "parcelscope/pipeline/CompareJob.h"
 #include "viz/ImageCheck.h"
@@ -685,11 +691,335 @@ private slots:
     QCOMPARE(window_->request().parameters.at("w-max"), wMax);
     QVERIFY(window_->request().parameters.at("w-min") < wMax);
   }
+  // A click selects the parcel under the cursor and its block: the inspector
+  // shows the parcel's attributes and metrics, the block panel its block.
+  void clickingAParcelInspectsItAndItsBlock() {
+    window_->openSample();
+    QVERIFY(settle());
+    const auto r = window_->result();
+    // A procedural parcel of block 3.
+    const int block = 3;
+    int parcel = -1;
+    for (std::size_t e = 0; e < r->generated.blocks.size() && parcel < 0; ++e) {
+      if (r->generated.blockIds[e] == block && !r->generated.blocks[e].parcels.empty())
+        parcel = r->generated.blocks[e].parcels.front();
+    }
+    QVERIFY(parcel >= 0);
+    const parcelscope::Point inside = parcelscope::interiorPoint(r->generated.parcels[parcel]);
+    auto* view = window_->proceduralView();
+    window_->zoomToExtent();
+    QTest::mouseClick(view->vtkWidget()->embeddedOpenGLWindow(), Qt::LeftButton, {}, view->widgetPoint(inside));
+    QTest::qWait(50);
+    QCOMPARE(window_->selectedParcel(), parcel);
+    QVERIFY(window_->selectedParcelIsProcedural());
+    QCOMPARE(window_->selectedBlock(), block);
+    const QString info = window_->parcelInfoText();
+    QVERIFY2(info.contains("Procedural parcel " + QString::number(parcel)), qPrintable(info));
+    for (const auto& q : parcelscope::analysis::parcelMetrics())
+      QVERIFY2(info.contains(QString::fromStdString(q.name)), qPrintable(info));
+    auto* blockInfo = window_->findChild<QTextBrowser*>("blockInfo");
+    QVERIFY(blockInfo->toPlainText().contains("Block 3"));
+
+    // An observed parcel: its key and its block.
+    const auto& observed = r->observed->layer.parcels;
+    std::size_t lot = 0;
+    while (lot < observed.size() && r->observed->analysis.blockOf[lot] != 5) ++lot;
+    QVERIFY(lot < observed.size());
+    const parcelscope::Point there = parcelscope::interiorPoint(observed[lot].shape);
+    auto* left = window_->observedView();
+    QTest::mouseClick(left->vtkWidget()->embeddedOpenGLWindow(), Qt::LeftButton, {}, left->widgetPoint(there));
+    QTest::qWait(50);
+    QCOMPARE(window_->selectedParcel(), static_cast<int>(lot));
+    QVERIFY(!window_->selectedParcelIsProcedural());
+    QCOMPARE(window_->selectedBlock(), 5);
+    QVERIFY2(window_->parcelInfoText().contains(
+                 QString::fromStdString(parcelscope::keyText(parcelscope::parcelKey(observed[lot])))),
+             qPrintable(window_->parcelInfoText()));
+    QVERIFY(blockInfo->toPlainText().contains("Block 5"));
+    window_->selectBlock(-1);
+  }
+
+  // Under each view: a scale bar of a round length that follows the zoom, and
+  // the input coordinates (lon/lat for the sample) of the point under the cursor.
+  void viewsHaveAScaleBarAndACoordinateReadout() {
+    window_->zoomToExtent();
+    QTest::qWait(50);
+    parcelscope::gui::MapView* view = window_->proceduralView();
+    view->render();
+    const double metres = view->scaleBarMetres();
+    QVERIFY(metres > 0);
+    QVERIFY(view->scaleBarPixels() > 20 && view->scaleBarPixels() <= 120);
+    QVERIFY(std::abs(metres / view->scaleBarPixels() - view->metresPerPixel()) < 0.02 * view->metresPerPixel());
+    const double mantissa = metres / std::pow(10.0, std::floor(std::log10(metres)));
+    QVERIFY2(std::abs(mantissa - 1) < 1e-9 || std::abs(mantissa - 2) < 1e-9 || std::abs(mantissa - 5) < 1e-9,
+             qPrintable(view->scaleBarText()));
+    QVERIFY(view->scaleBarText().endsWith(" m") || view->scaleBarText().endsWith(" km"));
+    QWindow* surface = view->vtkWidget()->embeddedOpenGLWindow();
+    const CameraState fitted = cameraState(view->camera());
+    const parcelscope::Point p{fitted.focal[0] + 0.2 * fitted.scale, fitted.focal[1] - 0.1 * fitted.scale};
+    for (int i = 0; i < 4; ++i) turnWheel(surface, view->widgetPoint(p), 120);
+    QTest::qWait(50);
+    view->render();
+    QVERIFY2(view->scaleBarMetres() < metres, qPrintable(view->scaleBarText()));
+
+    QTest::mouseMove(surface, view->widgetPoint(p));
+    QTest::qWait(50);
+    const parcelscope::Point source = window_->result()->observed->layer.frame.toSource(p);
+    const QString readout = view->readout();
+    QVERIFY2(readout.startsWith("lon -71."), qPrintable(readout));
+    const QRegularExpression numbers(R"(lon (-?[\d.]+), lat (-?[\d.]+))");
+    const auto m = numbers.match(readout);
+    QVERIFY2(m.hasMatch(), qPrintable(readout));
+    // Within a pixel or two of the point (about 1e-5 degrees here).
+    QVERIFY2(std::abs(m.captured(1).toDouble() - source.x) < 2e-5, qPrintable(readout));
+    QVERIFY2(std::abs(m.captured(2).toDouble() - source.y) < 2e-5, qPrintable(readout));
+    QCOMPARE(window_->observedView()->readout(), readout);  // both views say where the cursor is
+    window_->zoomToExtent();
+  }
+
+  // Help > About names the version and the licences of the code, its
+  // libraries and the data.
+  void helpAboutNamesVersionAndLicences() {
+    QAction* about = findAction(window_, "About ParcelScope...");
+    QVERIFY(about);
+    about->trigger();
+    QMessageBox* box = nullptr;
+    QTRY_VERIFY((box = window_->findChild<QMessageBox*>("aboutBox")) != nullptr);
+    const QString text = box->text();
+    QVERIFY2(text.contains(QString::fromStdString(parcelscope::pipeline::version())), qPrintable(text));
+    for (const char* licence : {"CC0 1.0", "PDDL 1.0", "Licence Ouverte 2.0", "LGPL", "BSD", "no licence stated"}) {
+      QVERIFY2(text.contains(licence), licence);
+    }
+    box->accept();
+  }
+
+  // A bound slider moves in fine steps where the values matter (a 40 px drag
+  // of W_max from 30 m stays well within a factor of three), and moving one
+  // while blocks have their own bounds says so, with the parcel count.
+  void boundSlidersAreFineAndSayWhenPerBlockBoundsGo() {
+    window_->openSample();
+    QVERIFY(settle());
+    auto* perBlock = window_->findChild<QCheckBox*>("perBlockBounds");
+    perBlock->setChecked(true);
+    QVERIFY(settle());
+    QVERIFY(window_->notice().isEmpty());
+    QSlider* slider = window_->parameterPanel()->slider("w-max");
+    QDoubleSpinBox* spin = window_->parameterPanel()->spinBox("w-max");
+    window_->parameterPanel()->setValues({{"w-max", 30.0}});
+    const int at30 = slider->value();
+    // A drag of 40 px moves the slider by 40 / width of its range.
+    const int steps = static_cast<int>(std::ceil(40.0 * (slider->maximum() - slider->minimum()) / slider->width()));
+    const auto before = window_->result();
+    slider->setValue(at30 + steps);
+    const double moved = spin->value();
+    QVERIFY2(moved > 30 && moved < 120, qPrintable(QString("40 px moved W_max from 30 m to %1 m").arg(moved)));
+    QVERIFY(!perBlock->isChecked());
+    QVERIFY2(window_->notice().contains("every block"), qPrintable(window_->notice()));
+    QVERIFY(settle());
+    const QString notice = window_->notice();
+    QVERIFY2(notice.contains(QString("%1 before, %2 now")
+                                 .arg(before->generated.parcels.size())
+                                 .arg(window_->result()->generated.parcels.size())),
+             qPrintable(notice));
+    // One slider step is a small change anywhere on it.
+    for (int position : {slider->minimum() + 10, (slider->minimum() + slider->maximum()) / 2, slider->maximum() - 10}) {
+      slider->setValue(position);
+      const double a = spin->value();
+      slider->setValue(position + 1);
+      const double b = spin->value();
+      QVERIFY2(b > a && b < a * 1.02 + 0.05 + 1e-9, qPrintable(QString("%1 -> %2").arg(a).arg(b)));
+    }
+    perBlock->setChecked(true);
+    QVERIFY(settle());
+    QVERIFY(window_->notice().isEmpty());
+  }
+
+  // Small screens and scaling: at 1280x720, and at the logical sizes of
+  // 1280x720 and 1366x768 at 1.5x and 1920x1080 at 2x, every parameter's
+  // control can be scrolled into view, whole, with a usable size.
+  void everyParameterIsReachableOnSmallScreens() {
+    const QSize original = window_->size();
+    auto* scroll = window_->findChild<QScrollArea*>("controlsScroll");
+    QVERIFY(scroll);
+    for (const QSize size : {QSize(1280, 720), QSize(853, 480), QSize(910, 512), QSize(960, 540)}) {
+      window_->resize(size);
+      QTest::qWait(100);
+      QVERIFY2(window_->size() == size, qPrintable(QString("asked %1x%2, got %3x%4 (minimum %5x%6)")
+                                                       .arg(size.width())
+                                                       .arg(size.height())
+                                                       .arg(window_->width())
+                                                       .arg(window_->height())
+                                                       .arg(window_->minimumSizeHint().width())
+                                                       .arg(window_->minimumSizeHint().height())));
+      QVERIFY(
+          window_->rect().contains(scroll->geometry().translated(scroll->parentWidget()->mapTo(window_, QPoint()))));
+      QList<QWidget*> controls;
+      for (QWidget* w : window_->parameterPanel()->findChildren<QWidget*>()) {
+        if (qobject_cast<QSlider*>(w) || qobject_cast<QDoubleSpinBox*>(w) || qobject_cast<QComboBox*>(w) ||
+            qobject_cast<QCheckBox*>(w))
+          controls << w;
+      }
+      for (const char* name : {"block-spin-w-max", "block-check-seed", "overrideBlock", "perBlockBounds", "style"}) {
+        controls << window_->findChild<QWidget*>(name);
+      }
+      QVERIFY(controls.size() > 20);
+      for (QWidget* w : controls) {
+        QVERIFY(w);
+        // As ensureWidgetVisible, for the whole widget (it keeps only a spin box's text cursor in view).
+        const QPoint at = w->mapTo(scroll->widget(), QPoint(0, 0));
+        scroll->ensureVisible(at.x() + w->width() / 2, at.y() + w->height() / 2, (w->width() + 1) / 2,
+                              (w->height() + 1) / 2);
+        QTest::qWait(5);
+        const QString what = QString("%1 at %2x%3").arg(w->objectName()).arg(size.width()).arg(size.height());
+        QVERIFY2(w->isVisibleTo(window_), qPrintable(what));
+        QVERIFY2(w->width() >= 12 && w->height() >= 12, qPrintable(what));
+        if (qobject_cast<QSlider*>(w)) QVERIFY2(w->width() >= 60, qPrintable(what + ": slider too short"));
+        const QRect inViewport(w->mapTo(scroll->viewport(), QPoint(0, 0)), w->size());
+        QVERIFY2(
+            scroll->viewport()->rect().contains(inViewport),
+            qPrintable(QString("%1 is clipped: (%2, %3) %4x%5 in a viewport of %6x%7, scrolled %8 of %9, panel %10")
+                           .arg(what)
+                           .arg(inViewport.x())
+                           .arg(inViewport.y())
+                           .arg(inViewport.width())
+                           .arg(inViewport.height())
+                           .arg(scroll->viewport()->width())
+                           .arg(scroll->viewport()->height())
+                           .arg(scroll->verticalScrollBar()->value())
+                           .arg(scroll->verticalScrollBar()->maximum())
+                           .arg(scroll->widget()->height())));
+      }
+      // The views and the histogram keep a size of their own.
+      for (parcelscope::gui::MapView* v : {window_->observedView(), window_->proceduralView()}) {
+        QVERIFY(v->vtkWidget()->width() >= 100 && v->vtkWidget()->height() >= 80);
+      }
+      QVERIFY(window_->numbers()->isVisible() && window_->numbers()->height() > 40);
+    }
+    window_->resize(original);
+    QTest::qWait(100);
+  }
+
+  // Cancel during a long update that showed a result in between: the view's
+  // title says it is partly updated and which styles it shows, and the
+  // numbers do not promise measurements that will not come.
+  void cancelLeavesATruthfulTitleAndTable() {
+    // The sample ten by ten times over: 1,000 blocks, long enough (seconds in
+    // the skeleton style) to show results in between and be cancelled before the end.
+    const QString big = dir_.path() + "/big_town.geojson";
+    {
+      const std::string text = slurp(QString(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_town.geojson");
+      const std::size_t open = text.find("\"features\"");
+      const std::size_t first = text.find('[', open);
+      const std::size_t last = text.rfind(']');
+      const QString features = QString::fromStdString(text.substr(first + 1, last - first - 1));
+      const QRegularExpression pair(R"(\[(-?\d+\.?\d*),\s*(-?\d+\.?\d*)\])");
+      QStringList copies;
+      for (int i = 0; i < 10; ++i) {
+        for (int j = 0; j < 10; ++j) {
+          QString out;
+          int at = 0;
+          for (auto it = pair.globalMatch(features); it.hasNext();) {
+            const auto m = it.next();
+            out +=
+                features.mid(at, m.capturedStart() - at) + QString("[%1,%2]")
+                                                               .arg(m.captured(1).toDouble() + 0.006 * i, 0, 'f', 7)
+                                                               .arg(m.captured(2).toDouble() + 0.0045 * j, 0, 'f', 7);
+            at = m.capturedEnd();
+          }
+          copies << out + features.mid(at);
+        }
+      }
+      std::ofstream(big.toStdString()) << text.substr(0, first + 1) << copies.join(",").toStdString()
+                                       << text.substr(last);
+    }
+    window_->setStyle("obb");
+    window_->openFile(big, {}, "use <> 'ROW'");
+    QVERIFY(settle(120000));
+    QVERIFY2(window_->lastError().isEmpty(), qPrintable(window_->lastError()));
+    QVERIFY(window_->result()->observed->analysis.blocks.size() >= 1000);
+    auto* cancel = window_->findChild<QPushButton*>("cancelButton");
+    QVERIFY(cancel);
+    bool clicked = false;
+    QMetaObject::Connection c = connect(window_, &MainWindow::partialShown, this, [&] {
+      if (!clicked) {
+        clicked = true;
+        cancel->click();
+      }
+    });
+    window_->setStyle("skeleton");
+    QVERIFY(settle(120000));
+    disconnect(c);
+    QVERIFY2(clicked, "no result in between was shown");
+    QVERIFY(window_->controller().failedOrCancelled());
+    const QString title = window_->proceduralView()->title();
+    QVERIFY2(title.contains("partly updated") && title.contains("cancelled"), qPrintable(title));
+    QVERIFY2(title.contains("obb") && title.contains("skeleton"), qPrintable(title));
+    QVERIFY2(!title.startsWith("Procedural (skeleton"), qPrintable(title));
+    QTableWidget* numbers = window_->numbers();
+    for (int row = 0; row < numbers->rowCount(); ++row) {
+      for (int column = 0; column < numbers->columnCount(); ++column) {
+        const QTableWidgetItem* item = numbers->item(row, column);
+        QVERIFY2(!item || item->text() != "measuring...", qPrintable(QString("row %1").arg(row)));
+      }
+    }
+    // The next change finishes the job and the title is the plain one again.
+    window_->setStyle("obb");
+    QVERIFY(settle(120000));
+    QVERIFY2(window_->proceduralView()->title().startsWith("Procedural (obb"),
+             qPrintable(window_->proceduralView()->title()));
+    window_->openSample();
+    QVERIFY(settle());
+  }
+
+  // Quitting with block overrides changed since the last save asks Save,
+  // Discard or Cancel (answered here by a timer, as a user would click);
+  // without changes it does not ask.
+  void quittingWithUnsavedOverridesAsks() {
+    window_->openSample();
+    QVERIFY(settle());
+    QVERIFY(!window_->unsavedOverrides());
+    window_->selectBlock(2);
+    window_->overrideSelectedBlock("obb", {{"seed", 5.0}});
+    QVERIFY(settle());
+    QVERIFY(window_->unsavedOverrides());
+    QStringList buttons;
+    auto answer = [&buttons](QMessageBox::StandardButton button) {
+      QTimer::singleShot(100, [&buttons, button] {
+        auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget());
+        if (!box) return;
+        buttons.clear();
+        for (QAbstractButton* b : box->buttons()) buttons << QString(b->text()).remove('&');
+        box->button(button)->click();
+      });
+    };
+    answer(QMessageBox::Cancel);
+    QVERIFY(!window_->close());
+    QVERIFY(window_->isVisible());
+    QVERIFY2(buttons.contains("Save") && buttons.contains("Discard") && buttons.contains("Cancel"),
+             qPrintable(buttons.join(",")));
+    // Saved: no question.
+    window_->saveSession(dir_.path() + "/quit-session.json");
+    QVERIFY(!window_->unsavedOverrides());
+    buttons.clear();
+    answer(QMessageBox::Cancel);
+    QVERIFY(window_->close());
+    QTest::qWait(200);
+    QVERIFY(buttons.isEmpty());
+    window_->show();
+    QVERIFY(QTest::qWaitForWindowExposed(window_));
+    window_->clearSelectedOverride();
+    QVERIFY(settle());
+    answer(QMessageBox::Discard);
+    QVERIFY(window_->close());
+    QCOMPARE(buttons.size(), 3);
+  }
 };
 
 int main(int argc, char** argv) {
   QSurfaceFormat::setDefaultFormat(QVTKOpenGLStereoWidget::defaultFormat());
   QApplication app(argc, argv);
+  // The quit prompt's test closes the window: that must not end the application.
+  QApplication::setQuitOnLastWindowClosed(false);
   std::filesystem::create_directories(PARCELSCOPE_RENDER_FAILURES);
   MainWindowTest test;
   return QTest::qExec(&test, argc, argv);

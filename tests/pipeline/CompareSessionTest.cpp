@@ -43,13 +43,12 @@ CompareRequest sampleRequest(const std::string& style = "obb") {
   return r;
 }
 
-// Same parcels (areas and centroids, in order), same metrics and distances;
+// Same parcels (vertex for vertex, in order), same metrics and distances;
 // without `context`, neighbours and street access are not compared.
 void expectSameResult(const CompareResult& a, const CompareResult& b, bool context = true) {
   ASSERT_EQ(a.generated.parcels.size(), b.generated.parcels.size());
   for (std::size_t i = 0; i < a.generated.parcels.size(); ++i) {
-    EXPECT_NEAR(area(a.generated.parcels[i]), area(b.generated.parcels[i]), 1e-9) << "parcel " << i;
-    EXPECT_NEAR(centroid(a.generated.parcels[i]).x, centroid(b.generated.parcels[i]).x, 1e-9) << "parcel " << i;
+    EXPECT_TRUE(sameVertices(a.generated.parcels[i], b.generated.parcels[i])) << "parcel " << i;
     if (!context) continue;
     EXPECT_EQ(a.generated.metrics[i].neighbours, b.generated.metrics[i].neighbours) << "parcel " << i;
     EXPECT_EQ(a.generated.metrics[i].streetAccess, b.generated.metrics[i].streetAccess) << "parcel " << i;
@@ -138,8 +137,8 @@ TEST(CompareSession, RegeneratesOnlyTheBlocksAnEditTouches) {
 // Random edit sequences (style, overrides, bounds, seed) end where a fresh
 // compare of the final request ends.
 TEST(CompareSession, RandomEditSequencesMatchAFreshCompare) {
-  const unsigned seed = std::random_device{}();
-  std::printf("seed %u\n", seed);
+  const unsigned seed = 290105;  // fixed: a failure replays with the same seed
+  SCOPED_TRACE("seed " + std::to_string(seed));
   std::mt19937 rng(seed);
   CompareSession session;
   CompareRequest request = sampleRequest();

@@ -26,6 +26,16 @@ struct Expect {
   const char* crs;
   std::int64_t minParcels, maxParcels, minBlocks, maxBlocks;
   double minMedianArea, maxMedianArea;
+  /// Largest |block area - sum of its parcels' areas| / that sum. A block is
+  /// the union of its parcels closed by the block tolerance: gaps narrower
+  /// than it are filled (the block is larger than the sum) and overlapping
+  /// parcels count once (smaller). Measured with the default parameters
+  /// (2026-11-25), the worst block of each dataset: cambridge_ma -3.4 % (one
+  /// block; the 99th percentile is 1.6e-4), rhone_69114
+  /// +0.61 %, eatonville_wa -0.13 %, malibu_ca +-0.065 %, paris_18e 2.4e-5,
+  /// seoul_jamsil 1.8e-5; most blocks are exact to 1e-15. The bounds are about
+  /// twice those, at least 1e-4.
+  double blockAreaDeviation;
 };
 
 void PrintTo(const Expect& e, std::ostream* os) { *os << e.file; }
@@ -61,11 +71,13 @@ TEST_P(SharedDataset, ReadsWithPlausibleParcelAndBlockCounts) {
   for (const auto& m : d.analysis.metrics) areas.push_back(m.area);
   EXPECT_GE(median(areas), e.minMedianArea);
   EXPECT_LE(median(areas), e.maxMedianArea);
-  // Every lot is in a block, every block's parcels sum to about its area.
+  // Every lot is in a block, and every block's area is its parcels' sum
+  // within the dataset's bound (see Expect::blockAreaDeviation).
   for (std::size_t b = 0; b < d.analysis.blocks.size(); ++b) {
     double sum = 0;
     for (int i : d.analysis.blocks[b].parcels) sum += d.analysis.metrics[i].area;
-    EXPECT_GT(d.analysis.statistics[b].blockArea, 0.5 * sum) << "block " << b;
+    EXPECT_NEAR(d.analysis.statistics[b].blockArea, sum, e.blockAreaDeviation * sum)
+        << "block " << b << " of " << d.analysis.blocks[b].parcels.size() << " parcels";
   }
 }
 
@@ -125,12 +137,13 @@ TEST_P(SharedDataset, DissolvedBlocksEqualGeosUnion) {
 
 INSTANTIATE_TEST_SUITE_P(
     Datasets, SharedDataset,
-    ::testing::Values(Expect{"cambridge_ma/ASSESSING_ParcelsFY2014.topojson", "", 13000, 13200, 650, 800, 200, 600},
-                      Expect{"paris_18e/cadastre-75118-parcelles.json", "", 6800, 6830, 250, 450, 150, 350},
-                      Expect{"malibu_ca/parcels.geojson", "", 7400, 7700, 60, 200, 1500, 5000},
-                      Expect{"eatonville_wa/parcels.geojson", "EPSG:2286", 1250, 1350, 20, 300, 500, 10000},
-                      Expect{"seoul_jamsil/parcels.geojson", "", 2300, 2400, 40, 200, 100, 2000},
-                      Expect{"rhone_69114/parcelles.json", "", 5950, 6050, 80, 400, 200, 5000}),
+    ::testing::Values(Expect{"cambridge_ma/ASSESSING_ParcelsFY2014.topojson", "", 13000, 13200, 650, 800, 200, 600,
+                             0.07},
+                      Expect{"paris_18e/cadastre-75118-parcelles.json", "", 6800, 6830, 250, 450, 150, 350, 1e-4},
+                      Expect{"malibu_ca/parcels.geojson", "", 7400, 7700, 60, 200, 1500, 5000, 1.5e-3},
+                      Expect{"eatonville_wa/parcels.geojson", "EPSG:2286", 1250, 1350, 20, 300, 500, 10000, 3e-3},
+                      Expect{"seoul_jamsil/parcels.geojson", "", 2300, 2400, 40, 200, 100, 2000, 1e-4},
+                      Expect{"rhone_69114/parcelles.json", "", 5950, 6050, 80, 400, 200, 5000, 0.012}),
     [](const ::testing::TestParamInfo<Expect>& param) {
       std::string n = param.param.file;
       return n.substr(0, n.find('/'));

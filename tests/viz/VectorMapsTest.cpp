@@ -8,6 +8,7 @@
 #include <regex>
 #include <sstream>
 
+#include "Pdf.h"
 #include "TestUtil.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/viz/Figures.h"
@@ -137,6 +138,58 @@ TEST(VectorMaps, RefusesWhatItCannotDraw) {
   MapPanel mismatched = m.panels[0];
   mismatched.values.pop_back();
   EXPECT_THROW(writeVectorMaps("t", {mismatched}, m.scale, 1800, 900, dir.file("map.svg")), Error);
+}
+
+// GL2PS's PDF (as Debian builds it) holds its streams uncompressed: the
+// rewrite deflates them and keeps every object findable.
+TEST(VectorMaps, PdfStreamsAreCompressedInPlace) {
+  test::TempDir dir;
+  const std::string image(100000, '\xff');  // a white raster
+  std::vector<std::string> objects = {"<< /Type /Catalog /Pages 2 0 R >>", "<< /Type /Pages /Kids [] /Count 0 >>",
+                                      "<< /Type /XObject /Subtype /Image /Length " + std::to_string(image.size()) +
+                                          " >>\nstream\n" + image + "\nendstream",
+                                      "<< /Length 5 0 R >>\nstream\nq Q\nendstream", "3"};
+  std::string pdf = "%PDF-1.4\n";
+  std::vector<std::size_t> offsets;
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    offsets.push_back(pdf.size());
+    pdf += std::to_string(i + 1) + " 0 obj\n" + objects[i] + "\nendobj\n";
+  }
+  const std::size_t xref = pdf.size();
+  pdf += "xref\n0 6\n0000000000 65535 f \n";
+  for (std::size_t o : offsets) {
+    char entry[24];
+    std::snprintf(entry, sizeof entry, "%010zu 00000 n \n", o);
+    pdf += entry;
+  }
+  pdf += "trailer\n<< /Size 6 /Root 1 0 R >>\nstartxref\n" + std::to_string(xref) + "\n%%EOF\n";
+  const std::string path = dir.write("chart.pdf", pdf);
+
+  EXPECT_EQ(detail::compressPdfStreams(path), 1);  // the image; not the stream whose length is an object
+  const std::string out = slurp(path);
+  EXPECT_LT(out.size(), 2000u);
+  const std::size_t startxref = out.rfind("startxref\n");
+  const std::size_t table = std::stoul(out.substr(startxref + 10));
+  ASSERT_EQ(out.compare(table, 9, "xref\n0 6\n"), 0);
+  std::istringstream entries(out.substr(table + 9));
+  std::string offset, generation, kind;
+  entries >> offset >> generation >> kind;
+  for (int i = 1; i <= 5; ++i) {
+    entries >> offset >> generation >> kind;
+    EXPECT_EQ(out.compare(std::stoul(offset), 7, std::to_string(i) + " 0 obj"), 0) << "object " << i;
+  }
+  const std::size_t lengthAt = out.find("/Length ", out.find("/Subtype /Image"));
+  ASSERT_NE(out.find("/Filter /FlateDecode", lengthAt), std::string::npos);
+  const std::size_t length = std::stoul(out.substr(lengthAt + 8));
+  const std::size_t data = out.find("stream\n", lengthAt) + 7;
+  std::string raw(image.size() + 16, '\0');
+  uLongf size = raw.size();
+  ASSERT_EQ(uncompress(reinterpret_cast<Bytef*>(raw.data()), &size, reinterpret_cast<const Bytef*>(out.data() + data),
+                       length),
+            Z_OK);
+  raw.resize(size);
+  EXPECT_EQ(raw, image);
+  EXPECT_NE(out.find("<< /Length 5 0 R >>\nstream\nq Q\nendstream"), std::string::npos);
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 
 #include "parcelscope/viz/Scenes.h"
 
+#include "Pdf.h"
+
 #include <vtkActor.h>
 #include <vtkAxis.h>
 #include <vtkBrush.h>
@@ -234,6 +236,7 @@ void writeFigure(vtkRenderWindow* window, const FigureOutput& out, const std::st
   exporter->SilentOn();
   exporter->Write();
   if (!std::filesystem::exists(path)) throw ioError(out.vector + ": cannot write vector figure");
+  if (path.extension() == ".pdf") detail::compressPdfStreams(out.vector);
 }
 
 vtkSmartPointer<vtkLookupTable> lookupTable(const ColourScale& scale) {

@@ -7,11 +7,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <memory>
+#include <regex>
 #include <sstream>
 
+#include "Pdf.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/viz/Figures.h"
 
@@ -367,5 +371,98 @@ void writeVectorMaps(const std::string& title, const std::vector<MapPanel>& pane
   draw(*canvas, title, panels, scale, width, height);
   canvas->save(path);
 }
+
+namespace detail {
+
+namespace {
+std::string deflate(const std::string& raw, const std::string& path) {
+  uLongf size = compressBound(static_cast<uLong>(raw.size()));
+  std::string packed(size, '\0');
+  if (compress2(reinterpret_cast<Bytef*>(packed.data()), &size, reinterpret_cast<const Bytef*>(raw.data()),
+                static_cast<uLong>(raw.size()), Z_BEST_COMPRESSION) != Z_OK) {
+    throw ioError(path + ": cannot compress a PDF stream");
+  }
+  packed.resize(size);
+  return packed;
+}
+}  // namespace
+
+int compressPdfStreams(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ioError(path + ": cannot read");
+  const std::string pdf((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto malformed = [&](const std::string& what) {
+    return ioError(path + ": not a PDF this can rewrite (" + what + ")");
+  };
+  const std::size_t xref = pdf.rfind("\nxref\n");
+  const std::size_t trailer = pdf.find("trailer", xref == std::string::npos ? 0 : xref);
+  if (pdf.rfind("%PDF-", 0) != 0 || xref == std::string::npos || trailer == std::string::npos) {
+    throw malformed("no header, cross-reference table or trailer");
+  }
+  // Objects before the table, copied with their uncompressed streams deflated.
+  std::string out;
+  int compressed = 0;
+  std::size_t at = 0;
+  const std::regex length(R"(/Length (\d+)(?! \d+ R))");
+  for (;;) {
+    const std::size_t stream = pdf.find("stream\n", at);
+    if (stream == std::string::npos || stream > xref) break;
+    if (stream >= 3 && pdf.compare(stream - 3, 3, "end") == 0) {  // "endstream\n"
+      out.append(pdf, at, stream + 7 - at);
+      at = stream + 7;
+      continue;
+    }
+    const std::size_t object = pdf.rfind(" obj", stream);
+    if (object == std::string::npos || object < at) throw malformed("a stream outside an object");
+    const std::string dictionary = pdf.substr(object, stream - object);
+    std::smatch m;
+    if (dictionary.find("/Filter") != std::string::npos || !std::regex_search(dictionary, m, length)) {
+      out.append(pdf, at, stream + 7 - at);
+      at = stream + 7;
+      continue;
+    }
+    const std::size_t dataAt = stream + 7, size = std::stoul(m[1]);
+    if (dataAt + size > xref) throw malformed("a stream longer than the file");
+    const std::string packed = deflate(pdf.substr(dataAt, size), path);
+    out.append(pdf, at, object - at);
+    out += dictionary.substr(0, static_cast<std::size_t>(m.position(0))) + "/Length " + std::to_string(packed.size()) +
+           " /Filter /FlateDecode" + dictionary.substr(static_cast<std::size_t>(m.position(0) + m.length(0)));
+    out += "stream\n" + packed;
+    at = dataAt + size;
+    ++compressed;
+  }
+  out.append(pdf, at, xref + 1 - at);
+  // A new cross-reference table: where each "N 0 obj" now starts.
+  std::vector<std::size_t> offsets;
+  const std::regex header(R"((?:^|\n)(\d+) 0 obj)");
+  for (std::sregex_iterator it(out.begin(), out.end(), header), end; it != end; ++it) {
+    const std::size_t n = std::stoul((*it)[1]);
+    if (offsets.size() <= n) offsets.resize(n + 1, 0);
+    offsets[n] = static_cast<std::size_t>(it->position(1));
+  }
+  if (offsets.empty()) throw malformed("no object");
+  const std::size_t table = out.size();
+  out += "xref\n0 " + std::to_string(offsets.size()) + "\n0000000000 65535 f \n";
+  for (std::size_t n = 1; n < offsets.size(); ++n) {
+    char entry[24];
+    std::snprintf(entry, sizeof entry, offsets[n] ? "%010zu 00000 n \n" : "%010zu 65535 f \n", offsets[n]);
+    out += entry;
+  }
+  const std::size_t startxref = pdf.find("startxref", trailer);
+  if (startxref == std::string::npos) throw malformed("no startxref");
+  out += pdf.substr(trailer, startxref - trailer) + "startxref\n" + std::to_string(table) + "\n%%EOF\n";
+  if (compressed == 0) return 0;
+  const std::string staged = path + ".compressing";
+  writeFile(staged, out);
+  std::error_code ec;
+  std::filesystem::rename(staged, path, ec);
+  if (ec) {
+    std::filesystem::remove(staged, ec);
+    throw ioError(path + ": cannot replace the file");
+  }
+  return compressed;
+}
+
+}  // namespace detail
 
 }  // namespace parcelscope::viz
