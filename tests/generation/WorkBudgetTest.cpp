@@ -128,6 +128,7 @@ constexpr double kSanitySeconds = 120;
 bool namesBudget(const std::string& reason) { return reason.find("work budget") != std::string::npos; }
 
 void expectWithinBudget(const Polygon& block, const Outcome& o, const std::string& what) {
+  std::printf("%s: %.2f s, peak memory +%.0f MiB\n", what.c_str(), o.seconds, o.peakGrowthGiB * 1024);
   EXPECT_LT(o.peakGrowthGiB, 1.0) << what;
   EXPECT_LT(o.seconds, kSanitySeconds) << what;
   EXPECT_TILES(block, o.result.parcels, what);
