@@ -276,4 +276,140 @@ double intersectionArea(const Polygon& a, const Polygon& b) {
   return result;
 }
 
+namespace {
+
+GEOSGeometry* lineToGeos(GEOSContextHandle_t ctx, const Polyline& line) {
+  std::vector<double> xy;
+  xy.reserve(2 * line.size());
+  for (const Point& p : line) {
+    xy.push_back(p.x);
+    xy.push_back(p.y);
+  }
+  GEOSCoordSequence* seq = GEOSCoordSeq_copyFromBuffer_r(ctx, xy.data(), static_cast<unsigned>(line.size()), 0, 0);
+  return seq ? GEOSGeom_createLineString_r(ctx, seq) : nullptr;
+}
+
+Geom linesToGeos(const std::vector<const Polyline*>& lines) {
+  GEOSContextHandle_t ctx = context();
+  std::vector<GEOSGeometry*> built;
+  for (const Polyline* l : lines) {
+    GEOSGeometry* g = l->size() >= 2 ? lineToGeos(ctx, *l) : nullptr;
+    if (!g) {
+      for (GEOSGeometry* b : built) GEOSGeom_destroy_r(ctx, b);
+      return nullptr;
+    }
+    built.push_back(g);
+  }
+  return Geom(
+      GEOSGeom_createCollection_r(ctx, GEOS_MULTILINESTRING, built.data(), static_cast<unsigned>(built.size())));
+}
+
+// Appends every line string of `g` (lines, multilines, collections).
+void collectLines(const GEOSGeometry* g, std::vector<Polyline>& out) {
+  GEOSContextHandle_t ctx = context();
+  if (GEOSisEmpty_r(ctx, g) == 1) return;
+  switch (GEOSGeomTypeId_r(ctx, g)) {
+    case GEOS_LINESTRING:
+    case GEOS_LINEARRING:
+      out.push_back(ringFromGeos(ctx, g));
+      return;
+    case GEOS_MULTILINESTRING:
+    case GEOS_GEOMETRYCOLLECTION: {
+      const int n = GEOSGetNumGeometries_r(ctx, g);
+      for (int i = 0; i < n; ++i) collectLines(GEOSGetGeometryN_r(ctx, g, i), out);
+      return;
+    }
+    default:
+      return;
+  }
+}
+
+}  // namespace
+
+std::vector<Polyline> nodeLines(const std::vector<Polyline>& lines, double grid) {
+  std::vector<const Polyline*> pointers;
+  for (const Polyline& l : lines) {
+    if (l.size() >= 2) pointers.push_back(&l);
+  }
+  if (pointers.empty()) return {};
+  Geom multi = linesToGeos(pointers);
+  Geom noded(multi ? GEOSUnaryUnionPrec_r(context(), multi.get(), grid) : nullptr);
+  if (!noded) throw geometryError("noding " + std::to_string(pointers.size()) + " lines failed");
+  std::vector<Polyline> out;
+  collectLines(noded.get(), out);
+  return out;
+}
+
+LineFaces polygonizeLines(const std::vector<Polyline>& noded) {
+  GEOSContextHandle_t ctx = context();
+  std::vector<const Polyline*> pointers;
+  for (const Polyline& l : noded) {
+    if (l.size() >= 2) pointers.push_back(&l);
+  }
+  LineFaces out;
+  if (pointers.empty()) return out;
+  Geom multi = linesToGeos(pointers);
+  GEOSGeometry *cuts = nullptr, *dangles = nullptr, *invalid = nullptr;
+  Geom faces(multi ? GEOSPolygonize_full_r(ctx, multi.get(), &cuts, &dangles, &invalid) : nullptr);
+  Geom ownedCuts(cuts), ownedDangles(dangles), ownedInvalid(invalid);
+  if (!faces) throw geometryError("faces of " + std::to_string(pointers.size()) + " lines failed");
+  collectPolygons(faces.get(), out.faces);
+  if (cuts) collectLines(cuts, out.cutEdges);
+  if (dangles) collectLines(dangles, out.dangles);
+  return out;
+}
+
+std::vector<Polygon> bufferedUnion(const std::vector<const Polyline*>& lines, const std::vector<double>& halfWidths,
+                                   int quadrantSegments) {
+  GEOSContextHandle_t ctx = context();
+  std::vector<GEOSGeometry*> buffers;
+  auto destroyAll = [&] {
+    for (GEOSGeometry* b : buffers) GEOSGeom_destroy_r(ctx, b);
+  };
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    if (lines[i]->size() < 2 || !(halfWidths[i] > 0)) continue;
+    Geom line(lineToGeos(ctx, *lines[i]));
+    GEOSGeometry* b = line ? GEOSBuffer_r(ctx, line.get(), halfWidths[i], quadrantSegments) : nullptr;
+    if (!b) {
+      destroyAll();
+      throw geometryError("buffer of a line failed");
+    }
+    buffers.push_back(b);
+  }
+  if (buffers.empty()) return {};
+  Geom all(
+      GEOSGeom_createCollection_r(ctx, GEOS_GEOMETRYCOLLECTION, buffers.data(), static_cast<unsigned>(buffers.size())));
+  Geom u(all ? GEOSUnaryUnion_r(ctx, all.get()) : nullptr);
+  if (!u) throw geometryError("union of " + std::to_string(buffers.size()) + " street buffers failed");
+  std::vector<Polygon> out;
+  collectPolygons(u.get(), out);
+  return out;
+}
+
+std::vector<Polygon> difference(const Polygon& a, const std::vector<const Polygon*>& cut, double grid) {
+  GEOSContextHandle_t ctx = context();
+  Geom ga = toGeos(a);
+  if (!ga) throw geometryError("difference: the polygon cannot be built");
+  std::vector<Polygon> out;
+  if (cut.empty()) {
+    out.push_back(a);
+    return out;
+  }
+  Geom gc = toGeos(cut);
+  Geom cutUnion(gc ? GEOSUnaryUnionPrec_r(ctx, gc.get(), grid) : nullptr);
+  Geom d(cutUnion ? GEOSDifferencePrec_r(ctx, ga.get(), cutUnion.get(), grid) : nullptr);
+  if (!d) throw geometryError("difference of a polygon and " + std::to_string(cut.size()) + " polygons failed");
+  collectPolygons(d.get(), out);
+  return out;
+}
+
+double unionArea(const std::vector<const Polygon*>& polygons, double grid) {
+  if (polygons.empty()) return 0;
+  Geom g = toGeos(polygons);
+  Geom u(g ? GEOSUnaryUnionPrec_r(context(), g.get(), grid) : nullptr);
+  double a = 0;
+  if (!u || GEOSArea_r(context(), u.get(), &a) != 1) throw geometryError("union area failed");
+  return a;
+}
+
 }  // namespace parcelscope::geos

@@ -45,4 +45,38 @@ std::vector<Polygon> validMultiPolygon(std::vector<Polygon> parts, bool& repaire
 /// Throws Error(Geometry) if GEOS fails.
 double intersectionArea(const Polygon& a, const Polygon& b);
 
+// Lines (street centre lines): noding, faces, buffers.
+
+/// An open polyline, local metres.
+using Polyline = std::vector<Point>;
+
+/// The lines noded on a `grid`-metre grid (GEOS snap-rounding union): wherever
+/// two lines cross or touch (within the grid) both are cut at one shared
+/// vertex, and pieces that overlap are merged into one. Each piece runs between
+/// two nodes; lines meeting end to end stay separate pieces. Throws
+/// Error(Geometry) if GEOS fails.
+std::vector<Polyline> nodeLines(const std::vector<Polyline>& lines, double grid);
+
+/// The faces of noded lines (GEOS polygonizer): every area the lines enclose,
+/// holes included (an enclosed face is a hole of the face around it and a face
+/// of its own). `dangles` are the pieces with a free end (dead ends), `cutEdges`
+/// pieces with a face on neither side or the same face on both.
+struct LineFaces {
+  std::vector<Polygon> faces;
+  std::vector<Polyline> dangles, cutEdges;
+};
+LineFaces polygonizeLines(const std::vector<Polyline>& noded);
+
+/// Each line buffered by its own half width in metres (round caps and joins,
+/// `quadrantSegments` segments per quarter circle), then all unioned.
+std::vector<Polygon> bufferedUnion(const std::vector<const Polyline*>& lines, const std::vector<double>& halfWidths,
+                                   int quadrantSegments = 4);
+
+/// `a` minus the union of `cut`, on a `grid`-metre grid (snap-rounding overlay);
+/// normalised valid parts. Throws Error(Geometry) if GEOS fails.
+std::vector<Polygon> difference(const Polygon& a, const std::vector<const Polygon*>& cut, double grid);
+
+/// Area of the union of `polygons` (snap-rounded on a `grid`-metre grid).
+double unionArea(const std::vector<const Polygon*>& polygons, double grid);
+
 }  // namespace parcelscope::geos

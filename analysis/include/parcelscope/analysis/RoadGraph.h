@@ -1,0 +1,133 @@
+#pragma once
+// A planar road graph built from street centre lines, and city blocks as its
+// faces (Vanegas et al. 2012, section 3.1: nodes are intersections, edges are
+// street segments with a width; a block is a face of the graph, its contour
+// moved inward by the half width of each street it faces).
+//
+// Real centre lines are not a clean graph: lines cross without a shared
+// vertex, stop short of the street they meet, run twice over the same segment,
+// and pass over each other on bridges. buildRoadGraph nodes crossings (except
+// for lines marked as not noded: bridges and tunnels), joins endpoints within a
+// snap distance, merges duplicate segments and keeps dead ends. Keys of nodes,
+// edges and blocks depend on geometry only, never on the order of the input.
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "parcelscope/core/GeosOps.h"
+#include "parcelscope/core/Keys.h"
+#include "parcelscope/core/Progress.h"
+
+namespace parcelscope::analysis {
+
+using geos::Polyline;
+
+/// One street centre line as read, local metres.
+struct StreetLine {
+  Polyline line;
+  double width = NAN;  ///< street width in m (kerb to kerb); NaN when unknown
+  std::string name;
+  bool noNode = false;  ///< a bridge or tunnel: meets other lines only at its ends
+  Key key = 0;          ///< the feature's key (hash of its geometry)
+};
+
+struct RoadGraphOptions {
+  /// Endpoints closer than this (m) become one node; a free end this close to
+  /// another line meets it there (a T-junction).
+  double snap = 1.0;
+};
+
+struct RoadNode {
+  Key key = 0;  ///< from its position, rounded to 1 cm
+  Point at;
+  int degree = 0;  ///< edges ending here (a loop counts twice); 1: a dead end
+};
+
+struct RoadEdge {
+  Key key = 0;  ///< from its end nodes' keys and its middle point
+  int from = -1, to = -1;
+  Polyline line;  ///< from node `from` to node `to`
+  double width = NAN;
+  std::string name;
+  bool noNode = false;
+  int source = -1;  ///< index of the StreetLine it comes from
+};
+
+struct RoadGraphReport {
+  std::int64_t lines = 0;             ///< lines given
+  std::int64_t skipped = 0;           ///< fewer than two distinct points
+  std::int64_t endpointsJoined = 0;   ///< endpoints moved onto another endpoint within the snap distance
+  std::int64_t endpointsOnLines = 0;  ///< free ends moved onto another line within the snap distance
+  std::int64_t duplicateEdges = 0;    ///< edges that more than one line ran along (merged)
+  std::int64_t deadEnds = 0;          ///< nodes of degree 1
+  std::int64_t notNoded = 0;          ///< lines kept apart from what they cross (bridges, tunnels)
+};
+
+struct RoadGraph {
+  std::vector<RoadNode> nodes;
+  std::vector<RoadEdge> edges;
+  RoadGraphReport report;
+};
+
+/// The graph of `lines`. Deterministic, and independent of the order of
+/// `lines`: nodes and edges come sorted by key. Throws Error(Geometry) if GEOS
+/// fails to node the lines.
+RoadGraph buildRoadGraph(const std::vector<StreetLine>& lines, const RoadGraphOptions& options = {});
+
+/// Fills the unknown widths of `graph`'s edges: measured from the blocks of
+/// observed parcels (`parcelBlocks`, the outlines `stats` builds) as the gap
+/// between the blocks on either side of the centre line (the median, over
+/// points every 5 m along the edge's middle 80 %, of the distances straight
+/// out to the nearest block outline on the left plus on the right; twice the
+/// one side where only one side has a block within `maxWidth` / 2), else
+/// `defaultWidth`. Returns how many edges were measured.
+std::int64_t fillStreetWidths(RoadGraph& graph, const std::vector<const Polygon*>& parcelBlocks, double defaultWidth,
+                              double maxWidth = 60.0);
+
+/// One block: a face of the graph minus the street surface.
+struct StreetBlock {
+  Key key = 0;  ///< setKey of the keys of the edges it faces (mixed with its part number when a face gives several)
+  Polygon shape;
+  /// For ring r (0 the outer ring, then the holes) and its edge from vertex i
+  /// to i+1: the index of the graph edge it faces (the nearest centre line),
+  /// or -1 when no centre line lies within its half width plus 1 m.
+  std::vector<std::vector<int>> faced;
+};
+
+struct StreetBlockOptions {
+  /// Faces larger than this (m²) are not blocks (the land around a network
+  /// that encloses it, open country); smaller than `minArea` left after the
+  /// streets are removed are dropped too.
+  double maxArea = 2e6;
+  double minArea = 1.0;
+  /// Segments per quarter circle of the street surface's round ends and joins.
+  int quadrantSegments = 4;
+};
+
+struct StreetBlocks {
+  std::vector<StreetBlock> blocks;  ///< sorted by key
+  std::int64_t faces = 0;           ///< faces of the graph
+  std::int64_t facesTooLarge = 0;   ///< faces above maxArea (dropped)
+  std::int64_t partsTooSmall = 0;   ///< pieces under minArea (dropped), faces filled by streets included
+};
+
+/// The blocks of `graph` (every edge width must be known: see
+/// fillStreetWidths). Faces come from the lines noded in full (a bridge's
+/// crossings included, so that the land under it is street); each face minus
+/// the surface of the streets near it (each centre line buffered by its half
+/// width, round ends) gives its blocks: widths differ edge by edge, a dead end
+/// cuts a slot into its block, an enclosed face is a hole of the block around
+/// it. Throws Error(Geometry) if GEOS fails, Error(Cancelled) when `progress`
+/// asks to stop.
+StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& options = {},
+                          const ProgressFn& progress = {});
+
+/// The street surface: every edge buffered by its half width, unioned.
+std::vector<Polygon> streetSurface(const RoadGraph& graph, int quadrantSegments = 4);
+
+/// The street widths of a block for the skeleton style (generation::StreetWidths):
+/// per ring and contour edge, the width of the street it faces, NaN where none.
+std::vector<std::vector<double>> facedWidths(const RoadGraph& graph, const StreetBlock& block);
+
+}  // namespace parcelscope::analysis

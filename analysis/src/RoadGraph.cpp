@@ -1,0 +1,586 @@
+#include "parcelscope/analysis/RoadGraph.h"
+
+#include <algorithm>
+#include <boost/geometry.hpp>
+#include <boost/geometry/index/rtree.hpp>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <unordered_map>
+#include <utility>
+
+#include "parcelscope/core/Error.h"
+#include "parcelscope/core/Parallel.h"
+
+namespace parcelscope::analysis {
+
+namespace {
+
+namespace bg = boost::geometry;
+namespace bgi = boost::geometry::index;
+using BPoint = bg::model::point<double, 2, bg::cs::cartesian>;
+using BBox = bg::model::box<BPoint>;
+// A segment of a polyline: (line, index of its first vertex).
+using SegmentEntry = std::pair<BBox, std::pair<int, int>>;
+using SegmentTree = bgi::rtree<SegmentEntry, bgi::quadratic<16>>;
+using BoxEntry = std::pair<BBox, int>;
+using BoxTree = bgi::rtree<BoxEntry, bgi::quadratic<16>>;
+
+// Lines are noded on this grid (m): crossings closer than it are one node.
+constexpr double kGrid = 1e-3;
+// Overlays of blocks and street surfaces are snap-rounded on this grid (m).
+constexpr double kOverlayGrid = 1e-6;
+
+BBox boxAround(const Point& a, const Point& b, double pad = 0) {
+  return {BPoint(std::min(a.x, b.x) - pad, std::min(a.y, b.y) - pad),
+          BPoint(std::max(a.x, b.x) + pad, std::max(a.y, b.y) + pad)};
+}
+
+BBox boxOf(const std::vector<Point>& points, double pad = 0) {
+  Box b = bounds(points);
+  return {BPoint(b.minX - pad, b.minY - pad), BPoint(b.maxX + pad, b.maxY + pad)};
+}
+
+SegmentTree segmentTree(const std::vector<const Polyline*>& lines, bool closed = false) {
+  std::vector<SegmentEntry> entries;
+  for (std::size_t l = 0; l < lines.size(); ++l) {
+    const Polyline& line = *lines[l];
+    const std::size_t n = line.size();
+    const std::size_t segments = closed ? n : (n ? n - 1 : 0);
+    for (std::size_t i = 0; i < segments; ++i) {
+      entries.push_back({boxAround(line[i], line[(i + 1) % n]), {static_cast<int>(l), static_cast<int>(i)}});
+    }
+  }
+  return SegmentTree(entries.begin(), entries.end());
+}
+
+// The point of segment ab nearest to p, and its parameter along ab.
+Point nearestOnSegment(const Point& p, const Point& a, const Point& b, double* t = nullptr) {
+  const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
+  double u = len2 > 0 ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / len2 : 0;
+  u = std::clamp(u, 0.0, 1.0);
+  if (t) *t = u;
+  return {a.x + u * dx, a.y + u * dy};
+}
+
+double distance(const Point& a, const Point& b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+double distanceToLine(const Point& p, const Polyline& line) {
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i + 1 < line.size(); ++i) {
+    best = std::min(best, distance(p, nearestOnSegment(p, line[i], line[i + 1])));
+  }
+  return best;
+}
+
+double length(const Polyline& line) {
+  double s = 0;
+  for (std::size_t i = 0; i + 1 < line.size(); ++i) s += distance(line[i], line[i + 1]);
+  return s;
+}
+
+// The point at arc length `s` along the line, and the unit direction there.
+std::pair<Point, Point> pointAt(const Polyline& line, double s) {
+  for (std::size_t i = 0; i + 1 < line.size(); ++i) {
+    const double d = distance(line[i], line[i + 1]);
+    if (d <= 0) continue;
+    if (s <= d || i + 2 == line.size()) {
+      const double u = std::clamp(s / d, 0.0, 1.0);
+      const Point dir{(line[i + 1].x - line[i].x) / d, (line[i + 1].y - line[i].y) / d};
+      return {{line[i].x + u * (line[i + 1].x - line[i].x), line[i].y + u * (line[i + 1].y - line[i].y)}, dir};
+    }
+    s -= d;
+  }
+  return {line.front(), {1, 0}};
+}
+
+Key positionKey(const Point& p) {
+  return mixKeys(static_cast<Key>(std::llround(p.x * 100)), static_cast<Key>(std::llround(p.y * 100)));
+}
+
+std::pair<long long, long long> gridCell(const Point& p, double cell) {
+  return {static_cast<long long>(std::floor(p.x / cell)), static_cast<long long>(std::floor(p.y / cell))};
+}
+
+struct CellHash {
+  std::size_t operator()(const std::pair<long long, long long>& c) const {
+    return static_cast<std::size_t>(mixKeys(static_cast<Key>(c.first), static_cast<Key>(c.second)));
+  }
+};
+
+bool lexLess(const Point& a, const Point& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); }
+
+// Union-find over endpoint indices.
+int findRoot(std::vector<int>& parent, int i) {
+  while (parent[static_cast<std::size_t>(i)] != i) {
+    parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+    i = parent[static_cast<std::size_t>(i)];
+  }
+  return i;
+}
+
+// Joins endpoints within `snap` of each other: each cluster moves to its
+// lexicographically least member (a choice independent of the input order).
+// Returns, per endpoint (2 per line), the size of its cluster.
+std::vector<int> joinEndpoints(std::vector<Polyline>& lines, double snap, std::int64_t& moved) {
+  const std::size_t n = 2 * lines.size();
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto endpoint = [&](std::size_t e) -> Point& {
+    Polyline& l = lines[e / 2];
+    return e % 2 ? l.back() : l.front();
+  };
+  std::unordered_map<std::pair<long long, long long>, std::vector<int>, CellHash> grid;
+  const double cell = std::max(snap, kGrid);
+  for (std::size_t e = 0; e < n; ++e) {
+    if (lines[e / 2].size() < 2) continue;
+    grid[gridCell(endpoint(e), cell)].push_back(static_cast<int>(e));
+  }
+  for (std::size_t e = 0; e < n; ++e) {
+    if (lines[e / 2].size() < 2) continue;
+    const auto [cx, cy] = gridCell(endpoint(e), cell);
+    for (long long dx = -1; dx <= 1; ++dx) {
+      for (long long dy = -1; dy <= 1; ++dy) {
+        const auto it = grid.find({cx + dx, cy + dy});
+        if (it == grid.end()) continue;
+        for (int other : it->second) {
+          if (static_cast<std::size_t>(other) <= e) continue;
+          if (distance(endpoint(e), endpoint(static_cast<std::size_t>(other))) <= snap) {
+            parent[static_cast<std::size_t>(findRoot(parent, static_cast<int>(e)))] = findRoot(parent, other);
+          }
+        }
+      }
+    }
+  }
+  std::unordered_map<int, Point> least;
+  std::unordered_map<int, int> size;
+  for (std::size_t e = 0; e < n; ++e) {
+    if (lines[e / 2].size() < 2) continue;
+    const int r = findRoot(parent, static_cast<int>(e));
+    auto [it, added] = least.emplace(r, endpoint(e));
+    if (!added && lexLess(endpoint(e), it->second)) it->second = endpoint(e);
+    ++size[r];
+  }
+  std::vector<int> clusterSize(n, 0);
+  for (std::size_t e = 0; e < n; ++e) {
+    if (lines[e / 2].size() < 2) continue;
+    const int r = findRoot(parent, static_cast<int>(e));
+    const Point target = least[r];
+    if (target.x != endpoint(e).x || target.y != endpoint(e).y) ++moved;
+    endpoint(e) = target;
+    clusterSize[e] = size[r];
+  }
+  return clusterSize;
+}
+
+// Moves each free end (an endpoint no other endpoint joined) within `snap` of
+// another line onto its nearest point there, a little past it so that the
+// noding finds the crossing.
+void endsOntoLines(std::vector<Polyline>& lines, const std::vector<int>& clusterSize, double snap,
+                   std::int64_t& moved) {
+  std::vector<const Polyline*> pointers;
+  for (const Polyline& l : lines) pointers.push_back(&l);
+  const SegmentTree tree = segmentTree(pointers);
+  std::vector<std::pair<std::size_t, Point>> moves;
+  for (std::size_t e = 0; e < 2 * lines.size(); ++e) {
+    const Polyline& own = lines[e / 2];
+    if (own.size() < 2 || clusterSize[e] != 1) continue;
+    const Point p = e % 2 ? own.back() : own.front();
+    const Point inner = e % 2 ? own[own.size() - 2] : own[1];
+    double best = std::numeric_limits<double>::infinity();
+    Point target{};
+    for (auto it = tree.qbegin(bgi::intersects(boxAround(p, p, snap))); it != tree.qend(); ++it) {
+      const auto [l, i] = it->second;
+      if (static_cast<std::size_t>(l) == e / 2) {
+        // Its own line only beyond the segment at this end.
+        const int adjacent = e % 2 ? static_cast<int>(own.size()) - 2 : 0;
+        if (i == adjacent) continue;
+      }
+      const Polyline& line = lines[static_cast<std::size_t>(l)];
+      const Point q = nearestOnSegment(p, line[static_cast<std::size_t>(i)], line[static_cast<std::size_t>(i) + 1]);
+      const double d = distance(p, q);
+      if (d < best || (d == best && lexLess(q, target))) {
+        best = d;
+        target = q;
+      }
+    }
+    if (!(best <= snap) || best <= 0) continue;
+    // Past the line by a grid step, along the end's own direction to it.
+    const double dx = target.x - inner.x, dy = target.y - inner.y, d = std::hypot(dx, dy);
+    if (d > 0) target = {target.x + 2 * kGrid * dx / d, target.y + 2 * kGrid * dy / d};
+    moves.push_back({e, target});
+  }
+  for (const auto& [e, target] : moves) {
+    Polyline& line = lines[e / 2];
+    (e % 2 ? line.back() : line.front()) = target;
+    ++moved;
+  }
+}
+
+// Splits `pieces` at the points of `at` that lie inside one of their segments
+// (within the noding grid), so that lines kept apart (bridges) still meet the
+// network at their ends.
+void splitAt(std::vector<Polyline>& pieces, const std::vector<Point>& at) {
+  for (const Point& p : at) {
+    for (std::size_t k = 0; k < pieces.size(); ++k) {
+      Polyline& line = pieces[k];
+      if (distance(line.front(), p) <= kGrid || distance(line.back(), p) <= kGrid) continue;
+      for (std::size_t i = 0; i + 1 < line.size(); ++i) {
+        double t = 0;
+        const Point q = nearestOnSegment(p, line[i], line[i + 1], &t);
+        if (distance(p, q) > kGrid) continue;
+        Polyline first(line.begin(), line.begin() + static_cast<long>(i) + 1), second;
+        first.push_back(p);
+        second.push_back(p);
+        second.insert(second.end(), line.begin() + static_cast<long>(i) + 1, line.end());
+        if (distance(first[first.size() - 2], p) <= kGrid) first.erase(first.end() - 2);
+        if (distance(second[1], p) <= kGrid) second.erase(second.begin() + 1);
+        if (first.size() < 2 || second.size() < 2) break;
+        line = std::move(first);
+        pieces.push_back(std::move(second));
+        break;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+RoadGraph buildRoadGraph(const std::vector<StreetLine>& input, const RoadGraphOptions& options) {
+  RoadGraph graph;
+  RoadGraphReport& report = graph.report;
+  report.lines = static_cast<std::int64_t>(input.size());
+  std::vector<Polyline> lines(input.size());
+  for (std::size_t i = 0; i < input.size(); ++i) {
+    for (const Point& p : input[i].line) {
+      if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
+      if (lines[i].empty() || lines[i].back().x != p.x || lines[i].back().y != p.y) lines[i].push_back(p);
+    }
+    if (lines[i].size() < 2) {
+      lines[i].clear();
+      ++report.skipped;
+    }
+  }
+  const std::vector<int> clusterSize = joinEndpoints(lines, options.snap, report.endpointsJoined);
+  endsOntoLines(lines, clusterSize, options.snap, report.endpointsOnLines);
+
+  // Noding: the lines that meet what they cross, then those that do not.
+  std::vector<Polyline> regular, apart;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    if (lines[i].empty()) continue;
+    (input[i].noNode ? apart : regular).push_back(lines[i]);
+    report.notNoded += input[i].noNode;
+  }
+  std::vector<Polyline> pieces = geos::nodeLines(regular, kGrid);
+  std::vector<Polyline> bridges = geos::nodeLines(apart, kGrid);
+  std::vector<Point> bridgeEnds;
+  for (const Polyline& b : bridges) {
+    bridgeEnds.push_back(b.front());
+    bridgeEnds.push_back(b.back());
+  }
+  splitAt(pieces, bridgeEnds);
+  // The stubs a free end left past the line it was moved onto.
+  {
+    std::map<std::pair<long long, long long>, int> ends;
+    auto cell = [](const Point& p) { return std::make_pair(std::llround(p.x / kGrid), std::llround(p.y / kGrid)); };
+    for (const Polyline& l : pieces) {
+      ++ends[cell(l.front())];
+      ++ends[cell(l.back())];
+    }
+    pieces.erase(std::remove_if(pieces.begin(), pieces.end(),
+                                [&](const Polyline& l) {
+                                  return length(l) <= 4 * kGrid &&
+                                         (ends[cell(l.front())] == 1 || ends[cell(l.back())] == 1);
+                                }),
+                 pieces.end());
+  }
+  const std::size_t regularPieces = pieces.size();
+  for (Polyline& b : bridges) pieces.push_back(std::move(b));
+
+  // Attributes: each piece takes the line it lies along (at its middle); where
+  // several do (duplicates), the one with a known and larger width, then the
+  // least key.
+  std::vector<const Polyline*> regularLines, apartLines;
+  std::vector<int> regularIndex, apartIndex;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    if (lines[i].empty()) continue;
+    (input[i].noNode ? apartLines : regularLines).push_back(&lines[i]);
+    (input[i].noNode ? apartIndex : regularIndex).push_back(static_cast<int>(i));
+  }
+  const SegmentTree regularTree = segmentTree(regularLines), apartTree = segmentTree(apartLines);
+  auto better = [&](int a, int b) {  // is line a a better source than line b?
+    const double wa = input[static_cast<std::size_t>(a)].width, wb = input[static_cast<std::size_t>(b)].width;
+    if (std::isnan(wa) != std::isnan(wb)) return !std::isnan(wa);
+    if (!std::isnan(wa) && wa != wb) return wa > wb;
+    return input[static_cast<std::size_t>(a)].key < input[static_cast<std::size_t>(b)].key;
+  };
+
+  // Nodes by position on the noding grid.
+  std::map<std::pair<long long, long long>, int> nodeAt;
+  auto nodeOf = [&](const Point& p) {
+    const std::pair<long long, long long> cell{std::llround(p.x / kGrid), std::llround(p.y / kGrid)};
+    auto [it, added] = nodeAt.emplace(cell, static_cast<int>(graph.nodes.size()));
+    if (added) graph.nodes.push_back({positionKey(p), p, 0});
+    return it->second;
+  };
+  for (std::size_t k = 0; k < pieces.size(); ++k) {
+    Polyline& line = pieces[k];
+    if (line.size() < 2 || length(line) <= 0) continue;
+    const bool bridge = k >= regularPieces;
+    const Point middle = pointAt(line, 0.5 * length(line)).first;
+    const SegmentTree& tree = bridge ? apartTree : regularTree;
+    const std::vector<const Polyline*>& candidates = bridge ? apartLines : regularLines;
+    const std::vector<int>& index = bridge ? apartIndex : regularIndex;
+    int source = -1, along = 0;
+    double nearest = std::numeric_limits<double>::infinity();
+    int nearestSource = -1;
+    for (auto it = tree.qbegin(bgi::intersects(boxAround(middle, middle, 0.01))); it != tree.qend(); ++it) {
+      const auto [l, i] = it->second;
+      const Polyline& c = *candidates[static_cast<std::size_t>(l)];
+      const double d = distance(
+          middle, nearestOnSegment(middle, c[static_cast<std::size_t>(i)], c[static_cast<std::size_t>(i) + 1]));
+      const int s = index[static_cast<std::size_t>(l)];
+      if (d < nearest) {
+        nearest = d;
+        nearestSource = s;
+      }
+      if (d > 0.01) continue;
+      if (source != s) ++along;
+      if (source < 0 || better(s, source)) source = s;
+    }
+    if (source < 0) source = nearestSource;
+    if (source < 0) continue;
+    if (along > 1) ++report.duplicateEdges;
+    RoadEdge e;
+    e.from = nodeOf(line.front());
+    e.to = nodeOf(line.back());
+    const StreetLine& s = input[static_cast<std::size_t>(source)];
+    e.width = s.width;
+    e.name = s.name;
+    e.noNode = s.noNode;
+    e.source = source;
+    e.line = std::move(line);
+    graph.edges.push_back(std::move(e));
+  }
+  // Keys; edges run from the node of lesser key; nodes and edges sorted by key.
+  for (RoadEdge& e : graph.edges) {
+    Key a = graph.nodes[static_cast<std::size_t>(e.from)].key, b = graph.nodes[static_cast<std::size_t>(e.to)].key;
+    if (a > b) {
+      std::reverse(e.line.begin(), e.line.end());
+      std::swap(e.from, e.to);
+      std::swap(a, b);
+    } else if (a == b && signedArea(e.line) < 0) {
+      std::reverse(e.line.begin(), e.line.end());  // a loop runs counter-clockwise
+    }
+    e.key = mixKeys(mixKeys(a, b), positionKey(pointAt(e.line, 0.5 * length(e.line)).first));
+    ++graph.nodes[static_cast<std::size_t>(e.from)].degree;
+    ++graph.nodes[static_cast<std::size_t>(e.to)].degree;
+  }
+  std::vector<int> order(graph.nodes.size()), rank(graph.nodes.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return graph.nodes[static_cast<std::size_t>(a)].key < graph.nodes[static_cast<std::size_t>(b)].key;
+  });
+  std::vector<RoadNode> nodes;
+  for (std::size_t r = 0; r < order.size(); ++r) {
+    rank[static_cast<std::size_t>(order[r])] = static_cast<int>(r);
+    nodes.push_back(graph.nodes[static_cast<std::size_t>(order[r])]);
+  }
+  graph.nodes = std::move(nodes);
+  for (RoadEdge& e : graph.edges) {
+    e.from = rank[static_cast<std::size_t>(e.from)];
+    e.to = rank[static_cast<std::size_t>(e.to)];
+  }
+  std::sort(graph.edges.begin(), graph.edges.end(), [](const RoadEdge& a, const RoadEdge& b) { return a.key < b.key; });
+  for (const RoadNode& n : graph.nodes) report.deadEnds += n.degree == 1;
+  return graph;
+}
+
+std::int64_t fillStreetWidths(RoadGraph& graph, const std::vector<const Polygon*>& parcelBlocks, double defaultWidth,
+                              double maxWidth) {
+  std::vector<const Polyline*> rings;
+  for (const Polygon* p : parcelBlocks) {
+    rings.push_back(&p->outer);
+    for (const Ring& h : p->holes) rings.push_back(&h);
+  }
+  const SegmentTree tree = segmentTree(rings, /*closed=*/true);
+  const double reach = 0.5 * maxWidth;
+  // Distance from p straight along unit vector n to the nearest outline, or NaN.
+  auto cast = [&](const Point& p, const Point& n) {
+    const Point end{p.x + reach * n.x, p.y + reach * n.y};
+    double best = std::numeric_limits<double>::infinity();
+    for (auto it = tree.qbegin(bgi::intersects(boxAround(p, end))); it != tree.qend(); ++it) {
+      const auto [r, i] = it->second;
+      const Polyline& ring = *rings[static_cast<std::size_t>(r)];
+      const Point a = ring[static_cast<std::size_t>(i)], b = ring[(static_cast<std::size_t>(i) + 1) % ring.size()];
+      // p + u n = a + v (b - a)
+      const double ex = b.x - a.x, ey = b.y - a.y, den = n.x * (-ey) - n.y * (-ex);
+      if (den == 0) continue;
+      const double rx = a.x - p.x, ry = a.y - p.y;
+      const double u = (rx * (-ey) - ry * (-ex)) / den, v = (n.x * ry - n.y * rx) / den;
+      if (u > 0 && u <= reach && v >= 0 && v <= 1) best = std::min(best, u);
+    }
+    return std::isfinite(best) ? best : NAN;
+  };
+  std::vector<char> measured(graph.edges.size(), 0);
+  parallelFor(graph.edges.size(), [&](std::size_t k) {
+    RoadEdge& e = graph.edges[k];
+    if (!std::isnan(e.width)) return;
+    const double len = length(e.line);
+    std::vector<double> widths;
+    const double from = 0.1 * len, to = 0.9 * len;
+    const int samples = std::max(1, static_cast<int>((to - from) / 5.0));
+    for (int i = 0; i < samples; ++i) {
+      const double s = samples == 1 ? 0.5 * len : from + (to - from) * (i + 0.5) / samples;
+      const auto [p, dir] = pointAt(e.line, s);
+      const Point left{-dir.y, dir.x}, right{dir.y, -dir.x};
+      const double l = cast(p, left), r = cast(p, right);
+      if (!std::isnan(l) && !std::isnan(r)) {
+        widths.push_back(l + r);
+      } else if (!std::isnan(l) || !std::isnan(r)) {
+        widths.push_back(2 * (std::isnan(l) ? r : l));
+      }
+    }
+    if (widths.empty()) {
+      e.width = defaultWidth;
+      return;
+    }
+    std::nth_element(widths.begin(), widths.begin() + static_cast<long>(widths.size() / 2), widths.end());
+    e.width = widths[widths.size() / 2];
+    measured[k] = 1;
+  });
+  return std::count(measured.begin(), measured.end(), 1);
+}
+
+std::vector<Polygon> streetSurface(const RoadGraph& graph, int quadrantSegments) {
+  std::vector<const Polyline*> lines;
+  std::vector<double> halves;
+  for (const RoadEdge& e : graph.edges) {
+    lines.push_back(&e.line);
+    halves.push_back(0.5 * e.width);
+  }
+  return geos::bufferedUnion(lines, halves, quadrantSegments);
+}
+
+StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& options, const ProgressFn& progress) {
+  for (const RoadEdge& e : graph.edges) {
+    if (!(e.width >= 0)) throw usageError("street blocks: an edge has no width (fill the widths first)");
+  }
+  StreetBlocks out;
+  std::vector<Polyline> all;
+  for (const RoadEdge& e : graph.edges) all.push_back(e.line);
+  const geos::LineFaces faces = geos::polygonizeLines(geos::nodeLines(all, kGrid));
+  out.faces = static_cast<std::int64_t>(faces.faces.size());
+  reportProgress(progress, 0.2, "faces");
+
+  // Each edge's surface, and an index of their boxes.
+  std::vector<std::vector<Polygon>> surfaces(graph.edges.size());
+  parallelFor(graph.edges.size(), [&](std::size_t k) {
+    const RoadEdge& e = graph.edges[k];
+    surfaces[k] = geos::bufferedUnion({&e.line}, {0.5 * e.width}, options.quadrantSegments);
+  });
+  std::vector<BoxEntry> boxes;
+  for (std::size_t k = 0; k < graph.edges.size(); ++k) {
+    boxes.push_back({boxOf(graph.edges[k].line, 0.5 * graph.edges[k].width), static_cast<int>(k)});
+  }
+  const BoxTree edgeTree(boxes.begin(), boxes.end());
+
+  struct FaceBlocks {
+    std::vector<StreetBlock> blocks;
+    bool tooLarge = false;
+    int tooSmall = 0;
+  };
+  std::vector<FaceBlocks> perFace(faces.faces.size());
+  parallelFor(
+      faces.faces.size(),
+      [&](std::size_t f) {
+        const Polygon& face = faces.faces[f];
+        FaceBlocks& result = perFace[f];
+        if (area(face) > options.maxArea) {
+          result.tooLarge = true;
+          return;
+        }
+        std::vector<int> near;
+        for (auto it = edgeTree.qbegin(bgi::intersects(boxOf(face.outer))); it != edgeTree.qend(); ++it) {
+          near.push_back(it->second);
+        }
+        std::sort(near.begin(), near.end());
+        std::vector<const Polygon*> cut;
+        for (int k : near) {
+          for (const Polygon& p : surfaces[static_cast<std::size_t>(k)]) cut.push_back(&p);
+        }
+        for (Polygon& part : geos::difference(face, cut, kOverlayGrid)) {
+          if (area(part) < options.minArea) {
+            ++result.tooSmall;
+            continue;
+          }
+          StreetBlock b;
+          std::vector<Key> facedKeys;
+          auto faceRing = [&](const Ring& ring) {
+            std::vector<int> faced(ring.size(), -1);
+            for (std::size_t i = 0; i < ring.size(); ++i) {
+              const Point& a = ring[i];
+              const Point& c = ring[(i + 1) % ring.size()];
+              const Point mid{0.5 * (a.x + c.x), 0.5 * (a.y + c.y)};
+              double best = std::numeric_limits<double>::infinity();
+              for (int k : near) {
+                const RoadEdge& e = graph.edges[static_cast<std::size_t>(k)];
+                const double d = distanceToLine(mid, e.line) - 0.5 * e.width;
+                if (d < best) {
+                  best = d;
+                  faced[i] = k;
+                }
+              }
+              if (!(best <= 1.0)) faced[i] = -1;
+              if (faced[i] >= 0) facedKeys.push_back(graph.edges[static_cast<std::size_t>(faced[i])].key);
+            }
+            b.faced.push_back(std::move(faced));
+          };
+          faceRing(part.outer);
+          for (const Ring& h : part.holes) faceRing(h);
+          std::sort(facedKeys.begin(), facedKeys.end());
+          facedKeys.erase(std::unique(facedKeys.begin(), facedKeys.end()), facedKeys.end());
+          b.key = setKey(facedKeys);
+          b.shape = std::move(part);
+          result.blocks.push_back(std::move(b));
+        }
+      },
+      [&](std::size_t done) {
+        reportProgress(progress, 0.2 + 0.8 * static_cast<double>(done) / static_cast<double>(faces.faces.size()),
+                       "blocks");
+      });
+  for (FaceBlocks& f : perFace) {
+    out.facesTooLarge += f.tooLarge;
+    out.partsTooSmall += f.tooSmall;
+    for (StreetBlock& b : f.blocks) out.blocks.push_back(std::move(b));
+  }
+  // Blocks facing the same streets (pieces of one face) are told apart by
+  // their place, in an order that does not depend on the input's.
+  auto place = [](const StreetBlock& b) { return centroid(b.shape); };
+  std::sort(out.blocks.begin(), out.blocks.end(), [&](const StreetBlock& a, const StreetBlock& b) {
+    if (a.key != b.key) return a.key < b.key;
+    return lexLess(place(a), place(b));
+  });
+  std::vector<Key> faceKeys;
+  for (const StreetBlock& b : out.blocks) faceKeys.push_back(b.key);
+  for (std::size_t i = 1, run = 0; i < out.blocks.size(); ++i) {
+    run = faceKeys[i] == faceKeys[i - 1] ? run + 1 : 0;
+    if (run) out.blocks[i].key = mixKeys(faceKeys[i], run);
+  }
+  std::sort(out.blocks.begin(), out.blocks.end(),
+            [](const StreetBlock& a, const StreetBlock& b) { return a.key < b.key; });
+  return out;
+}
+
+std::vector<std::vector<double>> facedWidths(const RoadGraph& graph, const StreetBlock& block) {
+  std::vector<std::vector<double>> widths;
+  for (const std::vector<int>& ring : block.faced) {
+    std::vector<double> w;
+    for (int e : ring) w.push_back(e >= 0 ? graph.edges[static_cast<std::size_t>(e)].width : NAN);
+    widths.push_back(std::move(w));
+  }
+  return widths;
+}
+
+}  // namespace parcelscope::analysis

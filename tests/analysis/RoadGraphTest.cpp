@@ -1,0 +1,282 @@
+// Road graphs and street blocks on synthetic networks (a grid, a radial
+// pattern, a curvy suburb with cul-de-sacs, T-junctions short of their street,
+// dangles, a bridge, a street crossing itself, duplicated and nearly duplicated
+// lines): blocks and street surface together cover the network's area with no
+// gap and no overlap, blocks are valid, keys do not depend on the order or
+// direction of the input lines.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <random>
+
+#include "parcelscope/analysis/RoadGraph.h"
+#include "parcelscope/core/GeosOps.h"
+
+namespace parcelscope::analysis {
+namespace {
+
+StreetLine street(Polyline line, double width = 10.0, std::string name = "") {
+  StreetLine s;
+  s.line = std::move(line);
+  s.width = width;
+  s.name = std::move(name);
+  return s;
+}
+
+// n x n lines `spacing` apart, each running one spacing past the outer ones.
+std::vector<StreetLine> grid(int n, double spacing, double width = 10.0) {
+  std::vector<StreetLine> lines;
+  const double from = -spacing, to = spacing * n;
+  for (int i = 0; i < n; ++i) {
+    lines.push_back(street({{from, i * spacing}, {to, i * spacing}}, width, "east " + std::to_string(i)));
+    lines.push_back(street({{i * spacing, from}, {i * spacing, to}}, width, "north " + std::to_string(i)));
+  }
+  return lines;
+}
+
+Polyline arc(double r, double a0, double a1, int n, Point c = {0, 0}) {
+  Polyline l;
+  for (int i = 0; i <= n; ++i) {
+    const double a = a0 + (a1 - a0) * i / n;
+    l.push_back({c.x + r * std::cos(a), c.y + r * std::sin(a)});
+  }
+  return l;
+}
+
+struct Built {
+  RoadGraph graph;
+  StreetBlocks blocks;
+};
+
+Built build(const std::vector<StreetLine>& lines, RoadGraphOptions options = {}) {
+  Built b;
+  b.graph = buildRoadGraph(lines, options);
+  b.blocks = streetBlocks(b.graph);
+  return b;
+}
+
+// Blocks plus the street surface cover the faces and the surface (the
+// network's area) once: the union's area is the sum of the parts.
+void expectCoverage(const Built& b, const std::string& what) {
+  const std::vector<Polygon> surface = streetSurface(b.graph);
+  std::vector<const Polygon*> all;
+  double blocks = 0, streets = 0;
+  for (const StreetBlock& s : b.blocks.blocks) {
+    EXPECT_TRUE(geos::isValid(s.shape)) << what << ": block " << s.key;
+    EXPECT_GT(area(s.shape), 0) << what;
+    blocks += area(s.shape);
+    all.push_back(&s.shape);
+  }
+  for (const Polygon& p : surface) {
+    streets += area(p);
+    all.push_back(&p);
+  }
+  const double together = geos::unionArea(all, 1e-6);
+  EXPECT_NEAR(blocks + streets, together, 1e-6 * together) << what << ": blocks and streets overlap";
+  // No gap: every face of the network lies in blocks and streets.
+  std::vector<Polyline> lines;
+  for (const RoadEdge& e : b.graph.edges) lines.push_back(e.line);
+  const auto faces = geos::polygonizeLines(geos::nodeLines(lines, 1e-3));
+  std::vector<const Polygon*> network = all;
+  for (const Polygon& f : faces.faces) network.push_back(&f);
+  EXPECT_NEAR(geos::unionArea(network, 1e-6), together, 1e-6 * together) << what << ": a gap";
+}
+
+std::map<Key, double> blockAreas(const Built& b) {
+  std::map<Key, double> m;
+  for (const StreetBlock& s : b.blocks.blocks) m[s.key] = area(s.shape);
+  return m;
+}
+
+// The same network with its lines shuffled and some reversed: the same keys
+// and blocks.
+void expectOrderFree(const std::vector<StreetLine>& lines, const std::string& what, std::uint32_t seed = 25) {
+  const Built a = build(lines);
+  std::vector<StreetLine> other = lines;
+  std::mt19937 rng(seed);
+  std::shuffle(other.begin(), other.end(), rng);
+  for (std::size_t i = 0; i < other.size(); i += 2) std::reverse(other[i].line.begin(), other[i].line.end());
+  const Built b = build(other);
+  ASSERT_EQ(a.graph.nodes.size(), b.graph.nodes.size()) << what;
+  ASSERT_EQ(a.graph.edges.size(), b.graph.edges.size()) << what;
+  for (std::size_t i = 0; i < a.graph.nodes.size(); ++i) EXPECT_EQ(a.graph.nodes[i].key, b.graph.nodes[i].key) << what;
+  for (std::size_t i = 0; i < a.graph.edges.size(); ++i) EXPECT_EQ(a.graph.edges[i].key, b.graph.edges[i].key) << what;
+  const auto areasA = blockAreas(a), areasB = blockAreas(b);
+  ASSERT_EQ(areasA.size(), areasB.size()) << what;
+  for (const auto& [key, area] : areasA) {
+    ASSERT_TRUE(areasB.count(key)) << what << ": block " << keyText(key) << " missing";
+    EXPECT_NEAR(areasB.at(key), area, 1e-6 * area) << what;
+  }
+}
+
+TEST(RoadGraph, GridGivesOneBlockPerCellInsetByHalfTheWidths) {
+  const Built b = build(grid(4, 100));
+  // 4 x 4 crossings, 8 dead ends where the lines run past the grid.
+  EXPECT_EQ(b.graph.nodes.size(), 16u + 16u);
+  EXPECT_EQ(b.graph.report.deadEnds, 16);
+  EXPECT_EQ(b.blocks.faces, 9);
+  ASSERT_EQ(b.blocks.blocks.size(), 9u);
+  for (const StreetBlock& s : b.blocks.blocks) {
+    EXPECT_NEAR(area(s.shape), 90.0 * 90.0, 1e-6);
+    for (const auto& ring : s.faced) {
+      for (int e : ring) EXPECT_GE(e, 0);
+    }
+  }
+  expectCoverage(b, "grid");
+  expectOrderFree(grid(4, 100), "grid");
+}
+
+TEST(RoadGraph, WidthsDifferEdgeByEdgeAndEachBlockEdgeKnowsItsStreet) {
+  std::vector<StreetLine> lines = grid(2, 100);  // one cell
+  lines[0].width = 20;                           // the street along y = 0
+  const Built b = build(lines);
+  ASSERT_EQ(b.blocks.blocks.size(), 1u);
+  const StreetBlock& s = b.blocks.blocks[0];
+  EXPECT_NEAR(area(s.shape), 90.0 * (100 - 10 - 5), 1e-6);
+  const auto widths = facedWidths(b.graph, s);
+  int wide = 0;
+  for (std::size_t i = 0; i < s.shape.outer.size(); ++i) {
+    const Point& p = s.shape.outer[i];
+    const Point& q = s.shape.outer[(i + 1) % s.shape.outer.size()];
+    const bool onWide = std::fabs(p.y - 10) < 1e-9 && std::fabs(q.y - 10) < 1e-9;
+    wide += onWide;
+    EXPECT_EQ(widths[0][i], onWide ? 20.0 : 10.0) << i;
+    if (onWide) EXPECT_EQ(b.graph.edges[static_cast<std::size_t>(s.faced[0][i])].name, "east 0");
+  }
+  EXPECT_EQ(wide, 1);
+  expectCoverage(b, "widths");
+}
+
+TEST(RoadGraph, DeadEndCutsASlotIntoItsBlock) {
+  std::vector<StreetLine> lines = grid(2, 100);
+  lines.push_back(street({{50, 0}, {50, 60}}, 8, "court"));  // a cul-de-sac from the south street
+  const Built b = build(lines);
+  EXPECT_EQ(b.graph.report.deadEnds, 8 + 1);
+  ASSERT_EQ(b.blocks.blocks.size(), 1u);
+  const double slot = 8 * (60 - 5) + M_PI * 16 / 2;                  // the stem beyond the street, and its round end
+  EXPECT_NEAR(area(b.blocks.blocks[0].shape), 90 * 90 - slot, 1.0);  // the round end is a polygon
+  expectCoverage(b, "dead end");
+  expectOrderFree(lines, "dead end");
+}
+
+TEST(RoadGraph, EndsShortOfAStreetMeetItWithinTheSnap) {
+  std::vector<StreetLine> lines = grid(2, 100);
+  lines.push_back(street({{50, 0.6}, {50, 99.5}}, 8, "cross"));  // stops short at both ends
+  RoadGraphOptions options;
+  options.snap = 1.0;
+  const Built b = build(lines, options);
+  EXPECT_EQ(b.graph.report.endpointsOnLines, 2);
+  EXPECT_EQ(b.blocks.blocks.size(), 2u);  // the cell is split in two
+  EXPECT_EQ(b.blocks.faces, 2);
+  // With a smaller snap the line keeps two dead ends: one face, though its
+  // surface still reaches across the cell.
+  options.snap = 0.2;
+  const Built apart = build(lines, options);
+  EXPECT_EQ(apart.graph.report.endpointsOnLines, 0);
+  EXPECT_EQ(apart.graph.report.deadEnds, b.graph.report.deadEnds + 2);
+  EXPECT_EQ(apart.blocks.faces, 1);
+  expectCoverage(b, "T-junctions");
+}
+
+TEST(RoadGraph, ABridgeCrossesWithoutANode) {
+  std::vector<StreetLine> lines = grid(3, 100);
+  StreetLine bridge = street({{-100, 150}, {300, 150}}, 12, "viaduct");
+  bridge.noNode = true;
+  lines.push_back(bridge);
+  const Built b = build(lines);
+  EXPECT_EQ(b.graph.report.notNoded, 1);
+  // Its crossings with the three north-south streets are not nodes.
+  for (const RoadNode& n : b.graph.nodes) EXPECT_FALSE(std::fabs(n.at.y - 150) < 1e-6 && n.degree == 4);
+  int viaduct = 0;
+  for (const RoadEdge& e : b.graph.edges) viaduct += e.name == "viaduct";
+  EXPECT_EQ(viaduct, 1);
+  // The land under it is street: the two cells it crosses are cut in two.
+  EXPECT_EQ(b.blocks.blocks.size(), 4u + 2u);
+  expectCoverage(b, "bridge");
+}
+
+TEST(RoadGraph, DuplicatedAndNearlyDuplicatedLinesAreMerged) {
+  std::vector<StreetLine> lines = grid(3, 100);
+  const Built plain = build(lines);
+  lines.push_back(street({{-100, 100}, {300, 100}}, 10, "twice"));
+  lines.push_back(street({{-100, 100.0002}, {300, 99.9998}}, 10, "nearly twice"));
+  const Built b = build(lines);
+  EXPECT_EQ(b.graph.edges.size(), plain.graph.edges.size());
+  EXPECT_GE(b.graph.report.duplicateEdges, 1);
+  EXPECT_EQ(b.blocks.blocks.size(), plain.blocks.blocks.size());
+  expectCoverage(b, "duplicates");
+}
+
+TEST(RoadGraph, AStreetCrossingItselfIsNodedThere) {
+  // A figure of eight through a square of streets.
+  std::vector<StreetLine> lines = {
+      street({{0, 0}, {200, 0}, {200, 200}, {0, 200}, {0, 0}}, 10, "ring"),
+      street({{20, 20}, {180, 180}, {180, 20}, {20, 180}, {20, 20}}, 6, "eight"),
+  };
+  const Built b = build(lines);
+  bool crossing = false;
+  for (const RoadNode& n : b.graph.nodes) crossing |= std::fabs(n.at.x - 100) < 1e-3 && std::fabs(n.at.y - 100) < 1e-3;
+  EXPECT_TRUE(crossing);
+  EXPECT_GE(b.blocks.blocks.size(), 3u);
+  expectCoverage(b, "self-crossing");
+  expectOrderFree(lines, "self-crossing");
+}
+
+TEST(RoadGraph, RadialPatternAndCurvySuburbWithCulDeSacs) {
+  std::vector<StreetLine> radial;
+  for (int r = 1; r <= 3; ++r) radial.push_back(street(arc(100.0 * r, 0, 2 * M_PI, 96), 8, "ring"));
+  for (int k = 0; k < 8; ++k) {
+    const double a = 2 * M_PI * k / 8;
+    radial.push_back(street({{0, 0}, {350 * std::cos(a), 350 * std::sin(a)}}, 12, "spoke"));
+  }
+  const Built r = build(radial);
+  EXPECT_EQ(r.blocks.blocks.size(), 8u * 3u);
+  expectCoverage(r, "radial");
+  expectOrderFree(radial, "radial");
+
+  // Curvy loop streets with cul-de-sacs ending in turning circles' centres.
+  std::vector<StreetLine> suburb = {street(arc(300, 0, 2 * M_PI, 120), 10, "loop"),
+                                    street(arc(150, 0, 2 * M_PI, 80), 8, "inner")};
+  for (int k = 0; k < 4; ++k) {
+    const double a = 2 * M_PI * k / 4 + 0.3;
+    suburb.push_back(street({{150 * std::cos(a), 150 * std::sin(a)}, {300 * std::cos(a), 300 * std::sin(a)}}, 8));
+    const double c = a + M_PI / 4;  // a court from the loop inward
+    suburb.push_back(street(arc(225, c, c + 0.3, 8), 7, "court"));
+    suburb.back().line.insert(suburb.back().line.begin(), {300 * std::cos(c), 300 * std::sin(c)});
+  }
+  const Built s = build(suburb);
+  EXPECT_GE(s.graph.report.deadEnds, 4);
+  EXPECT_EQ(s.blocks.blocks.size(), 4u + 1u);  // four between the loops, the inner disc
+  expectCoverage(s, "suburb");
+  expectOrderFree(suburb, "suburb");
+}
+
+TEST(RoadGraph, FacesAboveTheLimitAreDropped) {
+  const RoadGraph g = buildRoadGraph(grid(3, 100));
+  StreetBlockOptions options;
+  options.maxArea = 5000;  // each face is 10,000 m2
+  const StreetBlocks b = streetBlocks(g, options);
+  EXPECT_EQ(b.facesTooLarge, 4);
+  EXPECT_TRUE(b.blocks.empty());
+}
+
+TEST(RoadGraph, WidthsMeasuredFromTheBlocksOnEitherSide) {
+  // Two blocks of parcels 14 m apart around a centre line at y = 0, a third
+  // only on one side of the line at x = 200 (6 m from it).
+  const Polygon south = {{{0, -50}, {100, -50}, {100, -7}, {0, -7}}, {}};
+  const Polygon north = {{{0, 7}, {100, 7}, {100, 50}, {0, 50}}, {}};
+  const Polygon east = {{{206, -50}, {250, -50}, {250, 50}, {206, 50}}, {}};
+  RoadGraph g = buildRoadGraph(
+      {street({{0, 0}, {100, 0}}, NAN), street({{200, -50}, {200, 50}}, NAN), street({{500, 0}, {600, 0}}, NAN)});
+  EXPECT_EQ(fillStreetWidths(g, {&south, &north, &east}, 9.0), 2);
+  std::map<double, double> widthAtX;
+  for (const RoadEdge& e : g.edges) widthAtX[std::min(e.line.front().x, e.line.back().x)] = e.width;
+  EXPECT_NEAR(widthAtX[0], 14.0, 1e-9);
+  EXPECT_NEAR(widthAtX[200], 12.0, 1e-9);
+  EXPECT_EQ(widthAtX[500], 9.0);  // nothing near: the default
+}
+
+}  // namespace
+}  // namespace parcelscope::analysis
