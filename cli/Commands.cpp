@@ -13,6 +13,7 @@
 #include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/pipeline/Inspect.h"
 #include "parcelscope/pipeline/StatsJob.h"
+#include "parcelscope/pipeline/StreetsJob.h"
 #include "parcelscope/viz/CompareFigures.h"
 
 namespace parcelscope::cli {
@@ -26,6 +27,7 @@ const char* kOverview =
     "commands:\n"
     "  stats     read observed parcels, build blocks, write per-parcel metrics,\n"
     "            per-block statistics and generator parameters\n"
+    "  blocks    build the road graph of street centre lines and its blocks\n"
     "  generate  subdivide blocks into procedural parcels (OBB, skeleton or offset style)\n"
     "  compare   generate parcels in the blocks of observed ones and compare the two sets:\n"
     "            per-block and city-wide tables, distances, layers and figures\n"
@@ -42,6 +44,80 @@ std::vector<FlagSpec> inputFlags() {
           {"key-field",
            "field whose value is each feature's stable key (parcel_key, block_key); default: the "
            "features' geometries"}};
+}
+
+// The street layer's flags; `prefix` is "streets-" where the layer is not the
+// command's INPUT (generate, compare).
+std::vector<FlagSpec> streetFlags(const std::string& prefix) {
+  std::vector<FlagSpec> f;
+  if (!prefix.empty()) {
+    f.push_back({"streets",
+                 "street centre lines (any line layer GDAL reads): blocks come from the street network\n"
+                 "      and observed parcels are assigned to the block they overlap most"});
+    f.push_back({prefix + "layer", "layer of the street file to read (default: the first)"});
+    f.push_back({prefix + "where", "OGR SQL attribute filter on the street lines"});
+  }
+  f.push_back({"width-field", "street width field (metres, or the unit of a projected CRS: feet for EPSG:2286)"});
+  f.push_back({"class-field", "street class field, with --class-widths"});
+  f.push_back({"class-widths", "width in metres of each class value, e.g. \"1=20,2=15,residential=10\""});
+  f.push_back({"name-field", "street name field"});
+  f.push_back({"no-node-where",
+               "OGR SQL filter selecting the lines that meet nothing they cross (bridges, tunnels),\n"
+               "      e.g. \"BRIDGE = 'Y'\""});
+  return f;
+}
+
+// The street read options of `a`: the path and layer flags named with `prefix`.
+io::StreetReadOptions streetOptions(const Args& a, const std::string& path, const std::string& prefix) {
+  io::StreetReadOptions o;
+  o.path = path;
+  o.layer = a.value(prefix + "layer").value_or("");
+  o.where = a.value(prefix + "where").value_or("");
+  if (prefix.empty()) o.crsOverride = a.value("crs").value_or("");
+  o.widthField = a.value("width-field").value_or("");
+  o.classField = a.value("class-field").value_or("");
+  o.nameField = a.value("name-field").value_or("");
+  o.noNodeWhere = a.value("no-node-where").value_or("");
+  if (const auto widths = a.value("class-widths")) {
+    std::size_t at = 0;
+    while (at <= widths->size()) {
+      const std::size_t comma = std::min(widths->find(',', at), widths->size());
+      const std::string item = widths->substr(at, comma - at);
+      const std::size_t eq = item.rfind('=');
+      double w = NAN;
+      std::size_t used = 0;
+      try {
+        if (eq != std::string::npos) w = std::stod(item.substr(eq + 1), &used);
+      } catch (const std::exception&) {
+      }
+      if (eq == std::string::npos || eq == 0 || used != item.size() - eq - 1 || !std::isfinite(w) || w < 0) {
+        throw usageError("--class-widths: '" + item + "' is not CLASS=METRES (a width of 0 or more)");
+      }
+      o.classWidths[item.substr(0, eq)] = w;
+      at = comma + 1;
+    }
+    if (o.classField.empty()) throw usageError("--class-widths needs --class-field");
+  }
+  return o;
+}
+
+// --streets and its flags, when given.
+std::optional<io::StreetReadOptions> streetsOf(const Args& a) {
+  const auto path = a.value("streets");
+  if (!path) {
+    for (const char* flag : {"streets-layer", "streets-where", "width-field", "class-field", "class-widths",
+                             "name-field", "no-node-where"}) {
+      if (a.has(flag)) throw usageError(std::string("--") + flag + " needs --streets");
+    }
+    return std::nullopt;
+  }
+  return streetOptions(a, *path, "streets-");
+}
+
+template <typename T>
+std::vector<T> joined(std::vector<T> a, const std::vector<T>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
 }
 
 FlagSpec styleFlag() {
@@ -98,10 +174,12 @@ int dispatch(const std::vector<std::string>& args) {
   }
   if (args[0] == "metrics") return metricsCommand(rest);
   if (args[0] == "stats") return statsCommand(rest);
+  if (args[0] == "blocks") return blocksCommand(rest);
   if (args[0] == "generate") return generateCommand(rest);
   if (args[0] == "compare") return compareCommand(rest);
   if (args[0] == "inspect") return inspectCommand(rest);
-  throw usageError("unknown command '" + args[0] + "' (commands: stats, generate, compare, inspect, metrics, version)");
+  throw usageError("unknown command '" + args[0] +
+                   "' (commands: stats, blocks, generate, compare, inspect, metrics, version)");
 }
 
 int metricsCommand(const std::vector<std::string>& args) {
@@ -143,14 +221,58 @@ int statsCommand(const std::vector<std::string>& args) {
       pipeline::runStats(readOptions(a), a.parameters(), *a.value("out"), terminalProgress(a.has("quiet"))), a);
 }
 
+int blocksCommand(const std::vector<std::string>& args) {
+  std::vector<FlagSpec> flags = {{"layer", "layer of STREETS to read (default: the first)"},
+                                 {"where", "OGR SQL attribute filter on the street lines"},
+                                 {"crs", "CRS of STREETS (e.g. EPSG:2286), replacing a missing or wrong one"}};
+  flags = joined(flags, streetFlags(""));
+  flags.push_back({"parcels",
+                   "observed parcels: unknown widths are measured from the gap between their blocks,\n"
+                   "      and blocks.gpkg counts each block's parcels"});
+  flags.push_back({"parcels-where", "OGR SQL attribute filter on the parcels, e.g. \"ML <> 'ROAD'\""});
+  flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
+  flags.push_back({"quiet", "no progress or summary on stderr", false});
+  const auto params = joined(pipeline::streetParameters(), analysis::analysisParameters());
+  if (wantsHelp(args)) {
+    std::fputs(usageText("parcelscope blocks STREETS [--width-field F] [--default-width M] [--snap M] [--where SQL] "
+                         "[--parcels PARCELS] --out DIR",
+                         flags, params)
+                   .c_str(),
+               stdout);
+    std::fputs(
+        "\nBuilds the planar road graph of the street centre lines and its blocks (faces minus the\n"
+        "street surface). Writes DIR/blocks.gpkg (layer blocks), DIR/streets.gpkg (layers nodes and\n"
+        "edges), DIR/street_surface.gpkg and DIR/run.json.\n",
+        stdout);
+    return 0;
+  }
+  const Args a(args, flags, params);
+  if (a.positional().size() != 1) throw usageError("expected exactly one STREETS file");
+  if (!a.value("out")) throw usageError("--out DIR is required");
+  const io::StreetReadOptions streets = streetOptions(a, a.positional()[0], "");
+  std::optional<io::ReadOptions> parcels;
+  if (const auto path = a.value("parcels")) {
+    parcels.emplace();
+    parcels->path = *path;
+    parcels->where = a.value("parcels-where").value_or("");
+  } else if (a.has("parcels-where")) {
+    throw usageError("--parcels-where needs --parcels");
+  }
+  return reportOutcome(pipeline::runBlocks(streets, a.parameters(), parcels ? &*parcels : nullptr, *a.value("out"),
+                                           terminalProgress(a.has("quiet"))),
+                       a);
+}
+
 int generateCommand(const std::vector<std::string>& args) {
   auto flags = inputFlags();
   flags.push_back(styleFlag());
   flags.push_back(
       {"from-parcels", "INPUT holds observed parcels: build blocks and per-block bounds as 'stats' does", false});
+  flags = joined(flags, streetFlags("streets-"));
   flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
   flags.push_back({"quiet", "no progress or summary on stderr", false});
-  const std::vector<ParameterDescription> params = generation::generationParameterDescriptions();
+  const std::vector<ParameterDescription> params =
+      joined(generation::generationParameterDescriptions(), pipeline::streetParameters());
   if (wantsHelp(args)) {
     std::fputs(usageText("parcelscope generate INPUT [--style obb|skeleton|offset|auto] [options] [--seed N] --out DIR",
                          flags, params)
@@ -159,14 +281,24 @@ int generateCommand(const std::vector<std::string>& args) {
     std::fputs(
         "\nINPUT holds block polygons (e.g. blocks.gpkg from 'parcelscope stats', whose a_min, a_max,\n"
         "w_min and w_max fields are used per block unless given here), or observed parcels with\n"
-        "--from-parcels. Writes DIR/parcels.gpkg, DIR/parcels.csv and DIR/run.json.\n",
+        "--from-parcels. With --streets STREETS, blocks are the street network's (as 'parcelscope\n"
+        "blocks' builds them); INPUT, optional, then holds observed parcels, assigned to the street\n"
+        "block they overlap most for per-block bounds. Writes DIR/parcels.gpkg, DIR/parcels.csv and\n"
+        "DIR/run.json.\n",
         stdout);
     return 0;
   }
   const Args a(args, flags, params);
   pipeline::GenerateRequest request;
-  request.input = readOptions(a);
-  request.fromParcels = a.has("from-parcels");
+  request.streets = streetsOf(a);
+  if (request.streets && a.positional().empty()) {
+    // Blocks from the streets alone: the run's values for every block.
+    if (!a.value("out")) throw usageError("--out DIR is required");
+    if (a.has("from-parcels")) throw usageError("--from-parcels needs an INPUT of observed parcels");
+  } else {
+    request.input = readOptions(a);
+    request.fromParcels = a.has("from-parcels") || request.streets.has_value();
+  }
   request.style = a.value("style").value_or("obb");
   request.parameters = a.parameters();
   request.explicitParameters = givenParameters(a, params);
@@ -187,9 +319,10 @@ int compareCommand(const std::vector<std::string>& args) {
                    "session file (saved by parcelscope-gui, or a compare run.json): input, style,\n"
                    "      parameters, per-block overrides (the only way to give those here) and seed;\n"
                    "      INPUT and options given here win"});
+  flags = joined(flags, streetFlags("streets-"));
   flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
   flags.push_back({"quiet", "no progress or summary on stderr", false});
-  const auto params = pipeline::compareParameters();
+  const auto params = joined(pipeline::compareParameters(), pipeline::streetParameters());
   if (wantsHelp(args)) {
     std::fputs(usageText("parcelscope compare INPUT|--session FILE [--style obb|skeleton|offset|auto] [--k 2] [--seed "
                          "N] [options] --out DIR",
@@ -228,6 +361,7 @@ int compareCommand(const std::vector<std::string>& args) {
     request.parameters = a.parameters();
     request.explicitParameters = givenParameters(a, params);
   }
+  if (auto streets = streetsOf(a)) request.streets = std::move(streets);
   if (auto v = a.value("style")) request.style = *v;
   if (auto v = a.value("metric")) request.metric = *v;
   if (auto v = a.value("vector")) request.vectorFormat = *v;

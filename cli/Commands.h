@@ -9,6 +9,7 @@ int dispatch(const std::vector<std::string>& args);
 
 int metricsCommand(const std::vector<std::string>& args);
 int statsCommand(const std::vector<std::string>& args);
+int blocksCommand(const std::vector<std::string>& args);
 int generateCommand(const std::vector<std::string>& args);
 int compareCommand(const std::vector<std::string>& args);
 int inspectCommand(const std::vector<std::string>& args);

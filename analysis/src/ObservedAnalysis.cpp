@@ -316,6 +316,7 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
 void rederiveBlockBounds(ObservedAnalysis& a, double k) {
   a.clampedAMin = a.clampedWMin = 0;
   for (std::size_t b = 0; b < a.blocks.size(); ++b) {
+    if (a.blocks[b].parcels.empty()) continue;  // a street block without parcels keeps the run's bounds
     std::vector<double> areas, widths;
     for (int i : a.blocks[b].parcels) {
       areas.push_back(a.metrics[i].area);

@@ -310,6 +310,9 @@ RoadGraph buildRoadGraph(const std::vector<StreetLine>& input, const RoadGraphOp
   }
   const SegmentTree regularTree = segmentTree(regularLines), apartTree = segmentTree(apartLines);
   auto better = [&](int a, int b) {  // is line a a better source than line b?
+    if (input[static_cast<std::size_t>(a)].boundary != input[static_cast<std::size_t>(b)].boundary) {
+      return !input[static_cast<std::size_t>(a)].boundary;  // a street over the boundary
+    }
     const double wa = input[static_cast<std::size_t>(a)].width, wb = input[static_cast<std::size_t>(b)].width;
     if (std::isnan(wa) != std::isnan(wb)) return !std::isnan(wa);
     if (!std::isnan(wa) && wa != wb) return wa > wb;
@@ -359,6 +362,8 @@ RoadGraph buildRoadGraph(const std::vector<StreetLine>& input, const RoadGraphOp
     e.width = s.width;
     e.name = s.name;
     e.noNode = s.noNode;
+    e.boundary = s.boundary;
+    if (e.boundary) e.width = 0;
     e.source = source;
     e.line = std::move(line);
     graph.edges.push_back(std::move(e));
@@ -426,7 +431,7 @@ std::int64_t fillStreetWidths(RoadGraph& graph, const std::vector<const Polygon*
   std::vector<char> measured(graph.edges.size(), 0);
   parallelFor(graph.edges.size(), [&](std::size_t k) {
     RoadEdge& e = graph.edges[k];
-    if (!std::isnan(e.width)) return;
+    if (!std::isnan(e.width) || e.boundary) return;
     const double len = length(e.line);
     std::vector<double> widths;
     const double from = 0.1 * len, to = 0.9 * len;
@@ -503,7 +508,7 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
         }
         std::vector<int> near;
         for (auto it = edgeTree.qbegin(bgi::intersects(boxOf(face.outer))); it != edgeTree.qend(); ++it) {
-          near.push_back(it->second);
+          if (!graph.edges[static_cast<std::size_t>(it->second)].boundary) near.push_back(it->second);
         }
         std::sort(near.begin(), near.end());
         std::vector<const Polygon*> cut;
@@ -511,7 +516,7 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
           for (const Polygon& p : surfaces[static_cast<std::size_t>(k)]) cut.push_back(&p);
         }
         for (Polygon& part : geos::difference(face, cut, kOverlayGrid)) {
-          if (area(part) < options.minArea) {
+          if (area(part) < options.minArea || 2 * area(part) < options.minWidth * perimeter(part)) {
             ++result.tooSmall;
             continue;
           }

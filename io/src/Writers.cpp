@@ -119,6 +119,50 @@ Json readJson(const std::string& path) {
   return fromCpl(doc.GetRoot());
 }
 
+namespace {
+
+void setFields(OGRFeature& feature, const std::vector<Value>& row) {
+  for (std::size_t c = 0; c < row.size(); ++c) {
+    const Value& v = row[c];
+    const int idx = static_cast<int>(c);
+    if (const auto* n = std::get_if<std::int64_t>(&v)) {
+      feature.SetField(idx, static_cast<GIntBig>(*n));
+    } else if (const auto* d = std::get_if<double>(&v)) {
+      if (std::isnan(*d)) {
+        feature.SetFieldNull(idx);
+      } else {
+        feature.SetField(idx, *d);
+      }
+    } else {
+      feature.SetField(idx, std::get<std::string>(v).c_str());
+    }
+  }
+}
+
+template <typename Fail>
+void createFields(OGRLayer& layer, const Table& attributes, const Fail& fail) {
+  for (const Column& c : attributes.columns) {
+    const OGRFieldType type = c.type == Column::Type::Integer ? OFTInteger64
+                              : c.type == Column::Type::Real  ? OFTReal
+                                                              : OFTString;
+    OGRFieldDefn field(c.name.c_str(), type);
+    if (layer.CreateField(&field) != OGRERR_NONE) throw fail("cannot create field " + c.name);
+  }
+}
+
+OGRSpatialReference outputSrs(const CrsInfo& crs) {
+  OGRSpatialReference srs;
+  if (!crs.wkt.empty()) {
+    srs.importFromWkt(crs.wkt.c_str());
+  } else {
+    srs.SetFromUserInput("OGC:CRS84");
+  }
+  srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  return srs;
+}
+
+}  // namespace
+
 LayerWrite writePolygonLayer(const std::string& path, const std::string& layerName,
                              const std::vector<std::vector<Polygon>>& geometries, const Table& attributes,
                              const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex) {
@@ -139,24 +183,12 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
   GDALDatasetUniquePtr ds(driver->Create(path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
   if (!ds) throw fail(std::string("cannot create ") + format + " file");
 
-  OGRSpatialReference srs;
-  if (!crs.wkt.empty()) {
-    srs.importFromWkt(crs.wkt.c_str());
-  } else {
-    srs.SetFromUserInput("OGC:CRS84");
-  }
-  srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  OGRSpatialReference srs = outputSrs(crs);
   CPLStringList layerOptions;
   if (!geojson && !spatialIndex) layerOptions.SetNameValue("SPATIAL_INDEX", "NO");
   OGRLayer* layer = ds->CreateLayer(layerName.c_str(), &srs, wkbMultiPolygon, layerOptions.List());
   if (!layer) throw fail("cannot create layer " + layerName);
-  for (const Column& c : attributes.columns) {
-    const OGRFieldType type = c.type == Column::Type::Integer ? OFTInteger64
-                              : c.type == Column::Type::Real  ? OFTReal
-                                                              : OFTString;
-    OGRFieldDefn field(c.name.c_str(), type);
-    if (layer->CreateField(&field) != OGRERR_NONE) throw fail("cannot create field " + c.name);
-  }
+  createFields(*layer, attributes, fail);
   if (!geojson && ds->StartTransaction() != OGRERR_NONE) throw fail("cannot start transaction");
   // Geometries are taken back to the source CRS, checked and repaired there,
   // and converted in batches on a second thread while this one inserts the
@@ -193,17 +225,7 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
     for (std::size_t k = 0; k < batch.size(); ++k) {
       const std::size_t i = from + k;
       OGRFeature feature(layer->GetLayerDefn());
-      for (std::size_t c = 0; c < attributes.columns.size(); ++c) {
-        const Value& v = attributes.rows[i][c];
-        const int idx = static_cast<int>(c);
-        if (const auto* n = std::get_if<std::int64_t>(&v)) {
-          feature.SetField(idx, static_cast<GIntBig>(*n));
-        } else if (const auto* d = std::get_if<double>(&v)) {
-          feature.SetField(idx, *d);
-        } else {
-          feature.SetField(idx, std::get<std::string>(v).c_str());
-        }
-      }
+      setFields(feature, attributes.rows[i]);
       feature.SetGeometryDirectly(batch[k].release());
       if (layer->CreateFeature(&feature) != OGRERR_NONE) {
         throw fail("cannot write feature " + std::to_string(i));
@@ -214,6 +236,50 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
   ds.reset();  // flush and close before the caller renames the file
   if (CPLGetLastErrorType() == CE_Failure) throw fail("closing failed");
   return report;
+}
+
+void writeNetworkLayers(const std::string& path, const std::vector<Point>& nodes, const Table& nodeAttributes,
+                        const std::vector<std::vector<Point>>& edges, const Table& edgeAttributes,
+                        const LocalFrame& frame, const CrsInfo& crs) {
+  detail::ensureGdalRegistered();
+  detail::QuietErrors quiet;
+  CPLErrorReset();
+  auto fail = [&](const std::string& what) {
+    return ioError(path + ": " + what + " (" + std::string(CPLGetLastErrorMsg()) + ")");
+  };
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GPKG");
+  if (!driver) throw ioError(path + ": GDAL has no GPKG driver");
+  GDALDatasetUniquePtr ds(driver->Create(path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+  if (!ds) throw fail("cannot create GPKG file");
+  OGRSpatialReference srs = outputSrs(crs);
+  auto write = [&](const char* name, OGRwkbGeometryType type, const Table& attributes, std::size_t count,
+                   const auto& geometry) {
+    OGRLayer* layer = ds->CreateLayer(name, &srs, type, nullptr);
+    if (!layer) throw fail(std::string("cannot create layer ") + name);
+    createFields(*layer, attributes, fail);
+    if (ds->StartTransaction() != OGRERR_NONE) throw fail("cannot start transaction");
+    for (std::size_t i = 0; i < count; ++i) {
+      OGRFeature feature(layer->GetLayerDefn());
+      setFields(feature, attributes.rows[i]);
+      feature.SetGeometryDirectly(geometry(i));
+      if (layer->CreateFeature(&feature) != OGRERR_NONE) throw fail("cannot write feature " + std::to_string(i));
+    }
+    if (ds->CommitTransaction() != OGRERR_NONE) throw fail("cannot commit");
+  };
+  write("nodes", wkbPoint, nodeAttributes, nodes.size(), [&](std::size_t i) {
+    const Point p = frame.toSource(nodes[i]);
+    return new OGRPoint(p.x, p.y);
+  });
+  write("edges", wkbLineString, edgeAttributes, edges.size(), [&](std::size_t i) {
+    auto* line = new OGRLineString;
+    for (const Point& q : edges[i]) {
+      const Point p = frame.toSource(q);
+      line->addPoint(p.x, p.y);
+    }
+    return line;
+  });
+  ds.reset();
+  if (CPLGetLastErrorType() == CE_Failure) throw fail("closing failed");
 }
 
 std::string gdalVersion() { return GDALVersionInfo("RELEASE_NAME"); }

@@ -1,5 +1,7 @@
 #include "parcelscope/pipeline/BlockSource.h"
 
+#include "parcelscope/pipeline/StreetsJob.h"
+
 #include <cmath>
 #include <utility>
 
@@ -26,6 +28,13 @@ public:
         in.entries.push_back({block.id, block.parts[part], s.aMin, s.aMax, s.wMin, s.wMax, s.streetAccessShare,
                               block.key, static_cast<int>(part)});
       }
+    }
+    if (observed.streets) {
+      // Street blocks know the width of each street they face.
+      for (const analysis::StreetBlock& b : observed.streets->blocks.blocks) {
+        in.widths.push_back(analysis::facedWidths(observed.streets->graph, b));
+      }
+      in.streets = observed.streets;
     }
     if (observed_) {
       in.source = std::make_shared<const io::ParcelLayer>(observed_->layer);
@@ -79,7 +88,58 @@ std::unique_ptr<BlockSource> observedParcelBlocks(const io::ReadOptions& input, 
 
 std::unique_ptr<BlockSource> blockLayer(const io::ReadOptions& input) { return std::make_unique<BlockLayer>(input); }
 
+namespace {
+
+// Blocks of a street network. With observed parcels, those are read and
+// assigned to the street blocks (observed-parcel blocks regrouped); without,
+// every block has no bounds of its own.
+class StreetNetworkBlocks : public BlockSource {
+public:
+  StreetNetworkBlocks(io::StreetReadOptions streets, io::ReadOptions parcels, bool withParcels,
+                      ParameterValues parameters)
+      : streets_(std::move(streets)),
+        parcels_(std::move(parcels)),
+        withParcels_(withParcels),
+        parameters_(std::move(parameters)) {}
+
+  std::string kind() const override { return withParcels_ ? "street-network-with-parcels" : "street-network"; }
+
+  BlockInputs blocks(const ProgressFn& progress) const override {
+    if (withParcels_) {
+      const ObservedData observed = loadObservedInStreetBlocks(parcels_, &streets_, parameters_, progress);
+      return ObservedParcelBlocks(parcels_, parameters_, &observed).blocks({});
+    }
+    auto network = std::make_shared<StreetNetwork>(buildStreetNetwork(streets_, parameters_, nullptr, progress));
+    BlockInputs in;
+    for (std::size_t b = 0; b < network->blocks.blocks.size(); ++b) {
+      const analysis::StreetBlock& block = network->blocks.blocks[b];
+      in.entries.push_back({static_cast<std::int64_t>(b), block.shape, NAN, NAN, NAN, NAN, NAN, block.key, 0});
+      in.widths.push_back(analysis::facedWidths(network->graph, block));
+    }
+    auto layer = std::make_shared<io::ParcelLayer>();
+    layer->path = network->layer.path;
+    layer->layerName = network->layer.layerName;
+    layer->frame = network->layer.frame;
+    layer->crs = network->layer.crs;
+    in.source = std::move(layer);
+    in.streets = std::move(network);
+    return in;
+  }
+
+private:
+  io::StreetReadOptions streets_;
+  io::ReadOptions parcels_;
+  bool withParcels_;
+  ParameterValues parameters_;
+};
+
+}  // namespace
+
 std::unique_ptr<BlockSource> blockSourceOf(const GenerateRequest& request) {
+  if (request.streets && !(request.fromParcels && request.observed)) {
+    return std::make_unique<StreetNetworkBlocks>(*request.streets, request.input, request.fromParcels,
+                                                 request.parameters);
+  }
   if (request.fromParcels) return observedParcelBlocks(request.input, request.parameters, request.observed);
   return blockLayer(request.input);
 }

@@ -1,5 +1,7 @@
 #include "parcelscope/pipeline/CompareJob.h"
 
+#include "parcelscope/pipeline/StreetsJob.h"
+
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -60,6 +62,9 @@ double compareValue(const CompareRequest& request, const std::string& name) {
   for (const auto& d : compareParameters()) {
     if (d.name == name) return d.defaultValue;
   }
+  for (const auto& d : streetParameters()) {
+    if (d.name == name) return d.defaultValue;
+  }
   throw std::logic_error("compare: no parameter named " + name);
 }
 
@@ -109,6 +114,10 @@ void requireBlocks(const CompareRequest& request, const pipeline::ObservedData& 
 
 void checkRequest(const CompareRequest& request) {
   for (const auto& d : compareParameters()) {
+    const auto it = request.parameters.find(d.name);
+    if (it != request.parameters.end()) checkValue(d, it->second);
+  }
+  for (const auto& d : streetParameters()) {
     const auto it = request.parameters.find(d.name);
     if (it != request.parameters.end()) checkValue(d, it->second);
   }
@@ -229,7 +238,8 @@ CompareResult compare(const CompareRequest& request, const ProgressFn& progress)
   detail::checkRequest(request);
   CompareResult r;
   r.observed = std::make_shared<const pipeline::ObservedData>(
-      pipeline::loadObserved(request.input, request.parameters, scaledProgress(progress, 0.0, 0.45)));
+      pipeline::loadObservedInStreetBlocks(request.input, request.streets ? &*request.streets : nullptr,
+                                           request.parameters, scaledProgress(progress, 0.0, 0.45)));
   const analysis::ObservedAnalysis& a = r.observed->analysis;
   detail::requireBlocks(request, *r.observed);
   r.generated =
@@ -418,6 +428,10 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
                  .set("parameters_given", given)
                  .set("session", sessionJson(request));
   addObservedRecord(run, *r.observed);
+  if (r.observed->streets) {
+    run.set("streets",
+            streetRecord(*r.observed->streets).set("lots_outside_street_blocks", r.observed->outsideStreetBlocks));
+  }
   std::error_code ec;
   const bool regular = std::filesystem::is_regular_file(request.input.path, ec);
   run.set(

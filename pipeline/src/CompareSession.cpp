@@ -1,5 +1,7 @@
 #include "parcelscope/pipeline/CompareSession.h"
 
+#include "parcelscope/pipeline/StreetsJob.h"
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -30,10 +32,24 @@ bool sameInput(const io::ReadOptions& a, const io::ReadOptions& b) {
          a.keyField == b.keyField;
 }
 
-// Analysis parameters that shape the blocks (all but k, which only moves the bounds).
+bool sameStreets(const std::optional<io::StreetReadOptions>& a, const std::optional<io::StreetReadOptions>& b) {
+  if (!a || !b) return !a && !b;
+  return a->path == b->path && a->layer == b->layer && a->where == b->where && a->crsOverride == b->crsOverride &&
+         a->widthField == b->widthField && a->classField == b->classField && a->classWidths == b->classWidths &&
+         a->nameField == b->nameField && a->noNodeWhere == b->noNodeWhere;
+}
+
+// Analysis and street parameters that shape the blocks (all but k, which only
+// moves the bounds), and the streets.
 bool sameBlocks(const CompareRequest& a, const CompareRequest& b) {
   for (const auto& d : analysis::analysisParameters()) {
     if (d.name != "k" && compareValue(a, d.name) != compareValue(b, d.name)) return false;
+  }
+  if (!sameStreets(a.streets, b.streets)) return false;
+  if (a.streets) {
+    for (const auto& d : pipeline::streetParameters()) {
+      if (compareValue(a, d.name) != compareValue(b, d.name)) return false;
+    }
   }
   return true;
 }
@@ -138,7 +154,8 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
   double readSeconds = 0, blockSeconds = 0;
   if (reload) {
     auto loaded = std::make_shared<pipeline::ObservedData>(
-        pipeline::loadObserved(request.input, request.parameters, scaledProgress(progress, 0.0, 0.5)));
+        pipeline::loadObservedInStreetBlocks(request.input, request.streets ? &*request.streets : nullptr,
+                                             request.parameters, scaledProgress(progress, 0.0, 0.5)));
     detail::requireBlocks(request, *loaded);
     for (const auto& stage : loaded->layer.timings.stages()) readSeconds += stage.second;
     for (const auto& stage : loaded->analysis.timings.stages()) blockSeconds += stage.second;

@@ -1,5 +1,7 @@
 #include "parcelscope/pipeline/GenerateJob.h"
 
+#include "parcelscope/pipeline/StreetsJob.h"
+
 #include "parcelscope/pipeline/BlockSource.h"
 
 #include <algorithm>
@@ -259,6 +261,7 @@ GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<Bl
   }
   GeneratedParcels out;
   out.source = inputs.source;
+  out.streets = inputs.streets;
   out.seed = seed;
   const std::size_t n = inputs.entries.size();
   std::vector<std::size_t> first(n + 1, 0);  // index of each entry's first parcel
@@ -412,6 +415,7 @@ JobOutcome writeGenerate(io::OutputDirectory& out, const GenerateRequest& reques
     if (n > 0) styleCounts.set(name, static_cast<std::int64_t>(n));
   }
   run.set("blocks_by_style", styleCounts);
+  if (g.streets) run.set("streets", streetRecord(*g.streets));
   run.set("failures", failures);
   run.set("written", writtenLayersJson({{"parcels.gpkg", written}}));
   run.set("outputs", Json::array().push("parcels.gpkg").push("parcels.csv").push("run.json"));

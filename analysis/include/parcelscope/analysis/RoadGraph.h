@@ -30,6 +30,10 @@ struct StreetLine {
   std::string name;
   bool noNode = false;  ///< a bridge or tunnel: meets other lines only at its ends
   Key key = 0;          ///< the feature's key (hash of its geometry)
+  /// Not a street: the edge of the study area (where the data ends, a city
+  /// limit), which closes the faces at the edge of the network. It has no
+  /// width and no block faces it as a street.
+  bool boundary = false;
 };
 
 struct RoadGraphOptions {
@@ -51,7 +55,8 @@ struct RoadEdge {
   double width = NAN;
   std::string name;
   bool noNode = false;
-  int source = -1;  ///< index of the StreetLine it comes from
+  bool boundary = false;  ///< the study area's edge, not a street (see StreetLine::boundary)
+  int source = -1;        ///< index of the StreetLine it comes from
 };
 
 struct RoadGraphReport {
@@ -91,16 +96,20 @@ struct StreetBlock {
   Polygon shape;
   /// For ring r (0 the outer ring, then the holes) and its edge from vertex i
   /// to i+1: the index of the graph edge it faces (the nearest centre line),
-  /// or -1 when no centre line lies within its half width plus 1 m.
+  /// or -1 when no centre line lies within its half width plus 1 m (the edge
+  /// lies along the study area's boundary, say).
   std::vector<std::vector<int>> faced;
 };
 
 struct StreetBlockOptions {
   /// Faces larger than this (m²) are not blocks (the land around a network
-  /// that encloses it, open country); smaller than `minArea` left after the
-  /// streets are removed are dropped too.
+  /// that encloses it, open country); pieces smaller than `minArea` or
+  /// narrower than `minWidth` (twice the area over the perimeter) left after
+  /// the streets are removed are dropped too (slivers between a street and
+  /// the boundary).
   double maxArea = 2e6;
   double minArea = 1.0;
+  double minWidth = 1.0;
   /// Segments per quarter circle of the street surface's round ends and joins.
   int quadrantSegments = 4;
 };
@@ -109,7 +118,7 @@ struct StreetBlocks {
   std::vector<StreetBlock> blocks;  ///< sorted by key
   std::int64_t faces = 0;           ///< faces of the graph
   std::int64_t facesTooLarge = 0;   ///< faces above maxArea (dropped)
-  std::int64_t partsTooSmall = 0;   ///< pieces under minArea (dropped), faces filled by streets included
+  std::int64_t partsTooSmall = 0;   ///< pieces under minArea or minWidth (dropped)
 };
 
 /// The blocks of `graph` (every edge width must be known: see

@@ -51,6 +51,14 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
                              const std::vector<std::vector<Polygon>>& geometries, const Table& attributes,
                              const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex = true);
 
+/// Writes a GeoPackage with a point layer `nodes` (one point per row of
+/// `nodeAttributes`) and a line layer `edges` (one line string per row of
+/// `edgeAttributes`), mapped back from local metres with `frame` and tagged
+/// with `crs`. A NaN real is written as NULL. Throws Error(IO) on failure.
+void writeNetworkLayers(const std::string& path, const std::vector<Point>& nodes, const Table& nodeAttributes,
+                        const std::vector<std::vector<Point>>& edges, const Table& edgeAttributes,
+                        const LocalFrame& frame, const CrsInfo& crs);
+
 /// The GDAL version string, for run records.
 std::string gdalVersion();
 

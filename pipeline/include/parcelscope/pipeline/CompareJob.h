@@ -6,6 +6,7 @@
 // figures out. The command line and the GUI both call this.
 #include <functional>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <utility>
@@ -14,13 +15,19 @@
 #include "parcelscope/analysis/Comparison.h"
 #include "parcelscope/core/Parameter.h"
 #include "parcelscope/io/ParcelReader.h"
+#include "parcelscope/io/StreetReader.h"
 #include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/pipeline/StatsJob.h"
 
 namespace parcelscope::pipeline {
 
 struct CompareRequest {
-  io::ReadOptions input;      ///< observed parcels
+  io::ReadOptions input;  ///< observed parcels
+  /// Street centre lines: blocks come from the street network and the observed
+  /// parcels are assigned to them (see StreetsJob.h); the street parameters
+  /// (streetParameters()) are read from `parameters`. None: blocks grouped from
+  /// the parcels.
+  std::optional<io::StreetReadOptions> streets;
   std::string style = "obb";  ///< generator style, passed to pipeline::GenerateRequest::style
   /// Values named as in compareParameters() (analysis, generator and comparison).
   ParameterValues parameters;

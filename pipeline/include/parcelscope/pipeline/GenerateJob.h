@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "parcelscope/generation/SkeletonSubdivision.h"
 #include "parcelscope/generation/Styles.h"
 #include "parcelscope/io/ParcelReader.h"
+#include "parcelscope/io/StreetReader.h"
 #include "parcelscope/pipeline/StatsJob.h"
 
 namespace parcelscope::pipeline {
@@ -61,11 +63,18 @@ struct GenerateRequest {
   /// Error(Usage). A block named both ways takes the override by key.
   BlockOverrides overrides;
   BlockOverridesById overridesById;
+  /// Street centre lines: the blocks are the street network's (StreetsJob.h),
+  /// with the street parameters read from `parameters`. With fromParcels, the
+  /// observed parcels of `input` are assigned to them for per-block bounds;
+  /// without, `input.path` may be empty and every block takes the run's values.
+  std::optional<io::StreetReadOptions> streets;
 };
 
 struct GeneratedParcels {
   /// The input as read (frame, CRS, cleaning report), shared with the BlockInputs it came from.
   std::shared_ptr<const io::ParcelLayer> source;
+  /// The street network the blocks come from (--streets); null otherwise.
+  std::shared_ptr<const StreetNetwork> streets;
   std::vector<Block> blocks;           ///< block outlines; `parcels` index `parcels` below
   std::vector<std::int64_t> blockIds;  ///< id of each entry of `blocks` (ids repeat for multipart blocks)
   std::vector<Key> blockKeys;          ///< stable key of each entry of `blocks` (repeats as ids do)
@@ -101,6 +110,8 @@ struct BlockInputs {
     int part = 0;  ///< which part of a multipart block
   };
   std::shared_ptr<const io::ParcelLayer> source;  ///< the input as read (frame, CRS, cleaning report)
+  /// The street network the blocks come from (--streets); null otherwise.
+  std::shared_ptr<const StreetNetwork> streets;
   std::vector<Entry> entries;
   /// Street widths per entry (see StreetWidths), measured on first need by streetWidthsOf().
   std::vector<StreetWidths> widths;

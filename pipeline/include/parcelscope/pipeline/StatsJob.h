@@ -1,6 +1,7 @@
 #pragma once
 // The `stats` job: read observed parcels, analyse them, write the tables, the
 // block layer and the run record. The command line and the GUI both call this.
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -12,9 +13,16 @@
 
 namespace parcelscope::pipeline {
 
+struct StreetNetwork;
+
 struct ObservedData {
   io::ParcelLayer layer;
   analysis::ObservedAnalysis analysis;
+  /// With --streets: the street network whose blocks `analysis.blocks` are
+  /// (block b is the network's block b; see assignToStreetBlocks), and the
+  /// lots that lie in none of them. Null: blocks grouped from the parcels.
+  std::shared_ptr<const StreetNetwork> streets;
+  std::int64_t outsideStreetBlocks = 0;
 };
 
 /// Reads `input` and analyses it with `parameters` (names of analysisParameters()).

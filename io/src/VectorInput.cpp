@@ -1,0 +1,160 @@
+#include "VectorInput.h"
+
+#include <cpl_error.h>
+#include <ogr_spatialref.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include "OgrConvert.h"
+#include "parcelscope/core/Error.h"
+
+namespace parcelscope::io::detail {
+
+// GDAL's last message on one line (some span several, with a caret marker);
+// empty when GDAL left none.
+std::string gdalMessage() {
+  std::string m, raw = CPLGetLastErrorMsg();
+  for (char c : raw) {
+    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+    if (c == ' ' && (m.empty() || m.back() == ' ')) continue;
+    m += c;
+  }
+  while (!m.empty() && m.back() == ' ') m.pop_back();
+  return m;
+}
+
+std::string lastGdalMessage() {
+  const std::string m = gdalMessage();
+  return m.empty() ? "unknown GDAL error" : m;
+}
+
+// What a path that is neither a regular file nor a folder is, for messages.
+static std::string describeFileType(std::filesystem::file_type type) {
+  using std::filesystem::file_type;
+  switch (type) {
+    case file_type::fifo:
+      return "a named pipe (FIFO)";
+    case file_type::character:
+      return "a character device";
+    case file_type::block:
+      return "a block device";
+    case file_type::socket:
+      return "a socket";
+    default:
+      return "not a regular file";
+  }
+}
+
+// Opens `path` as a vector dataset. The path is looked at first (stat), so that
+// what GDAL cannot read is named (an empty file, a folder, a device) and a named
+// pipe without a writer is refused instead of blocking GDAL's open.
+GDALDatasetUniquePtr openVector(const std::string& path) {
+  namespace fs = std::filesystem;
+  detail::ensureGdalRegistered();
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (status.type() == fs::file_type::not_found) throw inputError(path + ": no such file");
+  if (ec) throw inputError(path + ": cannot be read (" + ec.message() + ")");
+  const bool folder = status.type() == fs::file_type::directory;
+  if (!folder && status.type() != fs::file_type::regular) {
+    throw inputError(path + ": is " + describeFileType(status.type()) +
+                     ", not a regular file or folder, so it is not read");
+  }
+  if (!folder && fs::file_size(path, ec) == 0 && !ec) throw inputError(path + ": is empty (0 bytes)");
+  QuietErrors quiet;
+  CPLErrorReset();
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
+  if (!ds) {
+    const std::string why = gdalMessage();
+    if (folder) {
+      throw inputError(path + ": is a folder, not a file, and GDAL reads no vector dataset from it" +
+                       (why.empty() ? "" : " (" + why + ")"));
+    }
+    throw inputError(path + ": is not a file format GDAL reads (not a vector format GDAL can read" +
+                     (why.empty() ? "; no driver recognises its contents" : ": " + why) + ")");
+  }
+  if (ds->GetLayerCount() == 0) throw inputError(path + ": holds no vector layer");
+  return ds;
+}
+
+// Whether every coordinate stored in `g` (x, y, and z and m where present) is
+// finite. OGR envelopes do not tell: their min and max pass over NaN.
+bool coordinatesFinite(const OGRGeometry& g) {
+  struct Visitor : OGRDefaultConstGeometryVisitor {
+    bool finite = true;
+    using OGRDefaultConstGeometryVisitor::visit;
+    // A point whose x and y are NaN counts as an empty point, so vertices are
+    // read from their curves, and only a standalone point may be empty.
+    void visit(const OGRPoint* p) override {
+      if (!finite || p->IsEmpty()) return;
+      finite = std::isfinite(p->getX()) && std::isfinite(p->getY()) && (!p->Is3D() || std::isfinite(p->getZ())) &&
+               (!p->IsMeasured() || std::isfinite(p->getM()));
+    }
+    void vertices(const OGRSimpleCurve& c) {
+      for (int i = 0, n = c.getNumPoints(); i < n && finite; ++i) {
+        finite = std::isfinite(c.getX(i)) && std::isfinite(c.getY(i)) && (!c.Is3D() || std::isfinite(c.getZ(i))) &&
+                 (!c.IsMeasured() || std::isfinite(c.getM(i)));
+      }
+    }
+    void visit(const OGRLineString* c) override { vertices(*c); }
+    void visit(const OGRLinearRing* c) override { vertices(*c); }
+    void visit(const OGRCircularString* c) override { vertices(*c); }
+  } visitor;
+  g.accept(&visitor);
+  return visitor.finite;
+}
+
+static std::string fmt(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+// Chooses the local frame and records the CRS, or throws when the CRS cannot be used.
+LocalFrame chooseFrame(const std::string& path, const OGRSpatialReference* srs, Envelope& env, CrsInfo& crs) {
+  const Point c = env.centre();
+  const double cx = c.x, cy = c.y;
+  const std::string hint = "; give the real CRS with --crs EPSG:N";
+  if (!srs) {
+    if (!env.looksLikeDegrees()) {
+      throw inputError(path + ": the layer declares no CRS and its coordinates (x " + fmt(env.minX) + " to " +
+                       fmt(env.maxX) + ", y " + fmt(env.minY) + " to " + fmt(env.maxY) + ") are not degrees" + hint);
+    }
+    crs.assumedLonLat = true;
+    crs.name = "assumed OGC:CRS84 (no CRS declared)";
+    return LocalFrame::geographic(cx, cy);
+  }
+  const char* name = srs->GetName();
+  crs.name = name ? name : "unnamed CRS";
+  if (const char* code = srs->GetAuthorityCode(nullptr)) {
+    const char* auth = srs->GetAuthorityName(nullptr);
+    crs.name += std::string(" (") + (auth ? auth : "") + ":" + code + ")";
+  }
+  if (srs->IsGeographic()) {
+    const double degreesPerUnit = srs->GetAngularUnits() * 180.0 / M_PI;  // 0.9 for grads
+    if (!(degreesPerUnit > 0)) throw inputError(path + ": CRS " + crs.name + " has no usable angular unit");
+    if (!env.looksLikeDegrees(degreesPerUnit)) {
+      throw inputError(path + ": the layer claims lon/lat (" + crs.name + ") but its coordinates (x " + fmt(env.minX) +
+                       " to " + fmt(env.maxX) + ", y " + fmt(env.minY) + " to " + fmt(env.maxY) +
+                       ") cannot be degrees" + hint);
+    }
+    OGRErr err = OGRERR_NONE;
+    const double a = srs->GetSemiMajor(&err);
+    const double invf = srs->GetInvFlattening(&err);
+    return LocalFrame::geographic(cx * degreesPerUnit, cy * degreesPerUnit, a, invf > 0 ? 1.0 / invf : 0.0,
+                                  degreesPerUnit);
+  }
+  if (srs->IsProjected()) {
+    const double unit = srs->GetLinearUnits();
+    if (!(unit > 0)) throw inputError(path + ": CRS " + crs.name + " has no usable linear unit");
+    return LocalFrame::projected(unit, cx, cy);
+  }
+  throw inputError(path + ": CRS " + crs.name + " is neither geographic nor projected, so parcels cannot be measured" +
+                   hint);
+}
+
+}  // namespace parcelscope::io::detail
