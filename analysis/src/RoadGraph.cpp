@@ -69,9 +69,10 @@ double distance(const Point& a, const Point& b) { return std::hypot(a.x - b.x, a
 double distanceToLine(const Point& p, const Polyline& line) {
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i + 1 < line.size(); ++i) {
-    best = std::min(best, distance(p, nearestOnSegment(p, line[i], line[i + 1])));
+    const Point q = nearestOnSegment(p, line[i], line[i + 1]);
+    best = std::min(best, (p.x - q.x) * (p.x - q.x) + (p.y - q.y) * (p.y - q.y));
   }
-  return best;
+  return std::sqrt(best);
 }
 
 double length(const Polyline& line) {
@@ -473,9 +474,14 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
     if (!(e.width >= 0)) throw usageError("street blocks: an edge has no width (fill the widths first)");
   }
   StreetBlocks out;
+  // The graph's edges are noded already, but for lines kept apart (bridges).
   std::vector<Polyline> all;
-  for (const RoadEdge& e : graph.edges) all.push_back(e.line);
-  const geos::LineFaces faces = geos::polygonizeLines(geos::nodeLines(all, kGrid));
+  bool apart = false;
+  for (const RoadEdge& e : graph.edges) {
+    all.push_back(e.line);
+    apart |= e.noNode;
+  }
+  const geos::LineFaces faces = geos::polygonizeLines(apart ? geos::nodeLines(all, kGrid) : all);
   out.faces = static_cast<std::int64_t>(faces.faces.size());
   reportProgress(progress, 0.2, "faces");
 
@@ -506,11 +512,20 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
           result.tooLarge = true;
           return;
         }
-        std::vector<int> near;
+        std::vector<int> boxed;
         for (auto it = edgeTree.qbegin(bgi::intersects(boxOf(face.outer))); it != edgeTree.qend(); ++it) {
-          if (!graph.edges[static_cast<std::size_t>(it->second)].boundary) near.push_back(it->second);
+          if (!graph.edges[static_cast<std::size_t>(it->second)].boundary) boxed.push_back(it->second);
         }
-        std::sort(near.begin(), near.end());
+        std::sort(boxed.begin(), boxed.end());
+        // Of the edges whose boxes meet the face's, those whose surface reaches it.
+        std::vector<const Polyline*> lines;
+        std::vector<double> reach;
+        for (int k : boxed) {
+          lines.push_back(&graph.edges[static_cast<std::size_t>(k)].line);
+          reach.push_back(0.5 * graph.edges[static_cast<std::size_t>(k)].width);
+        }
+        std::vector<int> near;
+        for (int i : geos::linesNear(face, lines, reach)) near.push_back(boxed[static_cast<std::size_t>(i)]);
         std::vector<const Polygon*> cut;
         for (int k : near) {
           for (const Polygon& p : surfaces[static_cast<std::size_t>(k)]) cut.push_back(&p);

@@ -254,6 +254,8 @@ CompareResult compare(const CompareRequest& request, const ProgressFn& progress)
                {"blocks", secondsIn(a.timings)},
                {"generate", secondsIn(r.generated.timings) - measure},
                {"metrics", measure + secondsSince(compareStart)}};
+  if (r.observed->streets)
+    r.seconds.insert(r.seconds.begin() + 2, {"streets", secondsIn(r.observed->streets->timings)});
   reportProgress(progress, 1.0, "comparing");
   return r;
 }

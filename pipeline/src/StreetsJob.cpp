@@ -135,9 +135,22 @@ std::int64_t assignToStreetBlocks(ObservedData& observed, std::shared_ptr<const 
         ++hits;
       }
     }
-    if (hits == 1 && candidates.size() == 1) {
-      to[p] = containing;
-      return;
+    // A parcel none of whose vertices lies in another block than the one
+    // holding its interior point overlaps that one most (it may reach into
+    // the street, not across it), but for a corner of another block cut by
+    // one of its edges.
+    if (hits == 1) {
+      bool elsewhere = false;
+      for (int b : candidates) {
+        if (b == containing) continue;
+        for (std::size_t i = 0; i < shape.outer.size() && !elsewhere; ++i) {
+          elsewhere = pointInPolygon(shape.outer[i], blocks[static_cast<std::size_t>(b)].shape);
+        }
+      }
+      if (!elsewhere) {
+        to[p] = containing;
+        return;
+      }
     }
     double best = 0;
     for (int b : candidates) {
@@ -199,7 +212,10 @@ ObservedData loadObservedInStreetBlocks(const io::ReadOptions& input, const io::
   auto network = std::make_shared<StreetNetwork>(
       buildStreetNetwork(*streets, parameters, &data, scaledProgress(progress, 0.6, 0.95)));
   const auto it = parameters.find("k");
-  data.outsideStreetBlocks = assignToStreetBlocks(data, std::move(network), it == parameters.end() ? 2.0 : it->second);
+  StreetNetwork* timed = network.get();
+  timed->timings.start("assign parcels");
+  data.outsideStreetBlocks = assignToStreetBlocks(data, network, it == parameters.end() ? 2.0 : it->second);
+  timed->timings.stop();
   reportProgress(progress, 1.0, "street blocks");
   return data;
 }

@@ -155,8 +155,11 @@ TEST(RoadGraph, DeadEndCutsASlotIntoItsBlock) {
   const Built b = build(lines);
   EXPECT_EQ(b.graph.report.deadEnds, 8 + 1);
   ASSERT_EQ(b.blocks.blocks.size(), 1u);
-  const double slot = 8 * (60 - 5) + M_PI * 16 / 2;                  // the stem beyond the street, and its round end
-  EXPECT_NEAR(area(b.blocks.blocks[0].shape), 90 * 90 - slot, 1.0);  // the round end is a polygon
+  // The stem beyond the street, and its round end: half a circle drawn with
+  // kStreetQuadrantSegments segments a quarter, inscribed in radius 4.
+  const int n = 2 * kStreetQuadrantSegments;
+  const double slot = 8 * (60 - 5) + n * 0.5 * 16 * std::sin(M_PI / n);
+  EXPECT_NEAR(area(b.blocks.blocks[0].shape), 90 * 90 - slot, 1e-6);
   expectCoverage(b, "dead end");
   expectOrderFree(lines, "dead end");
 }

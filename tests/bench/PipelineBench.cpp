@@ -26,6 +26,7 @@
 #include "parcelscope/pipeline/CompareSession.h"
 #include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/pipeline/StatsJob.h"
+#include "parcelscope/pipeline/StreetsJob.h"
 #include "parcelscope/viz/CompareFigures.h"
 #include "parcelscope/viz/Scenes.h"
 
@@ -139,6 +140,31 @@ void PlanBlocks(benchmark::State& state) {
   state.counters["blocks"] = static_cast<double>(plans);
 }
 BENCHMARK(PlanBlocks)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+
+// The road graph and street blocks of cambridge_ma's 2,614 centre lines (lines
+// read once, outside the loop; widths the default). Target: at most 0.5 s.
+void StreetGraphAndBlocks(benchmark::State& state) {
+  const std::string path = std::string(PARCELSCOPE_SHARED_DATASETS) + "/cambridge_ma/TRANS_Centerlines.geojson";
+  if (!std::filesystem::exists(path)) {
+    state.SkipWithError(("shared dataset not found: " + path).c_str());
+    return;
+  }
+  parcelscope::io::StreetReadOptions options;
+  options.path = path;
+  const auto layer = parcelscope::io::readStreets(options);
+  std::vector<parcelscope::analysis::StreetLine> lines;
+  for (const auto& f : layer.streets) lines.push_back({f.line, f.width, f.name, f.noNode, f.key});
+  std::size_t blocks = 0, edges = 0;
+  for (auto _ : state) {
+    auto graph = parcelscope::analysis::buildRoadGraph(lines);
+    parcelscope::analysis::fillStreetWidths(graph, {}, 12.0);
+    blocks = parcelscope::analysis::streetBlocks(graph).blocks.size();
+    edges = graph.edges.size();
+  }
+  state.counters["edges"] = static_cast<double>(edges);
+  state.counters["blocks"] = static_cast<double>(blocks);
+}
+BENCHMARK(StreetGraphAndBlocks)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
 // Runs `compare` into `out` and adds the seconds of each stage (summary.json)
 // to `seconds`; returns the summary.

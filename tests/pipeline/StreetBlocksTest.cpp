@@ -81,16 +81,22 @@ TEST(StreetBlocks, CambridgeStreetBlocksMatchTheParcelBlocks) {
     for (std::size_t k = 0; k < iou.size(); ++k) {
       if (iou[k] >= 0.8) continue;
       const Polygon& p = parcelBlocks[k];
-      double covered = 0; int pieces = 0; double bestArea = 0, bestI = 0;
+      double covered = 0;
+      int pieces = 0;
+      double bestArea = 0, bestI = 0;
       for (const Polygon* s : street) {
         const double i = geos::intersectionArea(p, *s);
         if (i > 0.05 * area(p)) ++pieces;
         covered += i;
-        if (i > bestI) { bestI = i; bestArea = area(*s); }
+        if (i > bestI) {
+          bestI = i;
+          bestArea = area(*s);
+        }
       }
       const Point c = centroid(p);
       const Point g = observed.layer.frame.toSource(c);
-      std::printf("DIAG iou %.3f area %.0f covered %.3f pieces %d best street area %.0f at %.6f,%.6f\n", iou[k], area(p), covered / area(p), pieces, bestArea, g.x, g.y);
+      std::printf("DIAG iou %.3f area %.0f covered %.3f pieces %d best street area %.0f at %.6f,%.6f\n", iou[k],
+                  area(p), covered / area(p), pieces, bestArea, g.x, g.y);
     }
   }
   const auto matched = std::count_if(iou.begin(), iou.end(), [](double v) { return v >= 0.8; });

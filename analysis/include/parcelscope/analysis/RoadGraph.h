@@ -90,6 +90,11 @@ RoadGraph buildRoadGraph(const std::vector<StreetLine>& lines, const RoadGraphOp
 std::int64_t fillStreetWidths(RoadGraph& graph, const std::vector<const Polygon*>& parcelBlocks, double defaultWidth,
                               double maxWidth = 60.0);
 
+/// Segments per quarter circle of a street surface's round ends and joins:
+/// a turning circle of 8 segments (2 per quarter) is within 8 % of the
+/// circle's area, and each segment costs every overlay that cuts a block.
+inline constexpr int kStreetQuadrantSegments = 2;
+
 /// One block: a face of the graph minus the street surface.
 struct StreetBlock {
   Key key = 0;  ///< setKey of the keys of the edges it faces (mixed with its part number when a face gives several)
@@ -110,8 +115,9 @@ struct StreetBlockOptions {
   double maxArea = 2e6;
   double minArea = 1.0;
   double minWidth = 1.0;
-  /// Segments per quarter circle of the street surface's round ends and joins.
-  int quadrantSegments = 4;
+  /// Segments per quarter circle of the street surface's round ends and
+  /// joins (streetSurface must be given the same to match the blocks).
+  int quadrantSegments = kStreetQuadrantSegments;
 };
 
 struct StreetBlocks {
@@ -133,7 +139,7 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
                           const ProgressFn& progress = {});
 
 /// The street surface: every edge buffered by its half width, unioned.
-std::vector<Polygon> streetSurface(const RoadGraph& graph, int quadrantSegments = 4);
+std::vector<Polygon> streetSurface(const RoadGraph& graph, int quadrantSegments = kStreetQuadrantSegments);
 
 /// The street widths of a block for the skeleton style (generation::StreetWidths):
 /// per ring and contour edge, the width of the street it faces, NaN where none.

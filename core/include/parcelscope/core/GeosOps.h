@@ -72,9 +72,14 @@ LineFaces polygonizeLines(const std::vector<Polyline>& noded);
 std::vector<Polygon> bufferedUnion(const std::vector<const Polyline*>& lines, const std::vector<double>& halfWidths,
                                    int quadrantSegments = 4);
 
-/// `a` minus the union of `cut`, on a `grid`-metre grid (snap-rounding overlay);
-/// normalised valid parts. Throws Error(Geometry) if GEOS fails.
+/// `a` minus the union of `cut` (floating overlay; where that fails or is
+/// invalid, snap rounding on a `grid`-metre grid); normalised valid parts. Throws Error(Geometry) if GEOS fails.
 std::vector<Polygon> difference(const Polygon& a, const std::vector<const Polygon*>& cut, double grid);
+
+/// Indices of the `lines` that come within `distances[i]` of `polygon`
+/// (inside it or near it; GEOS prepared geometry), in increasing order.
+std::vector<int> linesNear(const Polygon& polygon, const std::vector<const Polyline*>& lines,
+                           const std::vector<double>& distances);
 
 /// Area of the union of `polygons` (snap-rounded on a `grid`-metre grid).
 double unionArea(const std::vector<const Polygon*>& polygons, double grid);
