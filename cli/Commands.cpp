@@ -234,7 +234,7 @@ int blocksCommand(const std::vector<std::string>& args) {
   flags.push_back({"quiet", "no progress or summary on stderr", false});
   const auto params = joined(pipeline::streetParameters(), analysis::analysisParameters());
   if (wantsHelp(args)) {
-    std::fputs(usageText("parcelscope blocks STREETS [--width-field F] [--default-width M] [--snap M] [--where SQL] "
+    std::fputs(usageText("parcelscope blocks STREETS [--width-field F] [--default-width M] [--street-snap M] [--where SQL] "
                          "[--parcels PARCELS] --out DIR",
                          flags, params)
                    .c_str(),

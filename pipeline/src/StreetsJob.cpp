@@ -38,7 +38,7 @@ BBox boxOf(const Polygon& p) {
 
 const std::vector<ParameterDescription>& streetParameters() {
   static const std::vector<ParameterDescription> d = {
-      realParameter("snap",
+      realParameter("street-snap",
                     "Street line ends closer than this are one intersection; a line ending this close to another "
                     "meets it (a T-junction)",
                     "m", 0.0, 50.0, 1.0, "Streets"),
@@ -86,7 +86,7 @@ StreetNetwork buildStreetNetwork(const io::StreetReadOptions& streets, const Par
     }
   }
   analysis::RoadGraphOptions options;
-  options.snap = value(parameters, "snap");
+  options.snap = value(parameters, "street-snap");
   n.graph = analysis::buildRoadGraph(lines, options);
   reportProgress(progress, 0.4, "road graph");
   n.timings.start("widths");

@@ -7,12 +7,13 @@
 #include <boost/geometry.hpp>
 #include <boost/geometry/index/rtree.hpp>
 #include <cstdio>
-#include <cstdlib>
+#include <map>
 
 #include "TestUtil.h"
 #include "generation/TilingCheck.h"
 #include "parcelscope/core/GeosOps.h"
 #include "parcelscope/core/Parallel.h"
+#include "parcelscope/pipeline/CompareJob.h"
 #include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/pipeline/StreetsJob.h"
 
@@ -66,6 +67,19 @@ std::vector<double> bestIou(const std::vector<Polygon>& parcelBlocks, const std:
   return iou;
 }
 
+// Every flag names one parameter: the street network's parameters do not
+// share a name with the analysis, generator or comparison parameters (the
+// street snap once did with obb's snap).
+TEST(StreetParameters, NamesAreTheirOwn) {
+  std::map<std::string, int> seen;
+  for (const auto& d : compareParameters()) ++seen[d.name];
+  for (const auto& d : streetParameters()) {
+    EXPECT_EQ(seen.count(d.name), 0u) << d.name << " is a compare parameter too";
+    ++seen[d.name];
+  }
+  EXPECT_EQ(seen.count("street-snap"), 1u);
+}
+
 TEST(StreetBlocks, CambridgeStreetBlocksMatchTheParcelBlocks) {
   PARCELSCOPE_REQUIRE_SHARED_DATASETS();
   const ObservedData observed = loadObserved(cambridgeParcels(), defaults());
@@ -77,28 +91,6 @@ TEST(StreetBlocks, CambridgeStreetBlocksMatchTheParcelBlocks) {
   std::vector<const Polygon*> street;
   for (const auto& b : network.blocks.blocks) street.push_back(&b.shape);
   std::vector<double> iou = bestIou(parcelBlocks, street);
-  if (std::getenv("PARCELSCOPE_DIAG")) {
-    for (std::size_t k = 0; k < iou.size(); ++k) {
-      if (iou[k] >= 0.8) continue;
-      const Polygon& p = parcelBlocks[k];
-      double covered = 0;
-      int pieces = 0;
-      double bestArea = 0, bestI = 0;
-      for (const Polygon* s : street) {
-        const double i = geos::intersectionArea(p, *s);
-        if (i > 0.05 * area(p)) ++pieces;
-        covered += i;
-        if (i > bestI) {
-          bestI = i;
-          bestArea = area(*s);
-        }
-      }
-      const Point c = centroid(p);
-      const Point g = observed.layer.frame.toSource(c);
-      std::printf("DIAG iou %.3f area %.0f covered %.3f pieces %d best street area %.0f at %.6f,%.6f\n", iou[k],
-                  area(p), covered / area(p), pieces, bestArea, g.x, g.y);
-    }
-  }
   const auto matched = std::count_if(iou.begin(), iou.end(), [](double v) { return v >= 0.8; });
   std::nth_element(iou.begin(), iou.begin() + static_cast<long>(iou.size() / 2), iou.end());
   const double share = static_cast<double>(matched) / static_cast<double>(iou.size());
@@ -111,6 +103,53 @@ TEST(StreetBlocks, CambridgeStreetBlocksMatchTheParcelBlocks) {
   EXPECT_GE(iou[iou.size() / 2], 0.93);
   for (const auto& b : network.blocks.blocks) EXPECT_TRUE(geos::isValid(b.shape)) << keyText(b.key);
 }
+
+// Every style keeps its invariants in street blocks: parcels tile each block
+// (valid, no overlap, no gap), each has street access in obb at xi = 1, and
+// the same seed gives the same parcels.
+class StreetBlockStyles : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(StreetBlockStyles, CambridgeStreetBlocksAreTiledValidlyWithStreetAccess) {
+  PARCELSCOPE_REQUIRE_SHARED_DATASETS();
+  GenerateRequest request;
+  request.input = cambridgeParcels();
+  request.fromParcels = true;
+  request.streets = cambridgeStreets();
+  request.style = GetParam();
+  request.parameters = defaults();
+  for (const auto& [name, value] : defaultValues(generation::generationParameterDescriptions())) {
+    request.parameters[name] = value;
+  }
+  const GeneratedParcels g = generate(request);
+  ASSERT_TRUE(g.streets);
+  ASSERT_EQ(g.blocks.size(), g.streets->blocks.blocks.size());
+  int failed = 0, withoutAccess = 0;
+  for (std::size_t b = 0; b < g.blocks.size(); ++b) {
+    std::vector<Polygon> parcels;
+    for (int p : g.blocks[b].parcels) parcels.push_back(g.parcels[static_cast<std::size_t>(p)]);
+    const test::TilingReport r = test::checkTiling(g.blocks[b].parts.front(), parcels);
+    const std::string what = std::string(GetParam()) + " street block " + keyText(g.blockKeys[b]);
+    EXPECT_LE(r.areaError, 1e-6) << what;
+    EXPECT_LE(r.maxOverlap, 1e-6) << what;
+    EXPECT_EQ(r.invalid, 0) << what;
+    EXPECT_EQ(r.outside, 0) << what;
+  }
+  for (const auto& m : g.metrics) withoutAccess += !m.streetAccess;
+  failed = static_cast<int>(g.failedBlocks);
+  std::printf(
+      "cambridge_ma street blocks, %s: %zu blocks, %zu parcels, %d without street access, %lld fell back to "
+      "obb, %d failed\n",
+      GetParam(), g.blocks.size(), g.parcels.size(), withoutAccess, static_cast<long long>(g.fallbackBlocks), failed);
+  EXPECT_EQ(failed, 0);
+  if (std::string(GetParam()) == "obb") EXPECT_EQ(g.withoutAccess, 0);
+  const GeneratedParcels again = generate(request);
+  ASSERT_EQ(again.parcels.size(), g.parcels.size());
+  for (std::size_t i = 0; i < g.parcels.size(); ++i) {
+    ASSERT_TRUE(sameVertices(again.parcels[i], g.parcels[i])) << "parcel " << i;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Styles, StreetBlockStyles, ::testing::Values("obb", "skeleton"));
 
 }  // namespace
 }  // namespace parcelscope::pipeline

@@ -18,7 +18,7 @@
 
 namespace parcelscope::pipeline {
 
-/// The street network's parameters (group "Streets"): snap, default-width,
+/// The street network's parameters (group "Streets"): street-snap, default-width,
 /// max-block-area.
 const std::vector<ParameterDescription>& streetParameters();
 

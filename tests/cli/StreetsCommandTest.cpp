@@ -1,0 +1,207 @@
+// `parcelscope blocks` and `generate --streets` as a user runs them, on a
+// street network written here in lon/lat: a grid of named streets with a
+// width field for some, a viaduct marked as a bridge and a cul-de-sac. The
+// written layers are read back with GDAL: valid, keyed, the same whatever the
+// order of the input's features; generated parcels tile their street blocks.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include "OgrTestUtil.h"
+#include "TestUtil.h"
+#include "cli/CliRun.h"
+
+namespace parcelscope {
+namespace {
+
+namespace fs = std::filesystem;
+using test::CliRun;
+using test::slurp;
+using test::TempDir;
+
+CliRun run(const std::string& args) { return test::runCli(args); }
+
+struct Line {
+  std::vector<Point> lonLat;
+  std::string name;
+  std::string width;  // JSON value: a number or null
+  std::string bridge;
+};
+
+// A grid of 5 x 5 streets about 100 m apart near lon -71.1, lat 42.37, the
+// east-west ones 20 m wide (width field), a viaduct crossing the grid without
+// meeting it, and a cul-de-sac.
+std::vector<Line> network() {
+  const double lon0 = -71.1, lat0 = 42.37, dLon = 100 / 82200.0, dLat = 100 / 111050.0;
+  std::vector<Line> lines;
+  for (int i = 0; i < 5; ++i) {
+    lines.push_back({{{lon0 - dLon / 2, lat0 + i * dLat}, {lon0 + 4.5 * dLon, lat0 + i * dLat}},
+                     "East " + std::to_string(i),
+                     "20",
+                     "N"});
+    lines.push_back({{{lon0 + i * dLon, lat0 - dLat / 2}, {lon0 + i * dLon, lat0 + 4.5 * dLat}},
+                     "North " + std::to_string(i),
+                     "null",
+                     "N"});
+  }
+  lines.push_back(
+      {{{lon0 - dLon / 2, lat0 + 2.5 * dLat}, {lon0 + 4.5 * dLon, lat0 + 2.5 * dLat}}, "Viaduct", "12", "Y"});
+  lines.push_back({{{lon0 + 0.5 * dLon, lat0}, {lon0 + 0.5 * dLon, lat0 + 0.6 * dLat}}, "Court", "8", "N"});
+  return lines;
+}
+
+std::string geojson(std::vector<Line> lines, bool shuffled) {
+  if (shuffled) {
+    std::reverse(lines.begin(), lines.end());
+    for (std::size_t i = 0; i < lines.size(); i += 3) std::reverse(lines[i].lonLat.begin(), lines[i].lonLat.end());
+  }
+  std::ostringstream s;
+  s.precision(12);
+  s << "{\"type\": \"FeatureCollection\", \"features\": [";
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    s << (i ? "," : "") << "\n{\"type\": \"Feature\", \"properties\": {\"NAME\": \"" << lines[i].name
+      << "\", \"W\": " << lines[i].width << ", \"BR\": \"" << lines[i].bridge
+      << "\"}, \"geometry\": {\"type\": \"LineString\", \"coordinates\": [";
+    for (std::size_t k = 0; k < lines[i].lonLat.size(); ++k) {
+      s << (k ? "," : "") << "[" << lines[i].lonLat[k].x << "," << lines[i].lonLat[k].y << "]";
+    }
+    s << "]}}";
+  }
+  s << "]}\n";
+  return s.str();
+}
+
+const std::string kFlags = " --width-field W --name-field NAME --no-node-where \"BR = 'Y'\" --default-width 10 --quiet";
+
+std::map<std::string, double> blockAreas(const test::ReadLayer& layer) {
+  std::map<std::string, double> m;
+  for (const auto& f : layer.features) m[f->GetFieldAsString("block_key")] = f->GetFieldAsDouble("area");
+  return m;
+}
+
+TEST(BlocksCommand, WritesValidKeyedBlocksAndTheGraphWhateverTheFeatureOrder) {
+  TempDir dir;
+  const std::string streets = dir.write("streets.geojson", geojson(network(), false));
+  const std::string shuffled = dir.write("shuffled.geojson", geojson(network(), true));
+  const CliRun a = run("blocks '" + streets + "'" + kFlags + " --out '" + dir.file("a") + "'");
+  ASSERT_EQ(a.code, 0) << a.output;
+  for (const char* f : {"blocks.gpkg", "streets.gpkg", "street_surface.gpkg", "run.json"}) {
+    EXPECT_TRUE(fs::exists(dir.file("a") + "/" + f)) << f;
+  }
+  // 16 cells; the viaduct cuts the four it crosses in two.
+  const OGRSpatialReference crs = test::layerCrs(streets);
+  const test::ReadLayer blocks = test::expectValidPolygonLayer(
+      dir.file("a") + "/blocks.gpkg", 20, {"blocks", {"block_key", "area", "streets", "edge_keys"}, &crs});
+  test::expectValidPolygonLayer(dir.file("a") + "/street_surface.gpkg", 1, {"surface", {}, &crs});
+  // Blocks between two 20 m streets and two 10 m ones: 80 x 90 m, less the
+  // cul-de-sac's slot or the viaduct where they lie.
+  int full = 0;
+  for (const auto& f : blocks.features) full += std::fabs(f->GetFieldAsDouble("area") - 80 * 90) < 0.01 * 80 * 90;
+  EXPECT_EQ(full, 16 - 4 - 1);
+  const std::string names = [&] {
+    std::string all;
+    for (const auto& f : blocks.features) all += std::string(f->GetFieldAsString("streets")) + "|";
+    return all;
+  }();
+  EXPECT_NE(names.find("Court"), std::string::npos);
+  EXPECT_NE(names.find("Viaduct"), std::string::npos);
+
+  auto ds = test::openVectorFile(dir.file("a") + "/streets.gpkg");
+  ASSERT_TRUE(ds);
+  OGRLayer* nodes = ds->GetLayerByName("nodes");
+  OGRLayer* edges = ds->GetLayerByName("edges");
+  ASSERT_TRUE(nodes && edges);
+  // 25 crossings and 20 grid ends; the viaduct's 2 ends and the court's far end.
+  EXPECT_EQ(nodes->GetFeatureCount(), 25 + 20 + 2 + 1 + 1);  // and the court's junction
+  int viaduct = 0;
+  for (auto& e : *edges) viaduct += std::string(e->GetFieldAsString("name")) == "Viaduct";
+  EXPECT_EQ(viaduct, 1);  // it crosses the grid without a node
+  const std::string record = slurp(dir.file("a") + "/run.json");
+  EXPECT_NE(record.find("\"lines_not_noded\": 1"), std::string::npos) << record;
+  EXPECT_NE(record.find("\"widths_given\""), std::string::npos) << record;
+
+  ASSERT_EQ(run("blocks '" + shuffled + "'" + kFlags + " --out '" + dir.file("b") + "'").code, 0);
+  const test::ReadLayer again =
+      test::expectValidPolygonLayer(dir.file("b") + "/blocks.gpkg", 20, {"blocks", {"block_key"}, &crs});
+  const auto areasA = blockAreas(blocks), areasB = blockAreas(again);
+  ASSERT_EQ(areasA.size(), 20u);  // keys distinct
+  for (const auto& [key, area] : areasA) {
+    ASSERT_TRUE(areasB.count(key)) << "block " << key << " lost its key when the features were reordered";
+    EXPECT_NEAR(areasB.at(key), area, 1e-6 * area);
+  }
+}
+
+TEST(GenerateCommand, ParcelsTileTheStreetBlocksAndRepeatWithTheSeed) {
+  TempDir dir;
+  const std::string streets = dir.write("streets.geojson", geojson(network(), false));
+  ASSERT_EQ(run("blocks '" + streets + "'" + kFlags + " --out '" + dir.file("blocks") + "'").code, 0);
+  const test::ReadLayer blocks = test::expectValidPolygonLayer(dir.file("blocks") + "/blocks.gpkg", 20);
+  for (const char* style : {"obb", "skeleton"}) {
+    const std::string base = "generate --streets '" + streets + "'" + kFlags + " --style " + style +
+                             " --a-min 150 --a-max 600 --w-min 10 --w-max 25";
+    const CliRun a = run(base + " --seed 3 --out '" + dir.file(std::string(style) + "a") + "'");
+    ASSERT_EQ(a.code, 0) << a.output;
+    const std::string csv = slurp(dir.file(std::string(style) + "a") + "/parcels.csv");
+    const auto rows = std::count(csv.begin(), csv.end(), '\n') - 1;
+    ASSERT_GT(rows, 100) << style;
+    const OGRSpatialReference crs = test::layerCrs(streets);
+    const test::ReadLayer parcels = test::expectValidPolygonLayer(dir.file(std::string(style) + "a") + "/parcels.gpkg",
+                                                                  rows, {"parcels", {"block_key"}, &crs});
+    // Each street block's parcels add up to it (areas in square degrees, as
+    // written: edges straight in metres bow by about 0.2 mm over 100 m there).
+    std::map<std::string, double> byBlock;
+    for (std::size_t i = 0; i < parcels.features.size(); ++i) {
+      for (const Polygon& p : parcels.geometries[i])
+        byBlock[parcels.features[i]->GetFieldAsString("block_key")] += area(p);
+    }
+    ASSERT_EQ(byBlock.size(), 20u) << style;
+    for (std::size_t i = 0; i < blocks.features.size(); ++i) {
+      double blockArea = 0;
+      for (const Polygon& p : blocks.geometries[i]) blockArea += area(p);
+      const std::string key = blocks.features[i]->GetFieldAsString("block_key");
+      ASSERT_TRUE(byBlock.count(key)) << style << ": block " << key << " has no parcels";
+      EXPECT_NEAR(byBlock[key], blockArea, 1e-5 * blockArea) << style << ": block " << key;
+    }
+    const std::string record = slurp(dir.file(std::string(style) + "a") + "/run.json");
+    EXPECT_NE(record.find("\"street-network\""), std::string::npos) << record.substr(0, 400);
+    ASSERT_EQ(run(base + " --seed 3 --out '" + dir.file(std::string(style) + "b") + "'").code, 0);
+    EXPECT_TRUE(test::sameGeometries(
+        test::expectValidPolygonLayer(dir.file(std::string(style) + "b") + "/parcels.gpkg", rows), parcels))
+        << style;
+  }
+}
+
+TEST(BlocksCommand, BadStreetInputsAreOneLineErrors) {
+  TempDir dir;
+  const std::string streets = dir.write("streets.geojson", geojson(network(), false));
+  const std::string sample = std::string(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_town.geojson";
+  struct Case {
+    std::string args;
+    int code;
+    std::string says;
+  };
+  const std::vector<Case> cases = {
+      {"blocks '" + sample + "' --out '" + dir.file("o1") + "'", 1, "holds no line"},
+      {"blocks '" + streets + "' --width-field NOPE --out '" + dir.file("o2") + "'", 1,
+       "no field 'NOPE' (--width-field)"},
+      {"blocks '" + streets + "' --class-field NAME --class-widths 'East 0=abc' --out '" + dir.file("o3") + "'", 2,
+       "--class-widths"},
+      {"blocks '" + streets + "' --class-widths 'a=3' --out '" + dir.file("o4") + "'", 2, "needs --class-field"},
+      {"generate --width-field W --out '" + dir.file("o5") + "'", 2, "needs --streets"},
+      {"blocks '" + streets + "' --no-node-where 'NO SUCH' --out '" + dir.file("o6") + "'", 1, "--no-node-where"},
+  };
+  for (const Case& c : cases) {
+    const CliRun r = run(c.args + " --quiet");
+    EXPECT_EQ(r.code, c.code) << c.args << "\n" << r.output;
+    EXPECT_NE(r.output.find(c.says), std::string::npos) << c.args << "\n" << r.output;
+    // One line; a usage error adds where to find the usage.
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), c.code == 2 ? 2 : 1) << r.output;
+  }
+}
+
+}  // namespace
+}  // namespace parcelscope
