@@ -4,7 +4,9 @@
 Writes sample/sample_town.geojson (relative to this script's folder): a GeoJSON
 FeatureCollection in lon/lat (WGS84, no "crs" member) of a small made-up town
 of ten blocks separated by streets, each block tiled exactly by parcels, plus a
-fixed set of deliberate data quirks (see README.md in this folder).
+fixed set of deliberate data quirks (see README.md in this folder); and
+sample/sample_streets.geojson: the centre lines of its streets, with a name and
+a width (m), a ring road around the town and one cul-de-sac.
 
 Standard library only, deterministic: re-running gives a byte-identical file.
 
@@ -413,6 +415,39 @@ def main():
     print("blocks: %d" % len(blocks))
     print("lots (clean tiling, before quirks): %d" % sum(len(b["lots"]) for b in blocks))
     print("wrote %s" % os.path.relpath(out_path))
+    write_streets(os.path.join(here, "sample", "sample_streets.geojson"))
+
+
+# Street centre lines in the town's metres (before the shift): the middle of
+# each gap between blocks, a ring road around the town, a cul-de-sac into B5's
+# courtyard side. (name, width in m, points)
+STREETS = [
+    ("Ring Road", 12.0, [(-8, -8), (440, -8), (440, 420), (-8, 420), (-8, -8)]),
+    ("First Street", 16.0, [(-8, 108), (440, 108)]),
+    ("Second Street", 16.0, [(-8, 244), (440, 244)]),
+    ("Main Street", 16.0, [(168, -8), (168, 420)]),
+    ("Mill Lane", 14.0, [(283, -8), (283, 108)]),
+    ("Orchard Lane", 16.0, [(304, 108), (304, 244)]),
+    ("Church Lane", 16.0, [(268, 244), (268, 420)]),
+    ("Market Street", 16.0, [(268, 320), (440, 320)]),
+    ("Court Close", 8.0, [(304, 176), (272, 176)]),
+]
+
+
+def write_streets(path):
+    features = []
+    for n, (name, width, points) in enumerate(STREETS, 1):
+        features.append({
+            "type": "Feature",
+            "properties": {"street_id": "R-%02d" % n, "name": name, "width": width},
+            "geometry": {"type": "LineString",
+                         "coordinates": [to_lonlat(to_metres(translate(0, 0), p)) for p in points]},
+        })
+    with open(path, "w", encoding="utf-8", newline="\n") as f:
+        f.write('{"type":"FeatureCollection","features":[\n')
+        f.write(",\n".join(json.dumps(ft, separators=(",", ":")) for ft in features))
+        f.write("\n]}\n")
+    print("wrote %s (%d street centre lines)" % (os.path.relpath(path), len(features)))
 
 
 if __name__ == "__main__":

@@ -444,6 +444,28 @@ std::vector<int> linesNear(const Polygon& polygon, const std::vector<const Polyl
   return near;
 }
 
+std::vector<Polyline> linesOutside(const std::vector<Polyline>& lines, const std::vector<Polygon>& areas) {
+  GEOSContextHandle_t ctx = context();
+  std::vector<const Polyline*> pointers;
+  for (const Polyline& l : lines) {
+    if (l.size() >= 2) pointers.push_back(&l);
+  }
+  if (pointers.empty()) return {};
+  if (areas.empty()) return lines;
+  Geom g = linesToGeos(pointers);
+  std::vector<const Polygon*> parts;
+  for (const Polygon& a : areas) parts.push_back(&a);
+  Geom multi = toGeos(parts);
+  Geom area(multi ? GEOSCoverageUnion_r(ctx, multi.get()) : nullptr);
+  if (!valid(area.get())) area.reset(multi ? GEOSUnaryUnion_r(ctx, multi.get()) : nullptr);
+  Geom outside(g && area ? GEOSDifference_r(ctx, g.get(), area.get()) : nullptr);
+  if (!outside) throw geometryError("lines outside " + std::to_string(areas.size()) + " areas failed");
+  Geom merged(GEOSLineMerge_r(ctx, outside.get()));
+  std::vector<Polyline> out;
+  collectLines(merged ? merged.get() : outside.get(), out);
+  return out;
+}
+
 double unionArea(const std::vector<const Polygon*>& polygons, double grid) {
   if (polygons.empty()) return 0;
   Geom g = toGeos(polygons);

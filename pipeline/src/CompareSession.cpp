@@ -401,15 +401,28 @@ Json sessionJson(const CompareRequest& request) {
   };
   for (const auto& [key, o] : request.overrides) add(Json::object().set("block_key", keyText(key)), o);
   for (const auto& [id, o] : request.overridesById) add(Json::object().set("block_id", id), o);
-  return Json::object()
-      .set("parcelscope_session", 2)
-      .set("input", Json::object()
-                        .set("path", request.input.path)
-                        .set("layer", request.input.layer)
-                        .set("where", request.input.where)
-                        .set("crs", request.input.crsOverride)
-                        .set("key_field", request.input.keyField))
-      .set("style", request.style)
+  Json session = Json::object()
+                     .set("parcelscope_session", 2)
+                     .set("input", Json::object()
+                                       .set("path", request.input.path)
+                                       .set("layer", request.input.layer)
+                                       .set("where", request.input.where)
+                                       .set("crs", request.input.crsOverride)
+                                       .set("key_field", request.input.keyField));
+  if (const auto& st = request.streets) {
+    Json classWidths = Json::object();
+    for (const auto& [value, width] : st->classWidths) classWidths.set(value, width);
+    session.set("streets", Json::object()
+                               .set("path", st->path)
+                               .set("layer", st->layer)
+                               .set("where", st->where)
+                               .set("width_field", st->widthField)
+                               .set("class_field", st->classField)
+                               .set("class_widths", classWidths)
+                               .set("name_field", st->nameField)
+                               .set("no_node_where", st->noNodeWhere));
+  }
+  return session.set("style", request.style)
       .set("metric", request.metric)
       .set("parameters", parameters)
       .set("overrides", overrides);
@@ -446,6 +459,31 @@ CompareRequest readSession(const std::string& path) {
   request.input.where = text(*input, "where", "input.");
   request.input.crsOverride = text(*input, "crs", "input.");
   request.input.keyField = text(*input, "key_field", "input.");
+  if (const Json* st = root.find("streets"); st && !st->isNull()) {
+    if (!st->isObject()) throw bad("member streets is not an object");
+    io::StreetReadOptions o;
+    o.path = text(*st, "path", "streets.");
+    if (o.path.empty()) throw bad("member streets.path is missing");
+    if (std::filesystem::path(o.path).is_relative()) {
+      o.path = (std::filesystem::path(path).parent_path() / o.path).lexically_normal().string();
+    }
+    o.layer = text(*st, "layer", "streets.");
+    o.where = text(*st, "where", "streets.");
+    o.widthField = text(*st, "width_field", "streets.");
+    o.classField = text(*st, "class_field", "streets.");
+    o.nameField = text(*st, "name_field", "streets.");
+    o.noNodeWhere = text(*st, "no_node_where", "streets.");
+    if (const Json* widths = st->find("class_widths"); widths && !widths->isNull()) {
+      if (!widths->isObject()) throw bad("member streets.class_widths is not an object");
+      for (const auto& [value, width] : widths->members()) {
+        if (!width.isNumber() || !(width.number() >= 0)) {
+          throw bad("member streets.class_widths." + value + " is not a width of 0 or more");
+        }
+        o.classWidths[value] = width.number();
+      }
+    }
+    request.streets = std::move(o);
+  }
   if (const std::string style = text(root, "style", ""); !style.empty()) request.style = style;
   if (const std::string metric = text(root, "metric", ""); !metric.empty()) {
     try {
@@ -456,7 +494,8 @@ CompareRequest readSession(const std::string& path) {
     request.metric = metric;
   }
 
-  const std::vector<ParameterDescription> descriptions = compareParameters();
+  std::vector<ParameterDescription> descriptions = compareParameters();
+  for (const auto& d : pipeline::streetParameters()) descriptions.push_back(d);
   request.parameters = defaultValues(descriptions);
   auto readValues = [&](const Json& object, const std::string& where, ParameterValues& into,
                         std::set<std::string>* names) {

@@ -65,19 +65,28 @@ StreetNetwork buildStreetNetwork(const io::StreetReadOptions& streets, const Par
   std::vector<analysis::StreetLine> lines;
   lines.reserve(n.layer.streets.size());
   for (const io::StreetFeature& f : n.layer.streets) lines.push_back({f.line, f.width, f.name, f.noNode, f.key});
+  analysis::RoadGraphOptions options;
+  options.snap = value(parameters, "street-snap");
   if (observed && !observed->analysis.blocks.empty()) {
     // The study area's edge: where the parcels end (a city limit) closes the
-    // faces at the edge of the network. The outline of every parcel block,
-    // gaps narrower than two default widths (the streets between blocks)
-    // closed.
+    // faces the network leaves open there. The outline of every parcel block
+    // (gaps narrower than two default widths, the streets between blocks,
+    // closed), where it lies outside every face of the streets alone.
     std::vector<const Polygon*> all;
     for (const Block& b : observed->analysis.blocks) {
       for (const Polygon& part : b.parts) all.push_back(&part);
     }
+    std::vector<geos::Polyline> outline;
     for (const Polygon& part : geos::unionAndClose(all, 2 * value(parameters, "default-width"))) {
+      outline.push_back(part.outer);
+      outline.back().push_back(part.outer.front());
+    }
+    const analysis::RoadGraph streetsOnly = analysis::buildRoadGraph(lines, options);
+    std::vector<geos::Polyline> edges;
+    for (const analysis::RoadEdge& e : streetsOnly.edges) edges.push_back(e.line);
+    for (geos::Polyline& piece : geos::linesOutside(outline, geos::polygonizeLines(edges).faces)) {
       analysis::StreetLine edge;
-      edge.line = part.outer;
-      edge.line.push_back(part.outer.front());
+      edge.line = std::move(piece);
       edge.boundary = true;
       edge.width = 0;
       edge.key = hashBytes("boundary");
@@ -85,8 +94,6 @@ StreetNetwork buildStreetNetwork(const io::StreetReadOptions& streets, const Par
       ++n.boundaryLines;
     }
   }
-  analysis::RoadGraphOptions options;
-  options.snap = value(parameters, "street-snap");
   n.graph = analysis::buildRoadGraph(lines, options);
   reportProgress(progress, 0.4, "road graph");
   n.timings.start("widths");

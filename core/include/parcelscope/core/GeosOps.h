@@ -81,6 +81,10 @@ std::vector<Polygon> difference(const Polygon& a, const std::vector<const Polygo
 std::vector<int> linesNear(const Polygon& polygon, const std::vector<const Polyline*>& lines,
                            const std::vector<double>& distances);
 
+/// The parts of `lines` outside the union of `areas` (GEOS difference; the
+/// areas a clean coverage, such as faces, or not).
+std::vector<Polyline> linesOutside(const std::vector<Polyline>& lines, const std::vector<Polygon>& areas);
+
 /// Area of the union of `polygons` (snap-rounded on a `grid`-metre grid).
 double unionArea(const std::vector<const Polygon*>& polygons, double grid);
 
