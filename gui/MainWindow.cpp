@@ -63,6 +63,7 @@
 #include "parcelscope/io/ParcelReader.h"
 #include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/pipeline/Inspect.h"
+#include "parcelscope/pipeline/StreetsJob.h"
 #include "parcelscope/viz/CompareFigures.h"
 #include "parcelscope/viz/Scenes.h"
 
@@ -521,6 +522,13 @@ void MainWindow::buildMenus() {
   filterAction_ = file->addAction("&Filter features...", this, [this] { askForFilter(); });
   filterAction_->setObjectName("filterAction");
   filterAction_->setToolTip("Keep only the features whose attributes match a filter (the command line's --where)");
+  streetsAction_ = file->addAction("Open s&treets...", this, [this] { askForStreets(); });
+  streetsAction_->setObjectName("streetsAction");
+  streetsAction_->setToolTip(
+      "Blocks from street centre lines: the parcels are grouped into the blocks of the street network "
+      "(the command line's --streets)");
+  removeStreetsAction_ = file->addAction("Remove streets", this, [this] { removeStreets(); });
+  removeStreetsAction_->setObjectName("removeStreetsAction");
   file->addSeparator();
   file->addAction("Open session...", this, [this] {
     const QString path = QFileDialog::getOpenFileName(this, "Open session", {}, "ParcelScope session (*.json)");
@@ -593,6 +601,57 @@ void MainWindow::setFilter(const QString& where) {
   const io::ReadOptions& input = controller_.request().input;
   openFile(QString::fromStdString(input.path), QString::fromStdString(input.layer), where,
            QString::fromStdString(input.crsOverride));
+}
+
+void MainWindow::askForStreets() {
+  if (!controller_.loaded()) return showError("open a dataset first");
+  const QString path = QFileDialog::getOpenFileName(this, "Open street centre lines", {},
+                                                    "Vector data (*.geojson *.json *.gpkg *.shp *.fgb *.gml *.kml);;"
+                                                    "All files (*)");
+  if (path.isEmpty()) return;
+  // The width and the name from fields the user picks among the layer's.
+  QStringList numeric{"(none: measured from the parcels)"}, text{"(none)"};
+  try {
+    for (const auto& f : io::layerFields(path.toStdString())) {
+      (f.numeric ? numeric : text) << QString::fromStdString(f.name);
+    }
+  } catch (const std::exception& e) {
+    return showError(e.what());
+  }
+  bool ok = false;
+  const QString width = QInputDialog::getItem(this, "Street width",
+                                              "Field holding each street's width (metres, or the unit of a projected "
+                                              "CRS):",
+                                              numeric, 0, false, &ok);
+  if (!ok) return;
+  const QString name =
+      QInputDialog::getItem(this, "Street name", "Field holding each street's name:", text, 0, false, &ok);
+  if (!ok) return;
+  openStreets(path, width == numeric.front() ? QString() : width, name == text.front() ? QString() : name);
+}
+
+void MainWindow::openStreets(const QString& path, const QString& widthField, const QString& nameField) {
+  if (!controller_.loaded()) return showError("open a dataset first");
+  if (path.isEmpty()) return removeStreets();
+  io::StreetReadOptions streets;
+  streets.path = path.toStdString();
+  streets.widthField = widthField.toStdString();
+  streets.nameField = nameField.toStdString();
+  controller_.setStreets(streets);
+  markOverridesSaved();
+  selected_ = -1;
+  selectedParcel_ = -1;
+  updateActions();
+  submit();
+}
+
+void MainWindow::removeStreets() {
+  if (!controller_.loaded() || !controller_.request().streets) return;
+  controller_.setStreets(std::nullopt);
+  selected_ = -1;
+  selectedParcel_ = -1;
+  updateActions();
+  submit();
 }
 
 void MainWindow::askForCrs(const io::ReadOptions& input) {
@@ -1008,6 +1067,16 @@ void MainWindow::drawReport(const UpdateReport& report) {
       blocks.push_back(a.blockOf[i]);
     }
     observedView_->layer().setShapes(shapes, values, blocks);
+    // The street network the blocks come from, over both views.
+    std::vector<std::vector<Point>> lines;
+    std::vector<Polygon> surface;
+    if (const auto& network = r.observed->streets) {
+      for (const analysis::RoadEdge& e : network->graph.edges) {
+        if (!e.boundary) lines.push_back(e.line);
+      }
+      surface = analysis::streetSurface(network->graph);
+    }
+    for (MapView* view : {observedView_, proceduralView_}) view->streets().setStreets(lines, surface);
   }
   {
     // Grouped by block, so that only the layer parts holding changed blocks are built again.
@@ -1389,6 +1458,8 @@ void MainWindow::updateActions() {
   zoomToExtentAction_->setEnabled(extent_.has_value() && controller_.shownResult() != nullptr);
   setCrsAction_->setEnabled(controller_.loaded() || controller_.failedRequest());
   filterAction_->setEnabled(controller_.loaded());
+  streetsAction_->setEnabled(controller_.loaded());
+  removeStreetsAction_->setEnabled(controller_.loaded() && controller_.request().streets.has_value());
   const bool shown = controller_.shownResult() != nullptr;
   overrideBlock_->setEnabled(shown);
   clearOverride_->setEnabled(shown);

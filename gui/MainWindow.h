@@ -60,6 +60,11 @@ public:
   /// Reads the open input again keeping only the features that match `where`
   /// (an OGR SQL attribute filter, as the command line's --where; empty: all).
   void setFilter(const QString& where);
+  /// Blocks from the street centre lines of `path` (the command line's
+  /// --streets, with --width-field and --name-field; empty: none); drawn over
+  /// both views. removeStreets() goes back to blocks grouped from the parcels.
+  void openStreets(const QString& path, const QString& widthField = {}, const QString& nameField = {});
+  void removeStreets();
   /// Restores input, parameters, overrides and seed from a session file.
   void openSession(const QString& path);
   void saveSession(const QString& path);
@@ -205,6 +210,7 @@ private:
   void askForCrs(const io::ReadOptions& input);
   /// File > Filter features: asks for an attribute filter for the open input.
   void askForFilter();
+  void askForStreets();
 
   QThread thread_;
   SessionWorker* worker_;
@@ -274,6 +280,8 @@ private:
   QMenu* recentMenu_;
   QAction* setCrsAction_;
   QAction* filterAction_;
+  QAction* streetsAction_;
+  QAction* removeStreetsAction_;
   QAction* saveSessionAction_;
   QMenu* exportMenu_;
   QAction* zoomToExtentAction_;

@@ -198,6 +198,7 @@ MapView::MapView(const QString& title, bool withColourBar, QWidget* parent) : QW
   window_->AddRenderer(renderer_);
   window_->AddRenderer(legend_);
   layer_.addTo(renderer_);
+  streets_.addTo(renderer_);
   outline_.addTo(renderer_);
   // Before every frame, whoever asks for it (a change, a pan or zoom of the
   // shared camera): outlines for the shapes large enough at this zoom.

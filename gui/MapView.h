@@ -27,6 +27,7 @@ public:
 
   viz::MapLayer& layer() { return layer_; }
   viz::OutlineLayer& outline() { return outline_; }
+  viz::StreetLayer& streets() { return streets_; }
   void setTitle(const QString& title);
   QString title() const;
   /// Shares `camera` with this view (linked views follow each other).
@@ -67,6 +68,7 @@ private:
   vtkNew<vtkRenderer> legend_;
   viz::MapLayer layer_;
   viz::OutlineLayer outline_;
+  viz::StreetLayer streets_;
   bool renderPending_ = false;
   unsigned long observer_ = 0;
   unsigned long scaleObserver_ = 0;

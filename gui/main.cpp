@@ -1,4 +1,5 @@
 // parcelscope-gui [INPUT] [--layer L] [--where SQL] [--crs EPSG:N] [--session FILE] [--sample]
+//                 [--streets FILE [--width-field F] [--name-field F]]
 //                 [--subdivision-style STYLE] [--screenshot PNG] [--window-size WxH]
 #include <QVTKOpenGLStereoWidget.h>
 #include <QApplication>
@@ -32,7 +33,10 @@ int main(int argc, char** argv) {
                                 "size of the window in screen pixels (e.g. 1366x768; at QT_SCALE_FACTOR=1.5 "
                                 "that is 911 x 512 of the window's own)",
                                 "WxH");
-  parser.addOptions({layer, where, crs, session, sample, style, screenshot, size});
+  const QCommandLineOption streets("streets", "street centre lines: blocks from the street network", "FILE");
+  const QCommandLineOption widthField("width-field", "with --streets: the street width field", "F");
+  const QCommandLineOption nameField("name-field", "with --streets: the street name field", "F");
+  parser.addOptions({layer, where, crs, session, sample, style, screenshot, size, streets, widthField, nameField});
   parser.process(app);
 
   parcelscope::gui::MainWindow window;
@@ -71,5 +75,7 @@ int main(int argc, char** argv) {
   } else if (!parser.positionalArguments().isEmpty()) {
     window.openFile(parser.positionalArguments().front(), parser.value(layer), parser.value(where), parser.value(crs));
   }
+  if (parser.isSet(streets))
+    window.openStreets(parser.value(streets), parser.value(widthField), parser.value(nameField));
   return QApplication::exec();
 }

@@ -142,6 +142,20 @@ std::vector<std::string> layerNames(const std::string& path) {
   return names;
 }
 
+std::vector<FieldInfo> layerFields(const std::string& path, const std::string& layerName) {
+  const GDALDatasetUniquePtr ds = openVector(path);
+  OGRLayer* layer = layerName.empty() ? ds->GetLayer(0) : ds->GetLayerByName(layerName.c_str());
+  if (!layer) throw inputError(path + ": no layer named '" + layerName + "'");
+  std::vector<FieldInfo> fields;
+  OGRFeatureDefn* defn = layer->GetLayerDefn();
+  for (int i = 0; i < defn->GetFieldCount(); ++i) {
+    const OGRFieldType type = defn->GetFieldDefn(i)->GetType();
+    fields.push_back(
+        {defn->GetFieldDefn(i)->GetNameRef(), type == OFTInteger || type == OFTInteger64 || type == OFTReal});
+  }
+  return fields;
+}
+
 ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) {
   const std::string& path = options.path;
   Timings timings;

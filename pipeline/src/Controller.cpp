@@ -41,6 +41,13 @@ void Controller::openInput(const io::ReadOptions& input) {
   edited();
 }
 
+void Controller::setStreets(std::optional<io::StreetReadOptions> streets) {
+  request_.streets = std::move(streets);
+  request_.overrides.clear();
+  request_.overridesById.clear();
+  edited();
+}
+
 void Controller::openSession(const std::string& path) {
   CompareRequest next = readSession(path);
   next.parameters["figures"] = 0;

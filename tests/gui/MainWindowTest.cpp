@@ -56,6 +56,7 @@
 #include "parcelscope/core/Keys.h"
 #include "parcelscope/io/Writers.h"
 #include "parcelscope/pipeline/CompareJob.h"
+#include "parcelscope/pipeline/StreetsJob.h"
 #include "viz/ImageCheck.h"
 
 using parcelscope::gui::MainWindow;
@@ -969,6 +970,37 @@ private slots:
              qPrintable(window_->proceduralView()->title()));
     window_->openSample();
     QVERIFY(settle());
+  }
+
+  // Streets opened with the parcels: the blocks are the street network's (the
+  // command line's --streets gives the same parcels), the centre lines are
+  // drawn over both views, and removing them brings the parcel blocks back.
+  void streetsOpenedWithTheParcelsGiveTheirBlocksAndAreDrawn() {
+    window_->openSample();
+    QVERIFY(settle());
+    const std::size_t parcelBlocks = window_->result()->observed->analysis.blocks.size();
+    QCOMPARE(window_->proceduralView()->streets().lines(), std::size_t(0));
+    window_->openStreets(QString(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_streets.geojson", "width", "name");
+    QVERIFY(settle());
+    QVERIFY2(window_->lastError().isEmpty(), qPrintable(window_->lastError()));
+    const auto r = window_->result();
+    QVERIFY(r->observed->streets);
+    QCOMPARE(r->observed->analysis.blocks.size(), r->observed->streets->blocks.blocks.size());
+    QCOMPARE(r->observed->analysis.blocks.size(), std::size_t(10));
+    std::size_t streetEdges = 0;
+    for (const auto& e : r->observed->streets->graph.edges) streetEdges += !e.boundary;
+    QVERIFY(streetEdges >= 9);
+    QCOMPARE(window_->observedView()->streets().lines(), streetEdges);
+    QCOMPARE(window_->proceduralView()->streets().lines(), streetEdges);
+    QCOMPARE(static_cast<int>(r->generated.parcels.size()), libraryParcelCount());
+    auto* remove = window_->findChild<QAction*>("removeStreetsAction");
+    QVERIFY(remove && remove->isEnabled());
+    window_->removeStreets();
+    QVERIFY(settle());
+    QVERIFY(!window_->result()->observed->streets);
+    QCOMPARE(window_->result()->observed->analysis.blocks.size(), parcelBlocks);
+    QCOMPARE(window_->proceduralView()->streets().lines(), std::size_t(0));
+    QVERIFY(!remove->isEnabled());
   }
 
   // Quitting with block overrides changed since the last save asks Save,

@@ -1114,6 +1114,57 @@ void OutlineLayer::setShapes(const std::vector<const Polygon*>& shapes) {
 
 void OutlineLayer::addTo(vtkRenderer* renderer) { renderer->AddActor(impl_->actor); }
 
+struct StreetLayer::Impl {
+  vtkNew<vtkPolyData> centre, kerbs;
+  vtkNew<vtkPolyDataMapper> centreMapper, kerbMapper;
+  vtkNew<vtkActor> centreActor, kerbActor;
+  std::size_t lines = 0;
+};
+
+StreetLayer::StreetLayer() : impl_(std::make_unique<Impl>()) {
+  auto style = [](vtkPolyDataMapper* mapper, vtkPolyData* data, vtkActor* actor, double grey, float width) {
+    mapper->SetInputData(data);
+    mapper->ScalarVisibilityOff();
+    actor->SetMapper(mapper);
+    actor->SetPosition(0, 0, 1.5);
+    actor->GetProperty()->SetColor(grey, grey, grey);
+    actor->GetProperty()->SetLineWidth(width);
+    actor->GetProperty()->LightingOff();
+  };
+  style(impl_->centreMapper, impl_->centre, impl_->centreActor, 0.25, 1.5f);
+  style(impl_->kerbMapper, impl_->kerbs, impl_->kerbActor, 0.55, 1.0f);
+}
+
+StreetLayer::~StreetLayer() = default;
+
+void StreetLayer::setStreets(const std::vector<std::vector<Point>>& centreLines, const std::vector<Polygon>& surface) {
+  vtkNew<vtkPoints> points;
+  vtkNew<vtkCellArray> cells;
+  for (const auto& line : centreLines) {
+    if (line.size() < 2) continue;
+    cells->InsertNextCell(static_cast<vtkIdType>(line.size()));
+    for (const Point& p : line) cells->InsertCellPoint(points->InsertNextPoint(p.x, p.y, 0));
+  }
+  vtkNew<vtkPolyData> centre;
+  centre->SetPoints(points);
+  centre->SetLines(cells);
+  impl_->centre->ShallowCopy(centre);
+  impl_->lines = centreLines.size();
+  MapPanel panel;
+  for (const Polygon& p : surface) panel.shapes.push_back(&p);
+  panel.values.assign(panel.shapes.size(), 0.0);
+  PanelGeometry fresh;
+  buildPanel(panel, fresh);
+  impl_->kerbs->ShallowCopy(fresh.rings);
+}
+
+void StreetLayer::addTo(vtkRenderer* renderer) {
+  renderer->AddActor(impl_->kerbActor);
+  renderer->AddActor(impl_->centreActor);
+}
+
+std::size_t StreetLayer::lines() const { return impl_->lines; }
+
 void fitCamera(vtkRenderer* renderer, const Box& extent, double viewAspect) {
   const double margin = 0.03 * std::max(extent.width(), extent.height());
   const double halfHeight =

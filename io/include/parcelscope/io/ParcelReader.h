@@ -71,6 +71,15 @@ struct ParcelLayer {
 /// readParcels when the file cannot be opened or holds no layer.
 std::vector<std::string> layerNames(const std::string& path);
 
+/// The attribute fields of layer `layer` of `path` (empty: the first), in
+/// order, and whether each is numeric. Throws Error(Input) as layerNames, and
+/// when there is no such layer.
+struct FieldInfo {
+  std::string name;
+  bool numeric = false;
+};
+std::vector<FieldInfo> layerFields(const std::string& path, const std::string& layer = {});
+
 /// Reads, projects and cleans the polygons of one layer.
 /// Throws Error(Input) with a one-line message naming the file (and the feature
 /// or layer) when the file is missing, empty, neither a regular file nor a folder

@@ -20,6 +20,7 @@
 // than on the edit that failed.
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "parcelscope/core/Parcel.h"
@@ -66,6 +67,9 @@ public:
   /// Opens `input`: the overrides of the former input go (its blocks do not
   /// carry over), style, parameters and colouring stay.
   void openInput(const io::ReadOptions& input);
+  /// Blocks from the street network `streets` (none: grouped from the
+  /// parcels again); the overrides go, as the blocks change.
+  void setStreets(std::optional<io::StreetReadOptions> streets);
   /// Makes session file `path` the request (readSession), with figures off.
   /// Throws as readSession (Error(Input) naming the file), leaving the request
   /// as it was.

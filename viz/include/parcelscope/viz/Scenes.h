@@ -76,6 +76,26 @@ private:
   std::unique_ptr<Impl> impl_;
 };
 
+/// A street network drawn over a map: the street surface's kerb lines (thin,
+/// grey) and the centre lines (dark grey), above the parcels.
+class StreetLayer {
+public:
+  StreetLayer();
+  ~StreetLayer();
+  StreetLayer(const StreetLayer&) = delete;
+  StreetLayer& operator=(const StreetLayer&) = delete;
+  /// `centreLines`: open polylines; `surface`: the street surface's polygons
+  /// (their rings are drawn). Empty: nothing is drawn.
+  void setStreets(const std::vector<std::vector<Point>>& centreLines, const std::vector<Polygon>& surface);
+  void addTo(vtkRenderer* renderer);
+  /// Centre lines drawn (for tests).
+  std::size_t lines() const;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 /// Points the renderer's (parallel-projection) camera at `extent` with a margin.
 void fitCamera(vtkRenderer* renderer, const Box& extent, double viewAspect);
 
