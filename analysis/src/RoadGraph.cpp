@@ -403,6 +403,40 @@ RoadGraph buildRoadGraph(const std::vector<StreetLine>& input, const RoadGraphOp
   return graph;
 }
 
+namespace {
+// Appends the cubic Bezier a, b, c, d (a excluded) flattened to `tolerance`:
+// split in halves (de Casteljau) until the control points lie within
+// `tolerance` of the chord, which bounds the curve's distance from it.
+void flatten(const Point& a, const Point& b, const Point& c, const Point& d, double tolerance, int depth,
+             Polyline& out) {
+  const double chord = distance(a, d);
+  auto off = [&](const Point& p) {
+    return chord > 0 ? std::fabs((d.x - a.x) * (p.y - a.y) - (d.y - a.y) * (p.x - a.x)) / chord : distance(p, a);
+  };
+  if (depth >= 16 || std::max(off(b), off(c)) <= tolerance) {
+    out.push_back(d);
+    return;
+  }
+  auto mid = [](const Point& p, const Point& q) { return Point{0.5 * (p.x + q.x), 0.5 * (p.y + q.y)}; };
+  const Point ab = mid(a, b), bc = mid(b, c), cd = mid(c, d), abc = mid(ab, bc), bcd = mid(bc, cd), m = mid(abc, bcd);
+  flatten(a, ab, abc, m, tolerance, depth + 1, out);
+  flatten(m, bcd, cd, d, tolerance, depth + 1, out);
+}
+}  // namespace
+
+void setCurve(RoadGraph& graph, std::size_t edge, std::optional<std::array<Point, 2>> controls, double tolerance) {
+  if (edge >= graph.edges.size()) throw usageError("setCurve: no edge " + std::to_string(edge));
+  RoadEdge& e = graph.edges[edge];
+  const Point a = graph.nodes[static_cast<std::size_t>(e.from)].at, d = graph.nodes[static_cast<std::size_t>(e.to)].at;
+  e.controls = controls;
+  e.line = {a};
+  if (controls) {
+    flatten(a, (*controls)[0], (*controls)[1], d, std::max(tolerance, 1e-6), 0, e.line);
+  } else {
+    e.line.push_back(d);
+  }
+}
+
 std::int64_t fillStreetWidths(RoadGraph& graph, const std::vector<const Polygon*>& parcelBlocks, double defaultWidth,
                               double maxWidth) {
   std::vector<const Polyline*> rings;

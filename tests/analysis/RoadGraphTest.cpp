@@ -256,6 +256,43 @@ TEST(RoadGraph, RadialPatternAndCurvySuburbWithCulDeSacs) {
   expectOrderFree(suburb, "suburb");
 }
 
+// A curved edge (a cubic Bezier, as the paper's road graph has) is flattened
+// within its tolerance, keeps its key, and its blocks follow the curve.
+TEST(RoadGraph, CurvedEdgesAreFlattenedAndTheirBlocksFollowTheCurve) {
+  RoadGraph g = buildRoadGraph(grid(2, 100));
+  std::size_t south = g.edges.size();
+  for (std::size_t i = 0; i < g.edges.size(); ++i) {
+    const auto& e = g.edges[i];
+    const Point a = g.nodes[static_cast<std::size_t>(e.from)].at, b = g.nodes[static_cast<std::size_t>(e.to)].at;
+    if (a.y == 0 && b.y == 0 && std::min(a.x, b.x) == 0 && std::max(a.x, b.x) == 100) south = i;  // the cell's
+  }
+  ASSERT_LT(south, g.edges.size());
+  const Key key = g.edges[south].key;
+  const double flatArea = area(streetBlocks(g).blocks.at(0).shape);
+  // Control points 40 m south of the street: the curve bows 30 m south.
+  const Point a = g.nodes[static_cast<std::size_t>(g.edges[south].from)].at;
+  const Point d = g.nodes[static_cast<std::size_t>(g.edges[south].to)].at;
+  setCurve(g, south, std::array<Point, 2>{{{a.x + (d.x - a.x) / 3, -40}, {a.x + 2 * (d.x - a.x) / 3, -40}}}, 0.01);
+  EXPECT_EQ(g.edges[south].key, key);
+  ASSERT_TRUE(g.edges[south].controls);
+  EXPECT_GT(g.edges[south].line.size(), 8u);
+  double deepest = 0;
+  for (const Point& p : g.edges[south].line) deepest = std::min(deepest, p.y);
+  EXPECT_NEAR(deepest, -30, 0.01);  // B(1/2) = (a + 3 c1 + 3 c2 + d) / 8
+  // The block gains about the bow: x = 100 t, y = -120 t (1 - t), 2,000 m2
+  // (a little less: the curve leaves the corners at an angle, where the cross
+  // streets' surface cuts more of the block).
+  const StreetBlocks curved = streetBlocks(g);
+  ASSERT_EQ(curved.blocks.size(), 1u);
+  const double gained = area(curved.blocks[0].shape) - flatArea;
+  EXPECT_NEAR(gained, 2000, 200);
+  const Built b{g, curved};
+  expectCoverage(b, "curved");
+  setCurve(g, south, std::nullopt);
+  EXPECT_EQ(g.edges[south].line.size(), 2u);
+  EXPECT_NEAR(area(streetBlocks(g).blocks.at(0).shape), flatArea, 1e-6);
+}
+
 TEST(RoadGraph, FacesAboveTheLimitAreDropped) {
   const RoadGraph g = buildRoadGraph(grid(3, 100));
   StreetBlockOptions options;

@@ -10,8 +10,10 @@
 // for lines marked as not noded: bridges and tunnels), joins endpoints within a
 // snap distance, merges duplicate segments and keeps dead ends. Keys of nodes,
 // edges and blocks depend on geometry only, never on the order of the input.
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -51,7 +53,12 @@ struct RoadNode {
 struct RoadEdge {
   Key key = 0;  ///< from its end nodes' keys and its middle point
   int from = -1, to = -1;
-  Polyline line;  ///< from node `from` to node `to`
+  /// From node `from` to node `to`: the edge's geometry, or, for a curved
+  /// edge, its cubic Bezier flattened (see setCurve).
+  Polyline line;
+  /// A curved edge's two control points (a cubic Bezier from node `from` to
+  /// node `to`, Vanegas et al. 2012, section 3.1); none for a polyline edge.
+  std::optional<std::array<Point, 2>> controls;
   double width = NAN;
   std::string name;
   bool noNode = false;
@@ -79,6 +86,14 @@ struct RoadGraph {
 /// `lines`: nodes and edges come sorted by key. Throws Error(Geometry) if GEOS
 /// fails to node the lines.
 RoadGraph buildRoadGraph(const std::vector<StreetLine>& lines, const RoadGraphOptions& options = {});
+
+/// Makes edge `edge` the cubic Bezier from its `from` node through control
+/// points `c1`, `c2` to its `to` node (none: a straight segment between its
+/// nodes), flattened into `line` so that no point of the curve lies farther
+/// than `tolerance` (m) from it. Keys do not change: an edge keeps its identity
+/// when its curvature is edited. Throws Error(Usage) for an edge out of range.
+void setCurve(RoadGraph& graph, std::size_t edge, std::optional<std::array<Point, 2>> controls,
+              double tolerance = 0.05);
 
 /// Fills the unknown widths of `graph`'s edges: measured from the blocks of
 /// observed parcels (`parcelBlocks`, the outlines `stats` builds) as the gap
