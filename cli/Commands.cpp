@@ -234,11 +234,12 @@ int blocksCommand(const std::vector<std::string>& args) {
   flags.push_back({"quiet", "no progress or summary on stderr", false});
   const auto params = joined(pipeline::streetParameters(), analysis::analysisParameters());
   if (wantsHelp(args)) {
-    std::fputs(usageText("parcelscope blocks STREETS [--width-field F] [--default-width M] [--street-snap M] [--where SQL] "
-                         "[--parcels PARCELS] --out DIR",
-                         flags, params)
-                   .c_str(),
-               stdout);
+    std::fputs(
+        usageText("parcelscope blocks STREETS [--width-field F] [--default-width M] [--street-snap M] [--where SQL] "
+                  "[--parcels PARCELS] --out DIR",
+                  flags, params)
+            .c_str(),
+        stdout);
     std::fputs(
         "\nBuilds the planar road graph of the street centre lines and its blocks (faces minus the\n"
         "street surface). Writes DIR/blocks.gpkg (layer blocks), DIR/streets.gpkg (layers nodes and\n"
@@ -366,6 +367,9 @@ int compareCommand(const std::vector<std::string>& args) {
   if (auto v = a.value("metric")) request.metric = *v;
   if (auto v = a.value("vector")) request.vectorFormat = *v;
   if (auto v = a.value("parcels-format")) request.parcelsFormat = *v;
+  if (request.style == "all") {
+    return reportOutcome(viz::runLeaderboard(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
+  }
   return reportOutcome(viz::runCompare(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
 }
 

@@ -236,17 +236,25 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
 
 CompareResult compare(const CompareRequest& request, const ProgressFn& progress) {
   detail::checkRequest(request);
+  return compare(request,
+                 std::make_shared<const pipeline::ObservedData>(pipeline::loadObservedInStreetBlocks(
+                     request.input, request.streets ? &*request.streets : nullptr, request.parameters,
+                     scaledProgress(progress, 0.0, 0.45))),
+                 scaledProgress(progress, 0.45, 1.0));
+}
+
+CompareResult compare(const CompareRequest& request, std::shared_ptr<const pipeline::ObservedData> observed,
+                      const ProgressFn& progress) {
+  detail::checkRequest(request);
   CompareResult r;
-  r.observed = std::make_shared<const pipeline::ObservedData>(
-      pipeline::loadObservedInStreetBlocks(request.input, request.streets ? &*request.streets : nullptr,
-                                           request.parameters, scaledProgress(progress, 0.0, 0.45)));
+  r.observed = std::move(observed);
   const analysis::ObservedAnalysis& a = r.observed->analysis;
   detail::requireBlocks(request, *r.observed);
   r.generated =
-      pipeline::generate(detail::generateRequest(request, r.observed.get()), scaledProgress(progress, 0.45, 0.9));
+      pipeline::generate(detail::generateRequest(request, r.observed.get()), scaledProgress(progress, 0.0, 0.85));
 
   // Both sets measured with the same metrics; compared block by block, in parallel.
-  reportProgress(progress, 0.9, "comparing");
+  reportProgress(progress, 0.85, "comparing");
   const auto compareStart = std::chrono::steady_clock::now();
   detail::compareStage(r, request);
   const double measure = r.generated.timings.stages().empty() ? 0.0 : r.generated.timings.stages().back().second;

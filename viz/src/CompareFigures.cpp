@@ -1,5 +1,7 @@
 #include "parcelscope/viz/CompareFigures.h"
 
+#include <sstream>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -276,6 +278,50 @@ std::vector<std::string> drawCompareFigures(const CompareResult& r, const Compar
 const pipeline::FigureRenderer& compareFigureRenderer() {
   static const pipeline::FigureRenderer renderer{requireDisplay, drawCompareFigures, vtkVersionString()};
   return renderer;
+}
+
+std::vector<std::string> drawLeaderboard(const pipeline::Leaderboard& board, const CompareRequest& request,
+                                         const std::function<std::string(const std::string&)>& stage) {
+  if (board.entries.empty()) return {};
+  requireDisplay();
+  const analysis::ParcelQuantity& q = analysis::parcelQuantity("aspect_ratio");
+  const CompareResult& first = board.entries.front().result;
+  std::vector<MapPanel> panels(1 + board.entries.size());
+  const auto& parcels = board.observed->layer.parcels;
+  for (std::size_t i = 0; i < parcels.size(); ++i) {
+    if (board.observed->analysis.blockOf[i] < 0) continue;
+    panels[0].shapes.push_back(&parcels[i].shape);
+    panels[0].values.push_back(q.value(board.observed->analysis.metrics[i]));
+  }
+  panels[0].title = "Observed: " + std::to_string(panels[0].shapes.size());
+  for (std::size_t e = 0; e < board.entries.size(); ++e) {
+    const auto& g = board.entries[e].result.generated;
+    MapPanel& p = panels[e + 1];
+    for (std::size_t i = 0; i < g.parcels.size(); ++i) {
+      p.shapes.push_back(&g.parcels[i]);
+      p.values.push_back(q.value(g.metrics[i]));
+    }
+    std::ostringstream t;
+    t.precision(2);
+    t << board.entries[e].style << ": " << g.parcels.size() << ", fit "
+      << pipeline::fitScore(board.entries[e].result.city);
+    p.title = t.str();
+  }
+  const std::string title = "Parcel aspect ratio, observed and every style: " + inputName(request);
+  const int width = 600 * static_cast<int>(panels.size()), height = 700;
+  FigureOutput out;
+  out.png = stage("leaderboard.png");
+  out.width = width;
+  out.height = height;
+  const ColourScale scale = quantityScale(first, request, "aspect_ratio");
+  renderMaps(title, panels, scale, out);
+  writeVectorMaps(title, panels, scale, width, height, stage("leaderboard.svg"));
+  return {"leaderboard.png", "leaderboard.svg"};
+}
+
+pipeline::JobOutcome runLeaderboard(const CompareRequest& request, const std::string& outDir,
+                                    const ProgressFn& progress) {
+  return pipeline::runLeaderboard(request, outDir, progress, drawLeaderboard);
 }
 
 pipeline::JobOutcome runCompare(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress) {

@@ -107,6 +107,10 @@ void exportSession(const CompareRequest& request, const std::string& path);
 /// bad input or parameters (an unknown style is Error(Usage)), Error(Cancelled)
 /// when `progress` asks to stop.
 CompareResult compare(const CompareRequest& request, const ProgressFn& progress = {});
+/// The same with the observed data already read and analysed (as
+/// loadObservedInStreetBlocks gives it for `request`): only generates and compares.
+CompareResult compare(const CompareRequest& request, std::shared_ptr<const pipeline::ObservedData> observed,
+                      const ProgressFn& progress = {});
 
 /// What draws the figures of runCompare; the rendering library supplies one
 /// (viz::compareFigureRenderer()), so that this library links no renderer.

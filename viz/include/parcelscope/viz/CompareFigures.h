@@ -1,10 +1,12 @@
 #pragma once
 // The figures of `compare`: colour scales, histograms, maps, and the renderer
 // that pipeline::runCompare draws them with.
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "parcelscope/pipeline/CompareJob.h"
+#include "parcelscope/pipeline/Leaderboard.h"
 #include "parcelscope/viz/Figures.h"
 
 namespace parcelscope::viz {
@@ -62,6 +64,17 @@ void exportFigure(const CompareResult& result, const CompareRequest& request, co
 /// aspect ratio and blocks, the histograms of the compared metrics, and those
 /// of request.metric; it needs an X server (Error(IO) without one).
 const pipeline::FigureRenderer& compareFigureRenderer();
+
+/// The leaderboard's figure (compare --style all): the aspect-ratio maps of the
+/// observed parcels and of every style, small multiples on one scale, as
+/// leaderboard.png (rendered: needs an X server, started if none) and
+/// leaderboard.svg (vector paths). Returns the names written.
+std::vector<std::string> drawLeaderboard(const pipeline::Leaderboard& board, const CompareRequest& request,
+                                         const std::function<std::string(const std::string&)>& stage);
+
+/// pipeline::runLeaderboard with drawLeaderboard.
+pipeline::JobOutcome runLeaderboard(const CompareRequest& request, const std::string& outDir,
+                                    const ProgressFn& progress = {});
 
 /// pipeline::runCompare with compareFigureRenderer().
 pipeline::JobOutcome runCompare(const CompareRequest& request, const std::string& outDir,
