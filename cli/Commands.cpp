@@ -309,6 +309,7 @@ int generateCommand(const std::vector<std::string>& args) {
 int compareCommand(const std::vector<std::string>& args) {
   auto flags = inputFlags();
   flags.push_back(styleFlag());
+  flags.back().help += "\n      all: every style on the same blocks, a leaderboard (leaderboard.csv, ...)";
   {
     std::string help = "parcel quantity of the extra figures map_METRIC and hist_METRIC (default aspect_ratio):";
     for (const auto& q : analysis::parcelQuantities()) help += "\n      " + q.name + ": " + q.title;
