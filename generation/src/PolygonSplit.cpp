@@ -584,4 +584,116 @@ bool splitPieceIsSimple(const Ring& r, const Box& b, const Point& pivot, const P
   return true;
 }
 
+namespace {
+bool pointLess(const Point& a, const Point& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); }
+bool samePoint(const Point& a, const Point& b) { return a.x == b.x && a.y == b.y; }
+struct DirectedEdge {
+  Point from, to;
+};
+}  // namespace
+
+bool joinRingsFast(const std::vector<const Ring*>& parts, double tolerance, std::vector<Ring>& out) {
+  if (!(tolerance >= 0) || !std::isfinite(tolerance)) return false;
+  // Every vertex, by x, to find those lying on an edge.
+  thread_local std::vector<Point> points;
+  thread_local std::vector<DirectedEdge> edges;
+  thread_local std::vector<std::pair<double, Point>> inside;
+  points.clear();
+  edges.clear();
+  double partsArea = 0;
+  for (const Ring* r : parts) {
+    if (r->size() < 3) return false;
+    const double a = signedArea(*r);
+    if (!(a > 0)) return false;
+    partsArea += a;
+    points.insert(points.end(), r->begin(), r->end());
+  }
+  std::sort(points.begin(), points.end(), pointLess);
+  points.erase(std::unique(points.begin(), points.end(), samePoint), points.end());
+  for (const Ring* ring : parts) {
+    const Ring& r = *ring;
+    for (std::size_t i = 0, n = r.size(); i < n; ++i) {
+      const Point& a = r[i];
+      const Point& b = r[(i + 1) % n];
+      const double dx = b.x - a.x, dy = b.y - a.y, length = norm(dx, dy);
+      if (!(length > 0)) return false;
+      const double minX = std::min(a.x, b.x) - tolerance, maxX = std::max(a.x, b.x) + tolerance;
+      const double minY = std::min(a.y, b.y) - tolerance, maxY = std::max(a.y, b.y) + tolerance;
+      inside.clear();
+      auto q = std::lower_bound(points.begin(), points.end(), minX, [](const Point& p, double x) { return p.x < x; });
+      for (; q != points.end() && q->x <= maxX; ++q) {
+        if (q->y < minY || q->y > maxY || samePoint(*q, a) || samePoint(*q, b)) continue;
+        const double along = ((q->x - a.x) * dx + (q->y - a.y) * dy) / length;
+        const double off = std::fabs((q->y - a.y) * dx - (q->x - a.x) * dy) / length;
+        if (off <= tolerance && along > tolerance && along < length - tolerance) inside.push_back({along, *q});
+      }
+      std::sort(inside.begin(), inside.end(), [](const auto& x, const auto& y) {
+        return x.first < y.first || (x.first == y.first && pointLess(x.second, y.second));
+      });
+      Point from = a;
+      for (const auto& [along, p] : inside) {
+        if (samePoint(p, from)) continue;
+        edges.push_back({from, p});
+        from = p;
+      }
+      edges.push_back({from, b});
+    }
+  }
+  // Coinciding edges: in opposite directions they cancel; in the same
+  // direction, or more than two, the parts overlap.
+  auto key = [](const DirectedEdge& e) {
+    return pointLess(e.from, e.to) ? std::make_pair(e.from, e.to) : std::make_pair(e.to, e.from);
+  };
+  std::sort(edges.begin(), edges.end(), [&](const DirectedEdge& x, const DirectedEdge& y) {
+    const auto kx = key(x), ky = key(y);
+    if (!samePoint(kx.first, ky.first)) return pointLess(kx.first, ky.first);
+    return pointLess(kx.second, ky.second);
+  });
+  std::vector<DirectedEdge> kept;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i + 1;
+    const auto ki = key(edges[i]);
+    while (j < edges.size() && samePoint(key(edges[j]).first, ki.first) && samePoint(key(edges[j]).second, ki.second)) {
+      ++j;
+    }
+    if (j - i == 1) {
+      kept.push_back(edges[i]);
+    } else if (j - i != 2 || samePoint(edges[i].from, edges[i + 1].from)) {
+      return false;
+    }
+    i = j;
+  }
+  if (kept.empty()) return false;
+  std::sort(kept.begin(), kept.end(),
+            [](const DirectedEdge& x, const DirectedEdge& y) { return pointLess(x.from, y.from); });
+  for (std::size_t i = 1; i < kept.size(); ++i) {
+    if (samePoint(kept[i - 1].from, kept[i].from)) return false;  // two ways on: a pinch
+  }
+  std::vector<char> used(kept.size(), 0);
+  std::vector<Ring> rings;
+  double ringsArea = 0;
+  for (std::size_t first = 0; first < kept.size(); ++first) {
+    if (used[first]) continue;
+    Ring ring;
+    std::size_t at = first;
+    do {
+      if (used[at]) return false;  // a vertex reached twice: rings touching
+      used[at] = 1;
+      ring.push_back(kept[at].from);
+      const Point& to = kept[at].to;
+      const auto it = std::lower_bound(kept.begin(), kept.end(), to,
+                                       [](const DirectedEdge& e, const Point& p) { return pointLess(e.from, p); });
+      if (it == kept.end() || !samePoint(it->from, to)) return false;
+      at = static_cast<std::size_t>(it - kept.begin());
+    } while (at != first);
+    const double a = signedArea(ring);
+    if (!(a > 0)) return false;  // a hole
+    ringsArea += a;
+    rings.push_back(std::move(ring));
+  }
+  if (!(std::fabs(ringsArea - partsArea) <= 1e-9 * partsArea)) return false;
+  out = std::move(rings);
+  return true;
+}
+
 }  // namespace parcelscope::generation::detail

@@ -45,6 +45,18 @@ SplitPieces splitByLine(const Polygon& polygon, const Point& pivot, const Point&
 /// be used.
 bool splitByLineFast(const Polygon& polygon, const Point& pivot, const Point& dir, SplitPieces& out);
 
+/// The union of interior-disjoint counter-clockwise rings without holes that
+/// meet along shared edges, in floating point: edges are split at every vertex
+/// of the parts lying on them (within `tolerance` of the edge, further than it
+/// from its ends: T-junctions), edges that coincide (same end points, bit for
+/// bit) in opposite directions cancel, and the rest is linked into rings. The
+/// union's components (counter-clockwise, sharing no vertex) go to `out`.
+/// False, with `out` untouched, when the rest does not link into such rings (a
+/// hole, two parts touching at a point, an edge repeated: overlapping parts)
+/// or when the rings' area is not the parts' (to 1e-9): then the exact join
+/// must be used.
+bool joinRingsFast(const std::vector<const Ring*>& parts, double tolerance, std::vector<Ring>& out);
+
 /// True when the edge y-z returns along the edge x-y (they overlap past y):
 /// opposite directions, parallel to 1e-9 of their lengths' product.
 inline bool foldsBack(const Point& x, const Point& y, const Point& z) {

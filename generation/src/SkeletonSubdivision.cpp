@@ -242,11 +242,13 @@ struct Strip {
 };
 
 struct Candidate {
-  PWH shape;
+  PWH shape;     // exact route
+  Polygon fast;  // floating-point route: the shape as cut and joined in doubles (no holes)
   Polygon rounded;
   double area = 0;
   bool access = false;
-  bool stuck = false;  // no neighbour it could merge into
+  bool triangular = false;  // of the rounded shape (SkeletonBuilder::triangular)
+  bool stuck = false;       // no neighbour it could merge into
 };
 
 // Step 1 for one chord tolerance: the contour edges and the skeleton.
@@ -264,7 +266,15 @@ struct StripStage {
   std::vector<Region> regions;
   Region patios;
   std::vector<Strip> strips;
+  // The regions rounded to doubles, one counter-clockwise strictly simple ring
+  // per part, for the floating-point route of steps 4 and 5; null when that
+  // route does not apply (patios, a part with holes or not simple once rounded).
+  std::shared_ptr<const std::vector<std::vector<Ring>>> fastRegions;
 };
+
+// The floating-point route of steps 4 and 5 could not certify a step: the
+// block's steps 4 and 5 run again on the exact route.
+struct NeedExact {};
 
 // What one try (chord tolerance) has built so far and can hand to a later run.
 struct LayoutAttempt {
@@ -302,8 +312,15 @@ void dropMicroFeatures(Polygon& p, double eps) {
 class SkeletonBuilder {
 public:
   SkeletonBuilder(const Polygon& block, const SkeletonParameters& p, const detail::Rng& rng, const StreetWidths& widths,
-                  double chordTolerance)
-      : block_(block), outline_{block.outer, {}}, p_(p), rng_(rng), widths_(widths), chordTolerance_(chordTolerance) {
+                  double chordTolerance, bool exactOnly)
+      : block_(block),
+        outline_{block.outer, {}},
+        p_(p),
+        rng_(rng),
+        rngStart_(rng),
+        widths_(widths),
+        chordTolerance_(chordTolerance),
+        exactOnly_(exactOnly) {
     const Box b = bounds(block);
     size_ = b.width() + b.height();
     reach_ = 4.0 * size_ + 1.0;
@@ -315,12 +332,10 @@ public:
   // Runs every step; `memo` gives steps 1-3 when an earlier run built them
   // for this try, and receives them when this run builds them and `record`.
   void run(Subdivision& out, LayoutAttempt& memo, bool record) {
-    if (memo.skeleton) {
+    if (memo.skeleton) {  // its vertices and faces are copied only if steps 1-3 run again (below)
       const SkeletonStage& k = *memo.skeleton;
       edges_ = k.edges;
       ringStart_ = k.ringStart;
-      vertices_ = k.vertices;
-      faces_ = k.faces;
       maxTime_ = k.maxTime;
     } else {
       buildEdges();
@@ -330,21 +345,57 @@ public:
             std::make_shared<const SkeletonStage>(SkeletonStage{edges_, ringStart_, vertices_, faces_, maxTime_});
       }
     }
-    const double depth = maxTime_;
-    if (depth < p_.bounds.wMin) {
-      singleRow();
-    } else {
-      if (memo.strips) {
-        regions_ = memo.strips->regions;
-        patios_ = memo.strips->patios;
-        strips_ = memo.strips->strips;
-      } else {
+    const bool oneRow = maxTime_ < p_.bounds.wMin;
+    std::shared_ptr<const StripStage> stage;
+    if (!oneRow) {
+      stage = memo.strips;
+      if (!stage) {
+        if (memo.skeleton && faces_.empty()) {
+          vertices_ = memo.skeleton->vertices;
+          faces_ = memo.skeleton->faces;
+        }
         buildRegions();
         buildStrips();
         fixDiagonals();
         settle();
-        if (record) memo.strips = std::make_shared<const StripStage>(StripStage{regions_, patios_, strips_});
+        auto built = std::make_shared<StripStage>(
+            StripStage{std::move(regions_), std::move(patios_), std::move(strips_), nullptr});
+        built->fastRegions = roundedRegions(*built);
+        stage = std::move(built);
+        if (record) memo.strips = stage;
       }
+      strips_ = stage->strips;
+    }
+    // Steps 4 and 5 in floating point when the block or its strips allow it,
+    // certified step by step; on the exact route when a certificate fails.
+    const bool fastApplies = !exactOnly_ && (oneRow ? block_.holes.empty() && detail::isStrictlySimple(block_.outer)
+                                                    : stage->fastRegions != nullptr);
+    if (fastApplies) {
+      try {
+        fast_ = true;
+        if (oneRow) {
+          singleRowFast();
+        } else {
+          fastRegions_ = stage->fastRegions.get();
+          for (Strip& s : strips_) sliceFast(s);
+          backRegionsFast();
+        }
+        splitLarge();
+        mergeSmall();
+        emit(out);
+        return;
+      } catch (const NeedExact&) {
+        fast_ = false;
+        parcels_.clear();
+        rng_ = rngStart_;
+      }
+    }
+    out.skeletonExact = true;
+    if (oneRow) {
+      singleRow();
+    } else {
+      regions_ = stage->regions;
+      patios_ = stage->patios;
       for (Strip& s : strips_) slice(s);
       backRegions();
     }
@@ -919,6 +970,128 @@ private:
     for (const Region& r : pieces) addCandidates(detail::join(r));
   }
 
+  // ---- 4 and 5 in floating point ----------------------------------------------
+  // The floating-point route cuts and joins the regions rounded to doubles
+  // (splitByLineFast, joinRingsFast): every cut point is computed once and
+  // shared by the pieces on both sides, so the pieces still tile, and each
+  // step is certified (a piece strictly simple, splitPieceIsSimple; a union
+  // made of rings whose area is the parts'); a step that cannot be certified
+  // throws NeedExact. Its parcels differ from the exact route's by the
+  // rounding of the cut points (some 1e-16 of the coordinates).
+
+  // The strips' regions rounded to doubles; null when the route does not
+  // apply: the block has patios (joined exactly, step 1), or a region part has
+  // holes, vanishes, or is not strictly simple once rounded.
+  static std::shared_ptr<const std::vector<std::vector<Ring>>> roundedRegions(const StripStage& stage) {
+    if (!stage.patios.empty()) return nullptr;
+    auto out = std::make_shared<std::vector<std::vector<Ring>>>(stage.regions.size());
+    for (std::size_t g = 0; g < stage.regions.size(); ++g) {
+      for (const PWH& part : stage.regions[g]) {
+        Polygon q;
+        if (part.has_holes() || !detail::toDouble(part, q) || !detail::isStrictlySimple(q.outer)) return nullptr;
+        (*out)[g].push_back(std::move(q.outer));
+      }
+    }
+    return out;
+  }
+
+  // splitByLineFast of a ring, its pieces certified strictly simple.
+  static void splitFast(const Ring& ring, const Point& through, const Point& dir, detail::SplitPieces& split) {
+    if (!detail::splitByLineFast(Polygon{ring, {}}, through, dir, split) || split.pinched) throw NeedExact{};
+    for (const auto* side : {&split.left, &split.right}) {
+      for (const Polygon& q : *side) {
+        if (!q.holes.empty() || !detail::splitPieceIsSimple(q.outer, bounds(q.outer), through, dir)) throw NeedExact{};
+      }
+    }
+  }
+
+  std::vector<Ring> joinFast(const std::vector<const Ring*>& parts) const {
+    if (parts.size() == 1) return {*parts[0]};
+    std::vector<Ring> out;
+    if (parts.empty()) return out;
+    if (!detail::joinRingsFast(parts, 1e-9 * size_, out)) throw NeedExact{};
+    return out;
+  }
+
+  // slice() on the floating-point route.
+  void sliceFast(const Strip& s) {
+    const std::vector<double> cuts = cutPositions(s.start, s.end);
+    std::vector<std::vector<Ring>> pieces(cuts.size() + 1);
+    double at = 0;
+    std::size_t before = 0;  // cuts before the current edge
+    std::vector<Ring> rest, next;
+    for (int g : s.edges) {
+      const Edge& e = edges_[g];
+      rest = (*fastRegions_)[g];
+      std::size_t k = before;
+      const Point inward{e.a.y - e.b.y, e.b.x - e.a.x};
+      for (; k < cuts.size() && cuts[k] < at + e.length; ++k) {
+        if (rest.empty()) continue;
+        const double t = std::clamp((cuts[k] - at) / e.length, 0.0, 1.0);
+        const Point o{e.a.x + (e.b.x - e.a.x) * t, e.a.y + (e.b.y - e.a.y) * t};
+        next.clear();
+        for (const Ring& r : rest) {
+          detail::SplitPieces split;
+          splitFast(r, o, inward, split);
+          for (Polygon& q : split.left) pieces[k].push_back(std::move(q.outer));
+          for (Polygon& q : split.right) next.push_back(std::move(q.outer));
+        }
+        rest.swap(next);
+      }
+      for (Ring& r : rest) pieces[k].push_back(std::move(r));
+      before = k;
+      at += e.length;
+    }
+    std::vector<const Ring*> parts;
+    for (const std::vector<Ring>& r : pieces) {
+      parts.clear();
+      for (const Ring& q : r) parts.push_back(&q);
+      for (Ring& u : joinFast(parts)) addFastCandidate(std::move(u));
+    }
+  }
+
+  // singleRow() on the floating-point route, for a block without holes.
+  void singleRowFast() {
+    const OrientedBox box = minimumAreaBox(block_.outer);
+    const Point u = box.u, across{-u.y, u.x};
+    std::vector<Ring> rest{block_.outer}, next;
+    const double start = -0.5 * box.length;
+    for (double c : cutPositions(start, -start)) {
+      const Point o{box.center.x + u.x * c, box.center.y + u.y * c};
+      next.clear();
+      for (const Ring& r : rest) {
+        detail::SplitPieces split;
+        splitFast(r, o, across, split);
+        for (Polygon& q : split.left) addFastCandidate(std::move(q.outer));
+        for (Polygon& q : split.right) next.push_back(std::move(q.outer));
+      }
+      rest.swap(next);
+    }
+    for (Ring& r : rest) addFastCandidate(std::move(r));
+  }
+
+  void backRegionsFast() {
+    for (std::size_t g = static_cast<std::size_t>(ringStart_[1]); g < edges_.size(); ++g) {
+      for (const Ring& r : (*fastRegions_)[g]) addFastCandidate(r);
+    }
+  }
+
+  bool makeFastCandidate(Ring shape, Candidate& c) const {
+    c.fast = Polygon{std::move(shape), {}};
+    c.rounded = c.fast;
+    dropMicroFeatures(c.rounded, 1e-9 * size_);
+    if (!normalise(c.rounded)) return false;
+    c.area = area(c.rounded);
+    c.access = hasAccess(c.rounded);
+    c.triangular = triangular(c.rounded);
+    return true;
+  }
+
+  void addFastCandidate(Ring shape) {
+    Candidate c;
+    if (makeFastCandidate(std::move(shape), c)) parcels_.push_back(std::move(c));
+  }
+
   // Faces along holes: no street, merged into their neighbours afterwards.
   // Face by face, so that each merges into the parcel behind it rather than
   // one ring of back land wrapping the hole.
@@ -954,6 +1127,7 @@ private:
     if (!rounded(c.shape, c.rounded)) return false;
     c.area = area(c.rounded);
     c.access = hasAccess(c.rounded);
+    c.triangular = triangular(c.rounded);
     return true;
   }
 
@@ -991,13 +1165,24 @@ private:
       for (int attempt = 0; attempt < 8 && parcels_[i].area > p_.bounds.aMax; ++attempt) {
         Point x, y;
         if (!parcels_[i].access || !longestFrontage(parcels_[i].rounded, x, y)) break;
-        const K::Point_2 mid(0.5 * (x.x + y.x), 0.5 * (x.y + y.y));
-        const K::Vector_2 inward(x.y - y.y, y.x - x.x);
-        const Region left = detail::clipLeft(parcels_[i].shape, mid, inward, reach_);
-        const Region right = detail::clipLeft(parcels_[i].shape, mid, -inward, reach_);
-        if (left.size() != 1 || right.size() != 1) break;
         Candidate l, r;
-        if (!makeCandidate(left[0], l) || !makeCandidate(right[0], r)) break;
+        if (fast_) {
+          const Point mid{0.5 * (x.x + y.x), 0.5 * (x.y + y.y)}, inward{x.y - y.y, y.x - x.x};
+          detail::SplitPieces split;
+          splitFast(parcels_[i].fast.outer, mid, inward, split);
+          if (split.left.size() != 1 || split.right.size() != 1) break;
+          if (!makeFastCandidate(std::move(split.left[0].outer), l) ||
+              !makeFastCandidate(std::move(split.right[0].outer), r)) {
+            break;
+          }
+        } else {
+          const K::Point_2 mid(0.5 * (x.x + y.x), 0.5 * (x.y + y.y));
+          const K::Vector_2 inward(x.y - y.y, y.x - x.x);
+          const Region left = detail::clipLeft(parcels_[i].shape, mid, inward, reach_);
+          const Region right = detail::clipLeft(parcels_[i].shape, mid, -inward, reach_);
+          if (left.size() != 1 || right.size() != 1) break;
+          if (!makeCandidate(left[0], l) || !makeCandidate(right[0], r)) break;
+        }
         auto fine = [&](const Candidate& c) {
           return c.access && c.area >= p_.bounds.aMin && minimumAreaBox(c.rounded.outer).width >= p_.bounds.wMin;
         };
@@ -1037,7 +1222,7 @@ private:
       int worst = -1;
       for (std::size_t i = 0; i < parcels_.size(); ++i) {
         const Candidate& c = parcels_[i];
-        if (c.stuck || !(c.area < p_.bounds.aMin || !c.access || triangular(c.rounded))) continue;
+        if (c.stuck || !(c.area < p_.bounds.aMin || !c.access || c.triangular)) continue;
         if (worst < 0 || c.area < parcels_[worst].area) worst = static_cast<int>(i);
       }
       if (worst < 0) return;
@@ -1052,10 +1237,17 @@ private:
       std::sort(neighbours.begin(), neighbours.end());
       bool merged = false;
       for (const auto& [negShared, j] : neighbours) {
-        const Region u = detail::join({parcels_[worst].shape, parcels_[j].shape});
         Candidate c;
-        // One piece, whose holes are the block's (not two parcels closing around a third).
-        if (u.size() != 1 || !makeCandidate(u[0], c) || !holesAreTheBlocks(c.rounded)) continue;
+        if (fast_) {
+          // A union with a hole (around a third parcel or the block's hole)
+          // is left to the exact route.
+          std::vector<Ring> u = joinFast({&parcels_[worst].fast.outer, &parcels_[j].fast.outer});
+          if (u.size() != 1 || !makeFastCandidate(std::move(u[0]), c)) continue;
+        } else {
+          const Region u = detail::join({parcels_[worst].shape, parcels_[j].shape});
+          // One piece, whose holes are the block's (not two parcels closing around a third).
+          if (u.size() != 1 || !makeCandidate(u[0], c) || !holesAreTheBlocks(c.rounded)) continue;
+        }
         parcels_[j] = std::move(c);
         parcels_.erase(parcels_.begin() + worst);
         merged = true;
@@ -1124,8 +1316,12 @@ private:
   Polygon outline_;
   SkeletonParameters p_;
   detail::Rng rng_;
+  const detail::Rng rngStart_;  // rng_ before step 4, for the exact route after a failed certificate
   const StreetWidths& widths_;
   double chordTolerance_ = 0;
+  bool exactOnly_ = false;
+  bool fast_ = false;  // steps 4 and 5 on the floating-point route
+  const std::vector<std::vector<Ring>>* fastRegions_ = nullptr;
   double size_ = 0, reach_ = 0, accessTolerance_ = 0, target_ = 0, maxTime_ = 0;
   std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;  // outline_, for the access test
   std::vector<Edge> edges_;
@@ -1154,7 +1350,9 @@ void finish(const Polygon& block, const Point& o, Subdivision& out, double minFr
     // A parcel of no width (all corridor) vanishes; the area check below
     // catches anything of substance lost.
     if (!normalise(parcel)) continue;
-    std::vector<Polygon> parts = geos::validParts(parcel);
+    // A ring clearly simple (floating-point test with a margin) is valid as it is.
+    std::vector<Polygon> parts =
+        parcel.holes.empty() && isClearlySimple(parcel.outer) ? std::vector<Polygon>{parcel} : geos::validParts(parcel);
     double partsArea = 0;
     for (const Polygon& q : parts) partsArea += area(q);
     if (std::fabs(partsArea - area(parcel)) > 1e-9 * area(parcel)) throw Fallback("a parcel is not valid once rounded");
@@ -1243,7 +1441,7 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
       try {
         out = Subdivision{};
         SkeletonBuilder(local, p, detail::Rng{detail::splitmix64(seed ^ 0x5EC0DE)}, streetWidths,
-                        kChordTolerances[attempt])
+                        kChordTolerances[attempt], reuse.exactOnly)
             .run(out, layout->attempts[attempt], reuse.record);
         break;
       } catch (const SkeletonFolds&) {

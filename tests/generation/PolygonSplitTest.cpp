@@ -397,5 +397,48 @@ TEST(PolygonSplit, PieceEdgesCrossingOrNearlyTouchingAreNotProvenSimple) {
   EXPECT_FALSE(proven({{0, 0}, {10, 0}, {5, 0}, {5, 5}}));
 }
 
+// The floating-point union of the skeleton style's pieces: shared edges
+// cancel, T-junctions are split, and what it cannot certify it declines.
+TEST(PolygonSplit, FastJoinDissolvesSharedEdgesAndTJunctions) {
+  const Ring a{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, b{{1, 0}, {2, 0}, {2, 1}, {1, 1}};
+  std::vector<Ring> out;
+  ASSERT_TRUE(joinRingsFast({&a, &b}, 1e-9, out));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_DOUBLE_EQ(signedArea(out[0]), 2.0);
+  EXPECT_EQ(out[0].size(), 6u);  // the shared edge's ends stay as (collinear) vertices
+  // T-junctions: a 1 by 2 rectangle beside two unit squares, and a crossing
+  // point rounded off the edge by less than the tolerance.
+  const Ring tall{{0, 0}, {1, 0}, {1, 2}, {0, 2}}, low{{1, 0}, {2, 0}, {2, 1.0000000000001}, {1, 1.0000000000001}},
+      high{{1, 1.0000000000001}, {2, 1.0000000000001}, {2, 2}, {1, 2}};
+  ASSERT_TRUE(joinRingsFast({&tall, &low, &high}, 1e-9, out));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_NEAR(signedArea(out[0]), 4.0, 1e-12);
+  // Separate parts: two rings.
+  const Ring far{{5, 0}, {6, 0}, {6, 1}, {5, 1}};
+  ASSERT_TRUE(joinRingsFast({&a, &far}, 1e-9, out));
+  EXPECT_EQ(out.size(), 2u);
+}
+
+TEST(PolygonSplit, FastJoinDeclinesHolesPinchesAndOverlaps) {
+  std::vector<Ring> out{{{9, 9}, {10, 9}, {10, 10}}};
+  const std::vector<Ring> before = out;
+  // Four parts around a hole.
+  const Ring s{{0, 0}, {3, 0}, {3, 1}, {0, 1}}, e{{2, 1}, {3, 1}, {3, 3}, {2, 3}}, n{{0, 2}, {2, 2}, {2, 3}, {0, 3}},
+      w{{0, 1}, {1, 1}, {1, 2}, {0, 2}};
+  EXPECT_FALSE(joinRingsFast({&s, &e, &n, &w}, 1e-9, out));
+  // Two squares touching at a corner.
+  const Ring a{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, c{{1, 1}, {2, 1}, {2, 2}, {1, 2}};
+  EXPECT_FALSE(joinRingsFast({&a, &c}, 1e-9, out));
+  // Overlapping parts: a repeated edge, or the area of the rings not the parts'.
+  EXPECT_FALSE(joinRingsFast({&a, &a}, 1e-9, out));
+  const Ring shifted{{0.5, 0}, {1.5, 0}, {1.5, 1}, {0.5, 1}};
+  EXPECT_FALSE(joinRingsFast({&a, &shifted}, 1e-9, out));
+  // A clockwise part.
+  const Ring clockwise{{0, 0}, {0, 1}, {1, 1}, {1, 0}};
+  EXPECT_FALSE(joinRingsFast({&clockwise}, 1e-9, out));
+  ASSERT_EQ(out.size(), before.size());  // untouched
+  EXPECT_TRUE(sameRing(out[0], before[0], 0));
+}
+
 }  // namespace
 }  // namespace parcelscope::generation::detail

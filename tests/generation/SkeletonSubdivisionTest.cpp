@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "TestUtil.h"
@@ -299,6 +300,56 @@ TEST(SkeletonSubdivision, RandomShapesAreTiledValidlyWithStreetAccess) {
               parcels, patios, fallbacks, withoutAccess);
   EXPECT_EQ(withoutAccess, 0);
   EXPECT_LE(fallbacks, kRandomShapes / 20);  // the skeleton route handles at least 95 %
+}
+
+// Steps 4 and 5 run in floating point (splitByLineFast, joinRingsFast) with
+// the exact route as fallback: on random shapes both routes give the same
+// parcels up to the rounding of the cut points, and every parcel set tiles.
+TEST(SkeletonSubdivision, FloatingPointRouteAgreesWithTheExactRoute) {
+  std::mt19937_64 rng = test::seededRandom(20261127, "fast and exact routes");
+  int blocks = 0, fastBlocks = 0, identical = 0, parcels = 0;
+  for (int i = 0; i < 300 / test::kSanitizerDivisor; ++i) {
+    const Polygon block = test::randomShape(rng, i % test::kShapeKinds);
+    const double a = area(block);
+    const SkeletonParameters p = randomParameters(rng, a, i % 4 == 0, i % 8 == 0, i % 2 != 0);
+    const std::uint64_t s = rng();
+    const Subdivision fast = subdivideSkeleton(block, p, s);
+    SkeletonReuse exactOnly;
+    exactOnly.exactOnly = true;
+    const Subdivision exact = subdivideSkeleton(block, p, s, {}, exactOnly);
+    const std::string what = "shape " + std::to_string(i);
+    ASSERT_EQ(fast.fallback, exact.fallback) << what;
+    if (fast.fallback) continue;
+    ++blocks;
+    EXPECT_TRUE(exact.skeletonExact) << what;
+    if (fast.patioParcels > 0) EXPECT_TRUE(fast.skeletonExact) << what << ": patios are joined exactly";
+    fastBlocks += !fast.skeletonExact;
+    EXPECT_TILES(block, fast.parcels, what);
+    ASSERT_EQ(fast.parcels.size(), exact.parcels.size()) << what;
+    EXPECT_EQ(fast.withoutAccess, exact.withoutAccess) << what;
+    EXPECT_EQ(fast.oversize, exact.oversize) << what;
+    const Box b = bounds(block);
+    const double tolerance = 1e-9 * (b.width() + b.height());
+    for (std::size_t k = 0; k < fast.parcels.size(); ++k) {
+      const Polygon &x = fast.parcels[k], &y = exact.parcels[k];
+      EXPECT_NEAR(area(x), area(y), 1e-9 * a) << what << " parcel " << k;
+      // Every vertex of one within the tolerance of the other's boundary.
+      for (const auto& [from, to] : {std::pair{&x, &y}, std::pair{&y, &x}}) {
+        for (const Point& v : from->outer) {
+          double d = std::numeric_limits<double>::infinity();
+          for (std::size_t j = 0, n = to->outer.size(); j < n; ++j) {
+            d = std::min(d, pointSegmentDistance(v, to->outer[j], to->outer[(j + 1) % n]));
+          }
+          EXPECT_LE(d, tolerance) << what << " parcel " << k;
+        }
+      }
+      identical += sameVertices(x, y);
+      ++parcels;
+    }
+  }
+  std::printf("%d blocks, %d on the floating-point route, %d of %d parcels identical to the exact route's\n", blocks,
+              fastBlocks, identical, parcels);
+  EXPECT_GT(fastBlocks, blocks * 3 / 4);
 }
 
 void expectSameSubdivision(const Subdivision& a, const Subdivision& b, const std::string& what) {

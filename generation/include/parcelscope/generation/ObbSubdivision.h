@@ -66,6 +66,10 @@ struct Subdivision {
   /// when not, -1 when it was not tested (for ObbReuse::blockSimple).
   signed char blockSimple = -1;
   std::shared_ptr<const SkeletonLayout> skeletonLayout;  ///< skeleton styles only, when asked to record it
+  /// Skeleton styles only: steps 4 and 5 ran on the exact route (the block has
+  /// patios, or the floating-point route could not certify a step, or
+  /// SkeletonReuse::exactOnly).
+  bool skeletonExact = false;
 };
 
 /// Splits to reuse and whether to record this run's.

@@ -92,6 +92,9 @@ struct SkeletonReuse {
   /// only with the same d_offset, street angle and corner rule.
   const SkeletonLayout* previous = nullptr;
   bool record = false;  ///< keep this run's layout (with what it reused) in Subdivision::skeletonLayout
+  /// Steps 4 and 5 on the exact route only, never in floating point (for
+  /// tests comparing the two routes).
+  bool exactOnly = false;
 };
 
 /// True when the strips of a layout recorded with `recorded` serve a run with
