@@ -237,9 +237,9 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
 CompareResult compare(const CompareRequest& request, const ProgressFn& progress) {
   detail::checkRequest(request);
   return compare(request,
-                 std::make_shared<const pipeline::ObservedData>(pipeline::loadObservedInStreetBlocks(
-                     request.input, request.streets ? &*request.streets : nullptr, request.parameters,
-                     scaledProgress(progress, 0.0, 0.45))),
+                 std::make_shared<const pipeline::ObservedData>(
+                     pipeline::loadObservedInStreetBlocks(request.input, request.streets ? &*request.streets : nullptr,
+                                                          request.parameters, scaledProgress(progress, 0.0, 0.45))),
                  scaledProgress(progress, 0.45, 1.0));
 }
 
