@@ -324,6 +324,10 @@ public:
     const Box b = bounds(block);
     size_ = b.width() + b.height();
     reach_ = 4.0 * size_ + 1.0;
+    // Candidates are copied, not moved, when the vector grows (CGAL's
+    // polygons): room for the street parcels, about twice over.
+    const double expected = perimeter(outline_) / (0.5 * (p.bounds.wMin + p.bounds.wMax));
+    parcels_.reserve(16 + (expected < kMaxStripParcels ? static_cast<std::size_t>(2.0 * expected) : 0));
     accessTolerance_ = std::max(1e-6, 1e-9 * size_);
     outlineEdges_ = std::make_unique<analysis::PreparedBoundary>(outline_, accessTolerance_);
     target_ = 0.5 * (p.bounds.wMin + p.bounds.wMax);
@@ -1381,6 +1385,7 @@ struct SkeletonLayout {
   StreetWidths widths;
   SkeletonParameters parameters;
   std::array<LayoutAttempt, std::size(kChordTolerances)> attempts;  // by try
+  bool blockValid = false;  // the block passed the validity check (not made again for it)
 };
 
 namespace {
@@ -1416,7 +1421,8 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
   p.bounds.wMax = std::max(p.bounds.wMax, p.bounds.wMin);
   auto layout = std::make_shared<SkeletonLayout>();
   const SkeletonLayout* previous = reuse.previous;
-  if (previous && sameBlock(previous->block, block) && sameStreetWidths(previous->widths, streetWidths)) {
+  const bool sameBlockAsBefore = previous && sameBlock(previous->block, block);
+  if (sameBlockAsBefore && sameStreetWidths(previous->widths, streetWidths)) {
     layout->attempts = previous->attempts;
     // The skeleton (step 1) depends on the block and widths alone; the strips
     // also on d_offset, the street angle and the corner rule.
@@ -1434,9 +1440,11 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
   Subdivision out;
   std::string reason;
   try {
-    if (!normalise(local) || !detail::isValidForSplit(local)) {
+    const bool checked = sameBlockAsBefore && previous->blockValid;
+    if (!normalise(local) || (!checked && !detail::isValidForSplit(local))) {
       throw Fallback("the block is not a valid polygon with holes");
     }
+    layout->blockValid = true;
     for (std::size_t attempt = 0;; ++attempt) {
       try {
         out = Subdivision{};
