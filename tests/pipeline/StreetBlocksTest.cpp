@@ -149,7 +149,8 @@ TEST_P(StreetBlockStyles, CambridgeStreetBlocksAreTiledValidlyWithStreetAccess) 
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Styles, StreetBlockStyles, ::testing::Values("obb", "skeleton"));
+INSTANTIATE_TEST_SUITE_P(Styles, StreetBlockStyles, ::testing::Values("obb", "skeleton"),
+                         [](const auto& param) { return std::string(param.param); });
 
 }  // namespace
 }  // namespace parcelscope::pipeline
