@@ -178,8 +178,8 @@ std::vector<int> joinEndpoints(std::vector<Polyline>& lines, double snap, std::i
 // Moves each free end (an endpoint no other endpoint joined) within `snap` of
 // another line onto its nearest point there, a little past it so that the
 // noding finds the crossing.
-void endsOntoLines(std::vector<Polyline>& lines, const std::vector<int>& clusterSize, double snap,
-                   std::int64_t& moved) {
+void endsOntoLines(std::vector<Polyline>& lines, const std::vector<int>& clusterSize, const std::vector<char>& apart,
+                   double snap, std::int64_t& moved) {
   std::vector<const Polyline*> pointers;
   for (const Polyline& l : lines) pointers.push_back(&l);
   const SegmentTree tree = segmentTree(pointers);
@@ -189,14 +189,20 @@ void endsOntoLines(std::vector<Polyline>& lines, const std::vector<int>& cluster
     if (own.size() < 2 || clusterSize[e] != 1) continue;
     const Point p = e % 2 ? own.back() : own.front();
     const Point inner = e % 2 ? own[own.size() - 2] : own[1];
+    // Its own line only where it is more than the snap distance away along
+    // it: segments starting (from this end) within that path length are skipped.
+    std::vector<double> fromEnd(own.size(), 0);  // path length from this end to vertex i
+    for (std::size_t k = 1; k < own.size(); ++k) {
+      const std::size_t i = e % 2 ? own.size() - 1 - k : k, prev = e % 2 ? i + 1 : i - 1;
+      fromEnd[i] = fromEnd[prev] + distance(own[i], own[prev]);
+    }
     double best = std::numeric_limits<double>::infinity();
     Point target{};
     for (auto it = tree.qbegin(bgi::intersects(boxAround(p, p, snap))); it != tree.qend(); ++it) {
       const auto [l, i] = it->second;
       if (static_cast<std::size_t>(l) == e / 2) {
-        // Its own line only beyond the segment at this end.
-        const int adjacent = e % 2 ? static_cast<int>(own.size()) - 2 : 0;
-        if (i == adjacent) continue;
+        const std::size_t near = e % 2 ? static_cast<std::size_t>(i) + 1 : static_cast<std::size_t>(i);
+        if (fromEnd[near] <= snap) continue;
       }
       const Polyline& line = lines[static_cast<std::size_t>(l)];
       const Point q = nearestOnSegment(p, line[static_cast<std::size_t>(i)], line[static_cast<std::size_t>(i) + 1]);
@@ -207,9 +213,11 @@ void endsOntoLines(std::vector<Polyline>& lines, const std::vector<int>& cluster
       }
     }
     if (!(best <= snap) || best <= 0) continue;
-    // Past the line by a grid step, along the end's own direction to it.
+    // Past the line by a grid step, along the end's own direction to it, so
+    // that the noding finds the crossing; a line kept apart (a bridge) ends on
+    // it, and the line is cut there (splitAt).
     const double dx = target.x - inner.x, dy = target.y - inner.y, d = std::hypot(dx, dy);
-    if (d > 0) target = {target.x + 2 * kGrid * dx / d, target.y + 2 * kGrid * dy / d};
+    if (d > 0 && !apart[e / 2]) target = {target.x + 2 * kGrid * dx / d, target.y + 2 * kGrid * dy / d};
     moves.push_back({e, target});
   }
   for (const auto& [e, target] : moves) {
@@ -221,28 +229,58 @@ void endsOntoLines(std::vector<Polyline>& lines, const std::vector<int>& cluster
 
 // Splits `pieces` at the points of `at` that lie inside one of their segments
 // (within the noding grid), so that lines kept apart (bridges) still meet the
-// network at their ends.
+// network at their ends; each point is first put on the noding grid, where the
+// bridge's own end lies.
 void splitAt(std::vector<Polyline>& pieces, const std::vector<Point>& at) {
-  for (const Point& p : at) {
-    for (std::size_t k = 0; k < pieces.size(); ++k) {
-      Polyline& line = pieces[k];
+  std::vector<const Polyline*> pointers;
+  for (const Polyline& l : pieces) pointers.push_back(&l);
+  const SegmentTree tree = segmentTree(pointers);
+  struct Cut {
+    std::size_t segment;
+    double t;
+    Point at;
+  };
+  std::map<std::size_t, std::vector<Cut>> cuts;  // by piece
+  for (const Point& raw : at) {
+    const Point p{std::round(raw.x / kGrid) * kGrid, std::round(raw.y / kGrid) * kGrid};
+    for (auto it = tree.qbegin(bgi::intersects(boxAround(p, p, kGrid))); it != tree.qend(); ++it) {
+      const auto [l, i] = it->second;
+      const Polyline& line = pieces[static_cast<std::size_t>(l)];
       if (distance(line.front(), p) <= kGrid || distance(line.back(), p) <= kGrid) continue;
-      for (std::size_t i = 0; i + 1 < line.size(); ++i) {
-        double t = 0;
-        const Point q = nearestOnSegment(p, line[i], line[i + 1], &t);
-        if (distance(p, q) > kGrid) continue;
-        Polyline first(line.begin(), line.begin() + static_cast<long>(i) + 1), second;
-        first.push_back(p);
-        second.push_back(p);
-        second.insert(second.end(), line.begin() + static_cast<long>(i) + 1, line.end());
-        if (distance(first[first.size() - 2], p) <= kGrid) first.erase(first.end() - 2);
-        if (distance(second[1], p) <= kGrid) second.erase(second.begin() + 1);
-        if (first.size() < 2 || second.size() < 2) break;
-        line = std::move(first);
-        pieces.push_back(std::move(second));
-        break;
+      double t = 0;
+      const Point q = nearestOnSegment(p, line[static_cast<std::size_t>(i)], line[static_cast<std::size_t>(i) + 1], &t);
+      if (distance(p, q) <= kGrid) cuts[static_cast<std::size_t>(l)].push_back({static_cast<std::size_t>(i), t, p});
+    }
+  }
+  for (auto& [k, list] : cuts) {
+    std::sort(list.begin(), list.end(), [](const Cut& a, const Cut& b) {
+      return a.segment < b.segment || (a.segment == b.segment && a.t < b.t);
+    });
+    const Polyline line = pieces[k];
+    std::vector<Polyline> parts(1);
+    std::size_t next = 0;
+    for (std::size_t i = 0; i < line.size(); ++i) {
+      parts.back().push_back(line[i]);
+      for (; next < list.size() && list[next].segment == i; ++next) {
+        const Point& p = list[next].at;
+        if (distance(parts.back().back(), p) <= kGrid)
+          parts.back().back() = p;
+        else
+          parts.back().push_back(p);
+        if (parts.back().size() >= 2) parts.push_back({p});
       }
     }
+    if (parts.back().size() >= 2 && distance(parts.back()[parts.back().size() - 2], line.back()) <= kGrid &&
+        parts.back().size() == 2 && parts.size() > 1) {
+      parts.pop_back();  // a cut at the very end
+    }
+    std::vector<Polyline> kept;
+    for (Polyline& part : parts) {
+      if (part.size() >= 2 && length(part) > 0) kept.push_back(std::move(part));
+    }
+    if (kept.empty()) continue;
+    pieces[k] = std::move(kept.front());
+    for (std::size_t j = 1; j < kept.size(); ++j) pieces.push_back(std::move(kept[j]));
   }
 }
 
@@ -264,7 +302,9 @@ RoadGraph buildRoadGraph(const std::vector<StreetLine>& input, const RoadGraphOp
     }
   }
   const std::vector<int> clusterSize = joinEndpoints(lines, options.snap, report.endpointsJoined);
-  endsOntoLines(lines, clusterSize, options.snap, report.endpointsOnLines);
+  std::vector<char> apartLine(lines.size(), 0);
+  for (std::size_t i = 0; i < input.size(); ++i) apartLine[i] = input[i].noNode;
+  endsOntoLines(lines, clusterSize, apartLine, options.snap, report.endpointsOnLines);
 
   // Noding: the lines that meet what they cross, then those that do not.
   std::vector<Polyline> regular, apart;
@@ -274,9 +314,13 @@ RoadGraph buildRoadGraph(const std::vector<StreetLine>& input, const RoadGraphOp
     report.notNoded += input[i].noNode;
   }
   std::vector<Polyline> pieces = geos::nodeLines(regular, kGrid);
-  std::vector<Polyline> bridges = geos::nodeLines(apart, kGrid);
+  // Each line kept apart is noded on its own (where it crosses itself): it
+  // meets neither the others nor another bridge or tunnel it crosses, only
+  // what its ends lie on.
+  std::vector<Polyline> bridges;
   std::vector<Point> bridgeEnds;
-  for (const Polyline& b : bridges) {
+  for (const Polyline& b : apart) {
+    for (Polyline& piece : geos::nodeLines({b}, kGrid)) bridges.push_back(std::move(piece));
     bridgeEnds.push_back(b.front());
     bridgeEnds.push_back(b.back());
   }
@@ -314,10 +358,13 @@ RoadGraph buildRoadGraph(const std::vector<StreetLine>& input, const RoadGraphOp
     if (input[static_cast<std::size_t>(a)].boundary != input[static_cast<std::size_t>(b)].boundary) {
       return !input[static_cast<std::size_t>(a)].boundary;  // a street over the boundary
     }
-    const double wa = input[static_cast<std::size_t>(a)].width, wb = input[static_cast<std::size_t>(b)].width;
-    if (std::isnan(wa) != std::isnan(wb)) return !std::isnan(wa);
-    if (!std::isnan(wa) && wa != wb) return wa > wb;
-    return input[static_cast<std::size_t>(a)].key < input[static_cast<std::size_t>(b)].key;
+    const StreetLine &la = input[static_cast<std::size_t>(a)], &lb = input[static_cast<std::size_t>(b)];
+    if (std::isnan(la.width) != std::isnan(lb.width)) return !std::isnan(la.width);
+    if (!std::isnan(la.width) && la.width != lb.width) return la.width > lb.width;
+    if (la.key != lb.key) return la.key < lb.key;
+    // The same geometry twice: by its other attributes, never by input order.
+    if (la.name != lb.name) return la.name < lb.name;
+    return la.noNode < lb.noNode;
   };
 
   // Nodes by position on the noding grid.
@@ -325,7 +372,8 @@ RoadGraph buildRoadGraph(const std::vector<StreetLine>& input, const RoadGraphOp
   auto nodeOf = [&](const Point& p) {
     const std::pair<long long, long long> cell{std::llround(p.x / kGrid), std::llround(p.y / kGrid)};
     auto [it, added] = nodeAt.emplace(cell, static_cast<int>(graph.nodes.size()));
-    if (added) graph.nodes.push_back({positionKey(p), p, 0});
+    // Keyed by the same 1 mm cell that makes it one node: distinct nodes, distinct keys.
+    if (added) graph.nodes.push_back({mixKeys(static_cast<Key>(cell.first), static_cast<Key>(cell.second)), p, 0});
     return it->second;
   };
   for (std::size_t k = 0; k < pieces.size(); ++k) {
@@ -397,6 +445,20 @@ RoadGraph buildRoadGraph(const std::vector<StreetLine>& input, const RoadGraphOp
   for (RoadEdge& e : graph.edges) {
     e.from = rank[static_cast<std::size_t>(e.from)];
     e.to = rank[static_cast<std::size_t>(e.to)];
+  }
+  // Edges of one key (parallel edges between two nodes with middles within
+  // 1 cm) are told apart by their vertices, whatever the input order.
+  auto vertexLess = [](const Polyline& a, const Polyline& b) {
+    return std::lexicographical_compare(a.begin(), a.end(), b.begin(), b.end(), lexLess);
+  };
+  std::sort(graph.edges.begin(), graph.edges.end(), [&](const RoadEdge& a, const RoadEdge& b) {
+    return a.key != b.key ? a.key < b.key : vertexLess(a.line, b.line);
+  });
+  std::vector<Key> edgeKeys;
+  for (const RoadEdge& e : graph.edges) edgeKeys.push_back(e.key);
+  for (std::size_t i = 1, run = 0; i < graph.edges.size(); ++i) {
+    run = edgeKeys[i] == edgeKeys[i - 1] ? run + 1 : 0;
+    if (run) graph.edges[i].key = mixKeys(edgeKeys[i], run);
   }
   std::sort(graph.edges.begin(), graph.edges.end(), [](const RoadEdge& a, const RoadEdge& b) { return a.key < b.key; });
   for (const RoadNode& n : graph.nodes) report.deadEnds += n.degree == 1;
@@ -470,7 +532,7 @@ std::int64_t fillStreetWidths(RoadGraph& graph, const std::vector<const Polygon*
     const double len = length(e.line);
     std::vector<double> widths;
     const double from = 0.1 * len, to = 0.9 * len;
-    const int samples = std::max(1, static_cast<int>((to - from) / 5.0));
+    const int samples = std::clamp(static_cast<int>((to - from) / 5.0), 1, 200);
     for (int i = 0; i < samples; ++i) {
       const double s = samples == 1 ? 0.5 * len : from + (to - from) * (i + 0.5) / samples;
       const auto [p, dir] = pointAt(e.line, s);

@@ -400,7 +400,6 @@ std::vector<Polygon> difference(const Polygon& a, const std::vector<const Polygo
     out.push_back(a);
     return out;
   }
-  Geom gc = toGeos(cut);
   // Floating overlay first (GEOS's own fallbacks make it robust in nearly
   // every case), one cutter at a time (cheaper than their union first); snap
   // rounding on the grid when that fails or gives an invalid result (it costs
@@ -413,6 +412,7 @@ std::vector<Polygon> difference(const Polygon& a, const std::vector<const Polygo
   }
   Geom cutUnion;
   if (!valid(d.get())) {
+    Geom gc = toGeos(cut);
     cutUnion.reset(gc ? GEOSUnaryUnionPrec_r(ctx, gc.get(), grid) : nullptr);
     d.reset(cutUnion ? GEOSDifferencePrec_r(ctx, ga.get(), cutUnion.get(), grid) : nullptr);
   }

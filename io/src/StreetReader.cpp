@@ -4,6 +4,7 @@
 #include <ogr_spatialref.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <memory>
 #include <set>
 
@@ -91,6 +92,14 @@ StreetLayer readStreets(const StreetReadOptions& options, const LocalFrame* fram
     srs = &overrideSrs;
     result.crs.overridden = true;
   }
+  // A street layer that declares no CRS, read with parcels, is taken to be in
+  // theirs (its extent is checked against it below).
+  OGRSpatialReference targetSrs;
+  if (!srs && frame && targetCrs && !targetCrs->wkt.empty() &&
+      targetSrs.importFromWkt(targetCrs->wkt.c_str()) == OGRERR_NONE) {
+    targetSrs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    srs = &targetSrs;
+  }
   // Widths in a projected CRS's unit become metres.
   const double widthUnit = srs && srs->IsProjected() && srs->GetLinearUnits() > 0 ? srs->GetLinearUnits() : 1.0;
   const int widthIndex = fieldIndex(layer, options.widthField, path, "--width-field");
@@ -125,13 +134,24 @@ StreetLayer readStreets(const StreetReadOptions& options, const LocalFrame* fram
     a.fid = feature->GetFID();
     a.noNode = apart.count(feature->GetFID()) > 0;
     if (widthIndex >= 0 && feature->IsFieldSetAndNotNull(widthIndex)) {
-      const double w = feature->GetFieldAsDouble(widthIndex);
-      if (!std::isfinite(w) || w < 0) {
-        throw inputError(path + ": feature " + std::to_string(a.fid) + " has width " +
-                         feature->GetFieldAsString(widthIndex) + " in field '" + options.widthField +
-                         "' (a width is a number of 0 or more)");
+      // A text field is read as a number too: empty is no width, anything
+      // else but a whole decimal number is an error (never a silent 0).
+      const std::string text = feature->GetFieldAsString(widthIndex);
+      const bool numeric = layer->GetLayerDefn()->GetFieldDefn(widthIndex)->GetType() != OFTString;
+      double w = NAN;
+      if (numeric) {
+        w = feature->GetFieldAsDouble(widthIndex);
+      } else if (text.find_first_not_of(" \t") != std::string::npos) {
+        char* end = nullptr;
+        w = std::strtod(text.c_str(), &end);
+        while (end && (*end == ' ' || *end == '\t')) ++end;
+        if (!end || *end != '\0') w = -1;
       }
-      a.width = w * widthUnit;
+      if ((numeric || !std::isnan(w)) && (!std::isfinite(w) || w < 0)) {
+        throw inputError(path + ": feature " + std::to_string(a.fid) + " has width '" + text + "' in field '" +
+                         options.widthField + "' (a width is a number of 0 or more)");
+      }
+      if (!std::isnan(w)) a.width = w * widthUnit;
     }
     if (std::isnan(a.width) && classIndex >= 0 && feature->IsFieldSetAndNotNull(classIndex)) {
       const auto it = options.classWidths.find(feature->GetFieldAsString(classIndex));
@@ -160,6 +180,15 @@ StreetLayer readStreets(const StreetReadOptions& options, const LocalFrame* fram
   if (frame) {
     result.frame = *frame;
     result.crs = targetCrs ? *targetCrs : CrsInfo{};
+    // Coordinates that cannot be the parcels' (degrees against a projected
+    // CRS, or the other way round) are refused, not drawn kilometres away.
+    const bool degrees = env.looksLikeDegrees();
+    if (frame->isGeographic() && !degrees && !(srs && srs->IsProjected())) {
+      throw inputError(path + ": the street coordinates (x " + std::to_string(env.minX) + " to " +
+                       std::to_string(env.maxX) +
+                       ") cannot be degrees, the parcels' CRS; give the streets' CRS "
+                       "in the file");
+    }
     if (targetCrs && !targetCrs->wkt.empty() && srs) {
       target.importFromWkt(targetCrs->wkt.c_str());
       target.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);

@@ -54,8 +54,9 @@ const std::vector<ParameterDescription>& streetParameters() {
   return d;
 }
 
-StreetNetwork buildStreetNetwork(const io::StreetReadOptions& streets, const ParameterValues& parameters,
-                                 const ObservedData* observed, const ProgressFn& progress) {
+namespace {
+StreetNetwork buildNetwork(const io::StreetReadOptions& streets, const ParameterValues& parameters,
+                           const ObservedData* observed, const ProgressFn& progress) {
   StreetNetwork n;
   n.timings.start("read streets");
   n.layer =
@@ -115,6 +116,19 @@ StreetNetwork buildStreetNetwork(const io::StreetReadOptions& streets, const Par
   n.blocks = analysis::streetBlocks(n.graph, blockOptions, scaledProgress(progress, 0.5, 1.0));
   n.timings.stop();
   return n;
+}
+
+}  // namespace
+
+StreetNetwork buildStreetNetwork(const io::StreetReadOptions& streets, const ParameterValues& parameters,
+                                 const ObservedData* observed, const ProgressFn& progress) {
+  try {
+    return buildNetwork(streets, parameters, observed, progress);
+  } catch (const Error& e) {
+    // A geometric failure of the graph or the blocks names the street file.
+    if (e.kind() != Error::Kind::Geometry) throw;
+    throw geometryError(streets.path + ": " + e.what());
+  }
 }
 
 std::int64_t assignToStreetBlocks(ObservedData& observed, std::shared_ptr<const StreetNetwork> network, double k) {
@@ -316,7 +330,7 @@ Json streetRecord(const StreetNetwork& network) {
       .set("boundary_lines", network.boundaryLines)
       .set("faces", network.blocks.faces)
       .set("faces_above_max_block_area", network.blocks.facesTooLarge)
-      .set("pieces_below_1_m2", network.blocks.partsTooSmall)
+      .set("pieces_dropped", network.blocks.partsTooSmall)
       .set("blocks", static_cast<std::int64_t>(network.blocks.blocks.size()))
       .set("seconds", seconds);
 }

@@ -200,6 +200,65 @@ TEST(RoadGraph, ABridgeCrossesWithoutANode) {
   expectCoverage(b, "bridge");
 }
 
+// A bridge that stops 0.5 m short of a street meets it at a node of degree
+// 3, and crosses the streets it passes over without a node.
+TEST(RoadGraph, ABridgeEndingShortOfAStreetMeetsItThere) {
+  std::vector<StreetLine> lines = grid(3, 100);
+  StreetLine bridge = street({{-100, 150}, {199.5, 150}}, 12, "viaduct");
+  bridge.noNode = true;
+  lines.push_back(bridge);
+  const RoadGraph g = buildRoadGraph(lines);
+  EXPECT_EQ(g.report.endpointsOnLines, 1);
+  int meets = 0, crossings = 0;
+  for (const RoadNode& n : g.nodes) {
+    if (std::fabs(n.at.y - 150) > 1e-3) continue;
+    if (std::fabs(n.at.x - 200) < 1e-3) meets += n.degree == 3;
+    if (std::fabs(n.at.x) < 1e-3 || std::fabs(n.at.x - 100) < 1e-3) ++crossings;
+  }
+  EXPECT_EQ(meets, 1);
+  EXPECT_EQ(crossings, 0);
+  EXPECT_EQ(g.report.deadEnds, 12 + 1);  // the grid's ends, the bridge's west end
+  expectOrderFree(lines, "bridge short of a street");
+}
+
+// A bridge over a tunnel: neither meets the other (nor the streets between
+// their ends).
+TEST(RoadGraph, BridgesAndTunnelsCrossingEachOtherDoNotMeet) {
+  std::vector<StreetLine> lines = grid(2, 100);
+  StreetLine bridge = street({{0, 50}, {100, 50}}, 10, "bridge"), tunnel = street({{50, 0}, {50, 100}}, 8, "tunnel");
+  bridge.noNode = tunnel.noNode = true;
+  lines.push_back(bridge);
+  lines.push_back(tunnel);
+  const RoadGraph g = buildRoadGraph(lines);
+  for (const RoadNode& n : g.nodes) {
+    EXPECT_FALSE(std::fabs(n.at.x - 50) < 1e-3 && std::fabs(n.at.y - 50) < 1e-3) << "a node where they cross";
+  }
+  int ends = 0;  // each meets the grid at both ends
+  for (const RoadNode& n : g.nodes) ends += n.degree == 3;
+  EXPECT_EQ(ends, 4);
+}
+
+// The same geometry twice, with other names: the edge takes one of them,
+// the same whatever the order of the lines.
+TEST(RoadGraph, DuplicateLinesGiveTheSameAttributesWhateverTheOrder) {
+  std::vector<StreetLine> lines = grid(2, 100);
+  lines.push_back(street({{-100, 0}, {200, 0}}, 10, "Avenue A"));
+  lines.back().key = lines[0].key = 7;  // identical geometries hash alike
+  lines[0].name = "Boulevard B";
+  auto nameOfSouth = [](const RoadGraph& g) {
+    for (const RoadEdge& e : g.edges) {
+      if (e.line.front().y == 0 && e.line.back().y == 0 && std::min(e.line.front().x, e.line.back().x) == 0) {
+        return e.name;
+      }
+    }
+    return std::string("none");
+  };
+  const std::string name = nameOfSouth(buildRoadGraph(lines));
+  std::reverse(lines.begin(), lines.end());
+  EXPECT_EQ(nameOfSouth(buildRoadGraph(lines)), name);
+  EXPECT_EQ(name, "Avenue A");
+}
+
 TEST(RoadGraph, DuplicatedAndNearlyDuplicatedLinesAreMerged) {
   std::vector<StreetLine> lines = grid(3, 100);
   const Built plain = build(lines);

@@ -175,6 +175,52 @@ TEST(GenerateCommand, ParcelsTileTheStreetBlocksAndRepeatWithTheSeed) {
   }
 }
 
+// Widths in a text field are numbers or empty (no width), and in the unit of a
+// projected CRS: 40 US survey feet in EPSG:2286 are 12.19 m.
+TEST(BlocksCommand, WidthsInATextFieldAndInFeetAreRead) {
+  TempDir dir;
+  auto layer = [](const std::vector<std::string>& widths) {
+    // A 2 x 2 grid of streets 400 ft apart in Washington State Plane South (US feet).
+    const double x0 = 1160000, y0 = 680000;
+    const double lines[4][4] = {{x0 - 200, y0, x0 + 600, y0},
+                                {x0 - 200, y0 + 400, x0 + 600, y0 + 400},
+                                {x0, y0 - 200, x0, y0 + 600},
+                                {x0 + 400, y0 - 200, x0 + 400, y0 + 600}};
+    std::ostringstream s;
+    s.precision(12);
+    s << "{\"type\": \"FeatureCollection\", \"crs\": {\"type\": \"name\", \"properties\": {\"name\": "
+         "\"urn:ogc:def:crs:EPSG::2286\"}}, \"features\": [";
+    for (int i = 0; i < 4; ++i) {
+      s << (i ? "," : "") << "{\"type\": \"Feature\", \"properties\": {\"W\": \"" << widths[i]
+        << "\"}, \"geometry\": {\"type\": \"LineString\", \"coordinates\": [[" << lines[i][0] << "," << lines[i][1]
+        << "],[" << lines[i][2] << "," << lines[i][3] << "]]}}";
+    }
+    s << "]}\n";
+    return s.str();
+  };
+  const std::string good = dir.write("feet.geojson", layer({"40", "40", " 40 ", ""}));
+  const CliRun r = run("blocks '" + good + "' --width-field W --default-width 5 --quiet --out '" + dir.file("o") + "'");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string record = slurp(dir.file("o") + "/run.json");
+  EXPECT_NE(record.find("\"widths_given\": 9"), std::string::npos) << record;  // 3 lines of 3 edges each
+  auto ds = test::openVectorFile(dir.file("o") + "/streets.gpkg");
+  ASSERT_TRUE(ds);
+  std::map<std::string, int> widths;
+  for (auto& e : *ds->GetLayerByName("edges")) {
+    std::ostringstream w;
+    w.precision(4);
+    w << e->GetFieldAsDouble("width");
+    ++widths[w.str()];
+  }
+  EXPECT_EQ(widths["12.19"], 9);  // 40 ft
+  EXPECT_EQ(widths["5"], 3);      // the empty one: the default
+  const std::string bad = dir.write("bad.geojson", layer({"40", "wide", "40", "40"}));
+  const CliRun b = run("blocks '" + bad + "' --width-field W --quiet --out '" + dir.file("b") + "'");
+  EXPECT_EQ(b.code, 1) << b.output;
+  EXPECT_NE(b.output.find("has width 'wide' in field 'W'"), std::string::npos) << b.output;
+  EXPECT_NE(b.output.find("bad.geojson: feature 1"), std::string::npos) << b.output;
+}
+
 TEST(BlocksCommand, BadStreetInputsAreOneLineErrors) {
   TempDir dir;
   const std::string streets = dir.write("streets.geojson", geojson(network(), false));
