@@ -192,17 +192,8 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
 
   // CRS: --crs replaces whatever the file declares.
   OGRSpatialReference overrideSrs;
-  const OGRSpatialReference* srs = layer->GetSpatialRef();
-  if (!options.crsOverride.empty()) {
-    CPLErrorReset();
-    if (overrideSrs.SetFromUserInput(options.crsOverride.c_str()) != OGRERR_NONE) {
-      throw usageError(path + ": --crs " + options.crsOverride + " is not a CRS GDAL knows (" + lastGdalMessage() +
-                       ")");
-    }
-    overrideSrs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    srs = &overrideSrs;
-    result.crs.overridden = true;
-  }
+  const OGRSpatialReference* srs =
+      detail::layerCrs(path, *layer, options.crsOverride, overrideSrs, result.crs.overridden);
 
   std::vector<int> fieldIndex;
   for (const auto& name : options.numericFields) {

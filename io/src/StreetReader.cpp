@@ -81,17 +81,8 @@ StreetLayer readStreets(const StreetReadOptions& options, const LocalFrame* fram
   setFilter(options.where, "--where");
 
   OGRSpatialReference overrideSrs;
-  const OGRSpatialReference* srs = layer->GetSpatialRef();
-  if (!options.crsOverride.empty()) {
-    CPLErrorReset();
-    if (overrideSrs.SetFromUserInput(options.crsOverride.c_str()) != OGRERR_NONE) {
-      throw usageError(path + ": --crs " + options.crsOverride + " is not a CRS GDAL knows (" + lastGdalMessage() +
-                       ")");
-    }
-    overrideSrs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    srs = &overrideSrs;
-    result.crs.overridden = true;
-  }
+  const OGRSpatialReference* srs =
+      detail::layerCrs(path, *layer, options.crsOverride, overrideSrs, result.crs.overridden);
   // A street layer that declares no CRS, read with parcels, is taken to be in
   // theirs (its extent is checked against it below).
   OGRSpatialReference targetSrs;

@@ -157,4 +157,16 @@ LocalFrame chooseFrame(const std::string& path, const OGRSpatialReference* srs, 
                    hint);
 }
 
+const OGRSpatialReference* layerCrs(const std::string& path, OGRLayer& layer, const std::string& crsOverride,
+                                    OGRSpatialReference& storage, bool& overridden) {
+  if (crsOverride.empty()) return layer.GetSpatialRef();
+  CPLErrorReset();
+  if (storage.SetFromUserInput(crsOverride.c_str()) != OGRERR_NONE) {
+    throw usageError(path + ": --crs " + crsOverride + " is not a CRS GDAL knows (" + lastGdalMessage() + ")");
+  }
+  storage.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  overridden = true;
+  return &storage;
+}
+
 }  // namespace parcelscope::io::detail

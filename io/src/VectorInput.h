@@ -24,6 +24,12 @@ std::string lastGdalMessage();
 /// opens it). Throws Error(Input).
 GDALDatasetUniquePtr openVector(const std::string& path);
 
+/// The CRS of `layer`: `crsOverride` (the --crs flag) when given, parsed into
+/// `storage` (and `overridden` set), else the one the layer declares (null:
+/// none). Throws Error(Usage) naming `path` when GDAL does not know `crsOverride`.
+const OGRSpatialReference* layerCrs(const std::string& path, OGRLayer& layer, const std::string& crsOverride,
+                                    OGRSpatialReference& storage, bool& overridden);
+
 /// Whether every coordinate stored in `g` is finite.
 bool coordinatesFinite(const OGRGeometry& g);
 
