@@ -45,7 +45,7 @@ struct RoadGraphOptions {
 };
 
 struct RoadNode {
-  Key key = 0;  ///< from its position, rounded to 1 cm
+  Key key = 0;  ///< from its cell of the 1 mm noding grid (the cell that makes it one node)
   Point at;
   int degree = 0;  ///< edges ending here (a loop counts twice); 1: a dead end
 };
