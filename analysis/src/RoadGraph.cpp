@@ -1,8 +1,6 @@
 #include "parcelscope/analysis/RoadGraph.h"
 
 #include <algorithm>
-#include <boost/geometry.hpp>
-#include <boost/geometry/index/rtree.hpp>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -10,6 +8,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "parcelscope/core/BoxIndex.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
 
@@ -17,15 +16,12 @@ namespace parcelscope::analysis {
 
 namespace {
 
-namespace bg = boost::geometry;
 namespace bgi = boost::geometry::index;
-using BPoint = bg::model::point<double, 2, bg::cs::cartesian>;
-using BBox = bg::model::box<BPoint>;
-// A segment of a polyline: (line, index of its first vertex).
+using BBox = IndexBox;
+// Segments of polylines, each as (line, index of its first vertex).
 using SegmentEntry = std::pair<BBox, std::pair<int, int>>;
-using SegmentTree = bgi::rtree<SegmentEntry, bgi::quadratic<16>>;
+using SegmentTree = BoxTree<std::pair<int, int>>;
 using BoxEntry = std::pair<BBox, int>;
-using BoxTree = bgi::rtree<BoxEntry, bgi::quadratic<16>>;
 
 // Lines are noded on this grid (m): crossings closer than it are one node.
 constexpr double kGrid = 1e-3;
@@ -33,14 +29,10 @@ constexpr double kGrid = 1e-3;
 constexpr double kOverlayGrid = 1e-6;
 
 BBox boxAround(const Point& a, const Point& b, double pad = 0) {
-  return {BPoint(std::min(a.x, b.x) - pad, std::min(a.y, b.y) - pad),
-          BPoint(std::max(a.x, b.x) + pad, std::max(a.y, b.y) + pad)};
+  return indexBox({std::min(a.x, b.x), std::min(a.y, b.y), std::max(a.x, b.x), std::max(a.y, b.y)}, pad);
 }
 
-BBox boxOf(const std::vector<Point>& points, double pad = 0) {
-  Box b = bounds(points);
-  return {BPoint(b.minX - pad, b.minY - pad), BPoint(b.maxX + pad, b.maxY + pad)};
-}
+BBox boxOf(const std::vector<Point>& points, double pad = 0) { return indexBox(bounds(points), pad); }
 
 SegmentTree segmentTree(const std::vector<const Polyline*>& lines, bool closed = false) {
   std::vector<SegmentEntry> entries;
@@ -591,7 +583,7 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
   for (std::size_t k = 0; k < graph.edges.size(); ++k) {
     boxes.push_back({boxOf(graph.edges[k].line, 0.5 * graph.edges[k].width), static_cast<int>(k)});
   }
-  const BoxTree edgeTree(boxes.begin(), boxes.end());
+  const BoxTree<int> edgeTree(boxes.begin(), boxes.end());
 
   struct FaceBlocks {
     std::vector<StreetBlock> blocks;

@@ -1,12 +1,11 @@
 #include "parcelscope/pipeline/StreetsJob.h"
 
 #include <algorithm>
-#include <boost/geometry.hpp>
-#include <boost/geometry/index/rtree.hpp>
 #include <cmath>
 #include <set>
 #include <sstream>
 
+#include "parcelscope/core/BoxIndex.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/GeosOps.h"
 #include "parcelscope/core/Parallel.h"
@@ -16,10 +15,7 @@
 namespace parcelscope::pipeline {
 
 namespace {
-namespace bg = boost::geometry;
 namespace bgi = boost::geometry::index;
-using BPoint = bg::model::point<double, 2, bg::cs::cartesian>;
-using BBox = bg::model::box<BPoint>;
 
 double value(const ParameterValues& v, const std::string& name) {
   const auto it = v.find(name);
@@ -30,10 +26,7 @@ double value(const ParameterValues& v, const std::string& name) {
   throw usageError("no street parameter " + name);
 }
 
-BBox boxOf(const Polygon& p) {
-  const Box b = bounds(p);
-  return {BPoint(b.minX, b.minY), BPoint(b.maxX, b.maxY)};
-}
+IndexBox boxOf(const Polygon& p) { return indexBox(bounds(p)); }
 }  // namespace
 
 const std::vector<ParameterDescription>& streetParameters() {
@@ -134,9 +127,9 @@ StreetNetwork buildStreetNetwork(const io::StreetReadOptions& streets, const Par
 std::int64_t assignToStreetBlocks(ObservedData& observed, std::shared_ptr<const StreetNetwork> network, double k) {
   analysis::ObservedAnalysis& a = observed.analysis;
   const auto& blocks = network->blocks.blocks;
-  std::vector<std::pair<BBox, int>> boxes;
+  std::vector<std::pair<IndexBox, int>> boxes;
   for (std::size_t b = 0; b < blocks.size(); ++b) boxes.push_back({boxOf(blocks[b].shape), static_cast<int>(b)});
-  const bgi::rtree<std::pair<BBox, int>, bgi::quadratic<16>> tree(boxes.begin(), boxes.end());
+  const BoxTree<int> tree(boxes.begin(), boxes.end());
   const std::size_t n = observed.layer.parcels.size();
   std::vector<int> to(n, -1);
   parallelFor(n, [&](std::size_t p) {

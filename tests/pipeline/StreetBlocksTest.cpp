@@ -4,13 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <boost/geometry.hpp>
-#include <boost/geometry/index/rtree.hpp>
 #include <cstdio>
 #include <map>
 
 #include "TestUtil.h"
 #include "generation/TilingCheck.h"
+#include "parcelscope/core/BoxIndex.h"
 #include "parcelscope/core/GeosOps.h"
 #include "parcelscope/core/Parallel.h"
 #include "parcelscope/pipeline/CompareJob.h"
@@ -20,10 +19,7 @@
 namespace parcelscope::pipeline {
 namespace {
 
-namespace bg = boost::geometry;
 namespace bgi = boost::geometry::index;
-using BPoint = bg::model::point<double, 2, bg::cs::cartesian>;
-using BBox = bg::model::box<BPoint>;
 
 io::ReadOptions cambridgeParcels() {
   io::ReadOptions o;
@@ -47,18 +43,13 @@ ParameterValues defaults() {
 
 // Of each parcel block, the best intersection over union with a street block.
 std::vector<double> bestIou(const std::vector<Polygon>& parcelBlocks, const std::vector<const Polygon*>& street) {
-  std::vector<std::pair<BBox, int>> boxes;
-  for (std::size_t i = 0; i < street.size(); ++i) {
-    const Box b = bounds(*street[i]);
-    boxes.push_back({BBox(BPoint(b.minX, b.minY), BPoint(b.maxX, b.maxY)), static_cast<int>(i)});
-  }
-  const bgi::rtree<std::pair<BBox, int>, bgi::quadratic<16>> tree(boxes.begin(), boxes.end());
+  std::vector<std::pair<IndexBox, int>> boxes;
+  for (std::size_t i = 0; i < street.size(); ++i) boxes.push_back({indexBox(bounds(*street[i])), static_cast<int>(i)});
+  const BoxTree<int> tree(boxes.begin(), boxes.end());
   std::vector<double> iou(parcelBlocks.size(), 0);
   parallelFor(parcelBlocks.size(), [&](std::size_t k) {
     const Polygon& p = parcelBlocks[k];
-    const Box b = bounds(p);
-    for (auto it = tree.qbegin(bgi::intersects(BBox(BPoint(b.minX, b.minY), BPoint(b.maxX, b.maxY))));
-         it != tree.qend(); ++it) {
+    for (auto it = tree.qbegin(bgi::intersects(indexBox(bounds(p)))); it != tree.qend(); ++it) {
       const Polygon& s = *street[static_cast<std::size_t>(it->second)];
       const double i = geos::intersectionArea(p, s);
       iou[k] = std::max(iou[k], i / (area(p) + area(s) - i));
