@@ -2,9 +2,9 @@
 // Where a run's blocks come from. `generate`, `compare` and the session ask a
 // BlockSource for their blocks (BlockInputs: each block part with its key, its
 // own bounds and street-access share); each kind of input is one
-// implementation. Today: blocks grouped from observed parcels, and a layer of
-// block polygons; a street network (blocks as the faces of a road graph) is the
-// next.
+// implementation: blocks grouped from observed parcels, a layer of block
+// polygons, and a street network (blocks as the faces of a road graph, with
+// observed parcels assigned to them when given; see StreetsJob.h).
 #include <memory>
 #include <string>
 
@@ -18,7 +18,8 @@ namespace parcelscope::pipeline {
 class BlockSource {
 public:
   virtual ~BlockSource() = default;
-  /// Names the kind of source in run records: "observed-parcels" or "block-layer".
+  /// Names the kind of source in run records: "observed-parcels", "block-layer",
+  /// "street-network" or "street-network-with-parcels".
   virtual std::string kind() const = 0;
   /// The blocks, each multipart block as one entry per part. Throws Error(Input)
   /// on unreadable input, Error(Cancelled) when `progress` asks to stop.
@@ -38,8 +39,9 @@ std::unique_ptr<BlockSource> observedParcelBlocks(const io::ReadOptions& input, 
 /// gives the key otherwise).
 std::unique_ptr<BlockSource> blockLayer(const io::ReadOptions& input);
 
-/// The source a generate request names: observedParcelBlocks with fromParcels,
-/// else blockLayer.
+/// The source a generate request names: the street network with `streets`
+/// (its blocks, observed parcels of `input` assigned to them with fromParcels),
+/// else observedParcelBlocks with fromParcels, else blockLayer.
 std::unique_ptr<BlockSource> blockSourceOf(const GenerateRequest& request);
 
 }  // namespace parcelscope::pipeline
