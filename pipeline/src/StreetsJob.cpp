@@ -225,10 +225,9 @@ ObservedData loadObservedInStreetBlocks(const io::ReadOptions& input, const io::
   ObservedData data = loadObserved(input, parameters, scaledProgress(progress, 0.0, 0.6));
   auto network = std::make_shared<StreetNetwork>(
       buildStreetNetwork(*streets, parameters, &data, scaledProgress(progress, 0.6, 0.95)));
-  const auto it = parameters.find("k");
   StreetNetwork* timed = network.get();
   timed->timings.start("assign parcels");
-  data.outsideStreetBlocks = assignToStreetBlocks(data, network, it == parameters.end() ? 2.0 : it->second);
+  data.outsideStreetBlocks = assignToStreetBlocks(data, network, analysis::analysisOptionsFrom(parameters).k);
   timed->timings.stop();
   reportProgress(progress, 1.0, "street blocks");
   return data;
@@ -333,20 +332,18 @@ JobOutcome writeBlocks(io::OutputDirectory& out, const io::StreetReadOptions& st
                        const ParameterValues& parameters, const io::ReadOptions* parcels, const ProgressFn& progress) {
   ObservedData observed;
   if (parcels) observed = loadObserved(*parcels, parameters, scaledProgress(progress, 0.0, 0.4));
-  const StreetNetwork network = buildStreetNetwork(streets, parameters, parcels ? &observed : nullptr,
-                                                   scaledProgress(progress, parcels ? 0.4 : 0.0, 0.9));
+  const auto shared = std::make_shared<const StreetNetwork>(buildStreetNetwork(
+      streets, parameters, parcels ? &observed : nullptr, scaledProgress(progress, parcels ? 0.4 : 0.0, 0.9)));
+  const StreetNetwork& network = *shared;
   reportProgress(progress, 0.9, "writing");
   const io::LocalFrame& frame = network.layer.frame;
   const io::CrsInfo& crs = network.layer.crs;
   std::vector<std::vector<Polygon>> outlines;
   for (const analysis::StreetBlock& b : network.blocks.blocks) outlines.push_back({b.shape});
-  ObservedData assigned;
   const ObservedData* withParcels = nullptr;
   if (parcels) {
-    assigned = std::move(observed);
-    assignToStreetBlocks(assigned, std::make_shared<StreetNetwork>(network),
-                         parameters.count("k") ? parameters.at("k") : 2.0);
-    withParcels = &assigned;
+    assignToStreetBlocks(observed, shared, analysis::analysisOptionsFrom(parameters).k);
+    withParcels = &observed;
   }
   const io::LayerWrite blocksWritten = io::writePolygonLayer(out.stage("blocks.gpkg"), "blocks", outlines,
                                                              streetBlockTable(network, withParcels), frame, crs);
@@ -367,7 +364,7 @@ JobOutcome writeBlocks(io::OutputDirectory& out, const io::StreetReadOptions& st
   Json run = runRecord("blocks", parameters);
   run.set("streets", streetRecord(network));
   if (parcels) {
-    addObservedRecord(run, assigned);
+    addObservedRecord(run, observed);
   }
   run.set("written", writtenLayersJson({{"blocks.gpkg", blocksWritten}, {"street_surface.gpkg", surfaceWritten}}));
   run.set("outputs",
