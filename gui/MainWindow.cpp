@@ -1088,7 +1088,7 @@ void MainWindow::drawReport(const UpdateReport& report) {
     }
     for (std::size_t i = 0; i < r.generated.parcels.size(); ++i) {
       shapes.push_back(&r.generated.parcels[i]);
-      values.push_back(q.value(r.generated.metrics[i]));
+      values.push_back(r.generated.isUnassigned(i) ? std::nan("") : q.value(r.generated.metrics[i]));
     }
     proceduralView_->layer().setShapes(shapes, values, blocks);
     // The layer reads these shapes again when the zoom changes.
@@ -1193,7 +1193,9 @@ bool MainWindow::recolour(bool observedChanged) {
   }
   std::vector<double> generated;
   generated.reserve(r.generated.metrics.size());
-  for (const auto& m : r.generated.metrics) generated.push_back(q.value(m));
+  for (std::size_t i = 0; i < r.generated.metrics.size(); ++i) {
+    generated.push_back(r.generated.isUnassigned(i) ? std::nan("") : q.value(r.generated.metrics[i]));  // grey
+  }
   proceduralView_->layer().setValues(generated);
   const pipeline::CompareRequest shown = controller_.shownRequest();
   const viz::ColourScale scale = viz::quantityScale(r, shown, metric);
@@ -1213,10 +1215,12 @@ void MainWindow::titleProcedural() {
   if (!controller_.shownResult()) return;
   const pipeline::CompareResult& r = *controller_.shownResult();
   if (!partialCancelled_) {
-    proceduralView_->setTitle(QString("Procedural (%1, seed %2): %3 parcels")
+    const auto unassigned = static_cast<std::size_t>(r.generated.unassignedParcels);
+    proceduralView_->setTitle(QString("Procedural (%1, seed %2): %3 parcels%4")
                                   .arg(QString::fromStdString(controller_.shownRequest().style))
                                   .arg(r.generated.seed)
-                                  .arg(r.generated.parcels.size()));
+                                  .arg(r.generated.parcels.size() - unassigned)
+                                  .arg(unassigned > 0 ? QString(", %1 unassigned (grey)").arg(unassigned) : QString()));
     return;
   }
   // A cancelled update left a result in between: some blocks new, the others as before.

@@ -62,8 +62,11 @@ int mergeSlivers(const Polygon& block, Subdivision& out, double minFrontage) {
       ++i;
       continue;
     }
-    const std::size_t firstPatio = out.parcels.size() - static_cast<std::size_t>(out.patioParcels);
-    if (i >= firstPatio) {
+    const std::size_t firstUnassigned = out.parcels.size() - static_cast<std::size_t>(out.unassignedParcels);
+    const std::size_t firstPatio = firstUnassigned - static_cast<std::size_t>(out.patioParcels);
+    if (i >= firstUnassigned) {
+      --out.unassignedParcels;
+    } else if (i >= firstPatio) {
       --out.patioParcels;
     } else if (out.withoutAccess > 0 &&
                analysis::sharedBoundaryLength(sliver, outline, kMinParcelWidth) < minFrontage) {

@@ -29,7 +29,7 @@ constexpr double kMinParcelWidth = 1e-3;  // m
 
 /// Merges every sliver (see kMinParcelWidth) into the neighbouring parcel it
 /// shares the longest boundary with, when their union is one valid polygon.
-/// Keeps the order of the other parcels; adjusts patioParcels and
+/// Keeps the order of the other parcels; adjusts unassignedParcels, patioParcels and
 /// withoutAccess (a sliver with less than `minFrontage` m on the block's outer
 /// contour counted without access). Returns the number of slivers left (no
 /// neighbour to merge with).

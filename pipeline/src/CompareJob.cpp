@@ -168,16 +168,18 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
       }
       if (const auto found = observedBlock.find(key); found != observedBlock.end()) b = found->second;
     }
+    // Land a style left unassigned is no parcel: it is counted, not compared.
+    const std::vector<int> assigned = r.generated.assignedOf(r.generated.blocks[k].parcels);
     if (b < a.blocks.size()) {
       blockOfEntry[k] = b;
-      for (int i : r.generated.blocks[k].parcels) generatedIn[b].push_back(i);
+      generatedIn[b].insert(generatedIn[b].end(), assigned.begin(), assigned.end());
       continue;
     }
     const auto [it, added] = unmatchedOf.emplace(key, unmatched.size());
     if (added) unmatched.push_back({id, key, 0.0, {}});
     Unmatched& u = unmatched[it->second];
     for (const Polygon& part : r.generated.blocks[k].parts) u.area += area(part);
-    u.parcels.insert(u.parcels.end(), r.generated.blocks[k].parcels.begin(), r.generated.blocks[k].parcels.end());
+    u.parcels.insert(u.parcels.end(), assigned.begin(), assigned.end());
     blockOfEntry[k] = a.blocks.size() + it->second;
   }
   if (!r.observedSides) {
@@ -201,8 +203,16 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
   // The city-wide comparison (the largest item) first, beside the blocks.
   parallelFor(todo.size() + 1, [&](std::size_t t) {
     if (t == 0) {
-      r.city = analysis::compareSets(observedSides.back(), analysis::prepareSet(r.generated.metrics), bins, quantile,
-                                     &r.histograms);
+      std::vector<int> all;
+      if (!r.generated.unassigned.empty()) {
+        all.resize(r.generated.parcels.size());
+        for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
+      }
+      r.city = analysis::compareSets(
+          observedSides.back(),
+          analysis::prepareSet(r.generated.unassigned.empty() ? r.generated.metrics
+                                                              : pick(r.generated.metrics, r.generated.assignedOf(all))),
+          bins, quantile, &r.histograms);
       r.histogramBins = bins;
       r.histogramQuantile = quantile;
       return;
@@ -462,6 +472,8 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
                            .set("parcels", static_cast<std::int64_t>(r.generated.parcels.size()))
                            .set("parcels_oversize", r.generated.oversize)
                            .set("parcels_without_street_access", r.generated.withoutAccess)
+                           .set("unassigned_parcels", r.generated.unassignedParcels)
+                           .set("unassigned_area_m2", r.generated.unassignedArea)
                            .set("per_block_bounds_clamped", r.generated.clampedBounds)
                            .set("failures", failures));
   run.set("written", writtenLayersJson({{parcelsFile, parcelsWritten}, {"blocks.gpkg", blocksWritten}}));

@@ -300,6 +300,15 @@ GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<Bl
     out.oversize += s.oversize;
     out.withoutAccess += s.withoutAccess;
     out.patioParcels += s.patioParcels;
+    if (s.unassignedParcels > 0) {
+      out.unassigned.resize(out.parcels.size(), 0);
+      const std::vector<int>& in = out.blocks[k].parcels;
+      for (std::size_t i = in.size() - static_cast<std::size_t>(s.unassignedParcels); i < in.size(); ++i) {
+        out.unassigned[static_cast<std::size_t>(in[i])] = 1;
+        out.unassignedArea += out.metrics[static_cast<std::size_t>(in[i])].area;
+      }
+      out.unassignedParcels += s.unassignedParcels;
+    }
     if (s.fallback) {
       ++out.fallbackBlocks;
       out.failures.push_back("block " + std::to_string(id) + ": skeleton not usable (" + s.fallbackReason +
@@ -348,19 +357,31 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
   return out;
 }
 
+std::vector<int> GeneratedParcels::assignedOf(const std::vector<int>& list) const {
+  if (unassigned.empty()) return list;
+  std::vector<int> out;
+  out.reserve(list.size());
+  for (int i : list) {
+    if (!unassigned[static_cast<std::size_t>(i)]) out.push_back(i);
+  }
+  return out;
+}
+
 Table generatedParcelTable(const GeneratedParcels& g, std::vector<std::vector<Polygon>>* geometries) {
   Table table;
   table.columns = {{"parcel_id", Column::Type::Integer, ""},
                    {"parcel_key", Column::Type::String, ""},
                    {"block_id", Column::Type::Integer, ""},
-                   {"block_key", Column::Type::String, ""}};
+                   {"block_key", Column::Type::String, ""},
+                   {"role", Column::Type::String, ""}};  // "parcel", or "unassigned" land
   for (Column& c : analysis::metricColumns()) table.columns.push_back(std::move(c));
   std::map<Key, int> inBlock;  // parcels numbered so far per block (multipart blocks span entries)
   for (std::size_t b = 0; b < g.blocks.size(); ++b) {
     const std::string blockKey = keyText(g.blockKeys[b]);
     int& index = inBlock[g.blockKeys[b]];
     for (int i : g.blocks[b].parcels) {
-      std::vector<Value> row = {std::int64_t(i), blockKey + "-" + std::to_string(index++), g.blockIds[b], blockKey};
+      std::vector<Value> row = {std::int64_t(i), blockKey + "-" + std::to_string(index++), g.blockIds[b], blockKey,
+                                std::string(g.isUnassigned(static_cast<std::size_t>(i)) ? "unassigned" : "parcel")};
       for (Value& v : analysis::metricValues(g.metrics[i])) row.push_back(std::move(v));
       table.rows.push_back(std::move(row));
       if (geometries) geometries->push_back({g.parcels[i]});
@@ -406,6 +427,8 @@ JobOutcome writeGenerate(io::OutputDirectory& out, const GenerateRequest& reques
                         .set("parcels_oversize", g.oversize)
                         .set("parcels_without_street_access", g.withoutAccess)
                         .set("patio_parcels", g.patioParcels)
+                        .set("unassigned_parcels", g.unassignedParcels)
+                        .set("unassigned_area_m2", g.unassignedArea)
                         .set("blocks_fallback_obb", g.fallbackBlocks)
                         .set("per_block_bounds_clamped", g.clampedBounds)
                         .set("parcels_with_street_access_measured", withAccess));
@@ -427,6 +450,7 @@ JobOutcome writeGenerate(io::OutputDirectory& out, const GenerateRequest& reques
                         std::to_string(g.parcels.size()) + " parcels\n  " + std::to_string(g.oversize) +
                         " oversize (no admissible split), " + std::to_string(g.withoutAccess) +
                         " without street access (" + std::to_string(g.patioParcels) + " patio parcels), " +
+                        (g.unassignedParcels > 0 ? std::to_string(g.unassignedParcels) + " unassigned, " : "") +
                         std::to_string(g.fallbackBlocks) + " blocks fell back to obb, " +
                         std::to_string(g.failedBlocks) + " blocks refused";
   for (const auto& f : g.failures) summary += "\n  " + f;

@@ -110,6 +110,8 @@ ParcelInspection inspectGeneratedParcel(const GeneratedParcels& g, int parcel) {
     out.attributes.emplace_back("block_key", keyText(g.blockKeys[e]));
     out.attributes.emplace_back("style", e < g.blockStyles.size() ? g.blockStyles[e] : std::string());
   }
+  out.attributes.emplace_back("role",
+                              std::string(g.isUnassigned(static_cast<std::size_t>(parcel)) ? "unassigned" : "parcel"));
   out.metrics = metricsOf(g.metrics[static_cast<std::size_t>(parcel)]);
   return out;
 }

@@ -71,7 +71,7 @@ Table leaderboardTable(const Leaderboard& board) {
                            std::string(prefix) == "w1_" ? analysis::metricUnit(m) : ""});
     }
   }
-  for (const char* name : {"street_access_share", "undesirable_share", "fit"}) {
+  for (const char* name : {"street_access_share", "undesirable_share", "unassigned_share", "fit"}) {
     t.columns.push_back({name, Column::Type::Real, ""});
   }
   t.columns.push_back({"blocks_best", Column::Type::Integer, ""});
@@ -88,8 +88,14 @@ Table leaderboardTable(const Leaderboard& board) {
     for (analysis::ComparedMetric m : analysis::kComparedMetrics) row.push_back(city.distances(m).intersection);
     std::int64_t best = 0;
     for (int b : board.bestEntry) best += b == static_cast<int>(e);
-    row.insert(row.end(), {city.generated.streetAccessShare, city.generated.undesirableShare, fitScore(city), best,
-                           entry.seconds});
+    // Unassigned land as a share of the blocks' area (parish leaves it; the others none).
+    double blockArea = 0;
+    for (const Block& block : entry.result.generated.blocks) {
+      for (const Polygon& part : block.parts) blockArea += area(part);
+    }
+    const double unassignedShare = blockArea > 0 ? entry.result.generated.unassignedArea / blockArea : NAN;
+    row.insert(row.end(), {city.generated.streetAccessShare, city.generated.undesirableShare, unassignedShare,
+                           fitScore(city), best, entry.seconds});
     t.rows.push_back(std::move(row));
   }
   return t;

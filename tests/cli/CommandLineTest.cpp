@@ -205,7 +205,7 @@ TEST(GenerateCommand, FromParcelsWritesParcelsAndIsReproducibleFromTheSeed) {
     EXPECT_TRUE(fs::exists(dir.file("a") + "/" + f)) << f;
   }
   const std::string csv = slurp(dir.file("a") + "/parcels.csv");
-  EXPECT_EQ(csv.rfind("parcel_id,parcel_key,block_id,block_key,area,perimeter,width", 0), 0u) << csv.substr(0, 80);
+  EXPECT_EQ(csv.rfind("parcel_id,parcel_key,block_id,block_key,role,area,perimeter,width", 0), 0u) << csv.substr(0, 80);
   EXPECT_GT(std::count(csv.begin(), csv.end(), '\n'), 100);
   const std::string json = slurp(dir.file("a") + "/run.json");
   EXPECT_NE(json.find("\"blocks_failed\": 0"), std::string::npos) << json;

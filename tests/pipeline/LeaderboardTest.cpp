@@ -54,6 +54,48 @@ TEST(Leaderboard, EachStyleIsWhatItsOwnCompareGivesAndEachBlockGetsItsBestFit) {
   EXPECT_EQ(leaderboardBlockTable(board).rows.size(), blocks);
 }
 
+// parish leaves lots without street access unassigned: they are written with
+// their role, counted in the leaderboard, and kept out of every comparison.
+TEST(Leaderboard, UnassignedLandIsCountedAndWrittenButNotCompared) {
+  CompareRequest request = sampleRequest();
+  request.style = "parish";
+  const CompareResult r = compare(request);
+  const GeneratedParcels& g = r.generated;
+  ASSERT_GT(g.unassignedParcels, 0);
+  ASSERT_EQ(g.unassigned.size(), g.parcels.size());
+  std::int64_t flagged = 0;
+  double flaggedArea = 0;
+  for (std::size_t i = 0; i < g.parcels.size(); ++i) {
+    flagged += g.unassigned[i];
+    if (g.unassigned[i]) flaggedArea += area(g.parcels[i]);
+    if (g.unassigned[i]) EXPECT_FALSE(g.metrics[i].streetAccess) << i;  // no access is why it was left
+  }
+  EXPECT_EQ(flagged, g.unassignedParcels);
+  EXPECT_NEAR(flaggedArea, g.unassignedArea, 1e-6 * flaggedArea);
+  EXPECT_EQ(r.city.generated.parcels, static_cast<std::int64_t>(g.parcels.size()) - g.unassignedParcels);
+  EXPECT_EQ(r.city.generated.streetAccessShare, 1.0);
+  std::int64_t compared = 0;
+  for (const auto& b : r.blocks) compared += b.comparison.generated.parcels;
+  EXPECT_EQ(compared, r.city.generated.parcels);
+  const Table t = generatedParcelTable(g);
+  std::int64_t written = 0;
+  for (const auto& row : t.rows) written += std::get<std::string>(row[t.column("role")]) == "unassigned";
+  EXPECT_EQ(written, g.unassignedParcels);
+
+  request.style = "all";
+  const Leaderboard board = leaderboard(request);
+  const Table lt = leaderboardTable(board);
+  for (std::size_t e = 0; e < board.entries.size(); ++e) {
+    const double share = std::get<double>(lt.rows[e][lt.column("unassigned_share")]);
+    if (board.entries[e].style == "parish") {
+      EXPECT_GT(share, 0.0);
+      EXPECT_LT(share, 1.0);
+    } else {
+      EXPECT_EQ(share, 0.0) << board.entries[e].style;
+    }
+  }
+}
+
 TEST(Leaderboard, WritesItsTablesAndRunRecordWhole) {
   test::TempDir dir;
   const std::string out = dir.file("board");

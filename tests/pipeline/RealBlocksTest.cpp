@@ -70,7 +70,7 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
   parallelFor(n, [&](std::size_t k) {
     results[k] = runBlock(inputs, k, plans[k], minFrontage).subdivision;
     reports[k] = test::checkTiling(inputs.entries[k].shape, results[k].parcels);
-    if (style == "obb" && !results[k].failed) {
+    if ((style == "obb" || style == "parish") && !results[k].failed) {
       // The access the subdivision decided on is the measured one.
       measuredWithout[k] = test::measuredWithoutAccess(inputs.entries[k].shape, results[k].parcels, minFrontage);
     }
@@ -86,6 +86,9 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
     EXPECT_EQ(reports[k].outside, 0) << what;
     if (style == "obb") {
       EXPECT_EQ(measuredWithout[k], results[k].withoutAccess) << what;
+    } else if (style == "parish") {
+      // Exactly the lots without street access are left unassigned.
+      EXPECT_EQ(measuredWithout[k], results[k].unassignedParcels) << what;
     }
     parcels += static_cast<int>(results[k].parcels.size());
     withoutAccess += results[k].withoutAccess;
@@ -140,7 +143,9 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
 // recorded (OBB splits under new A_max and W_max; the skeleton layout under
 // new bounds, omega and seed, then the skeleton alone under a new street
 // angle) gives, to the last bit, what a fresh run gives.
-TEST_P(RealBlocks, RunsReusingTheLastRunGiveWhatFreshRunsGive) {
+// (parish keeps nothing for a later run to reuse.)
+class RealBlocksReuse : public RealBlocks {};
+TEST_P(RealBlocksReuse, RunsReusingTheLastRunGiveWhatFreshRunsGive) {
   PARCELSCOPE_REQUIRE_SHARED_DATASETS();
   const Dataset& dataset = std::get<0>(GetParam());
   const std::string style = std::get<1>(GetParam());
@@ -187,19 +192,26 @@ TEST_P(RealBlocks, RunsReusingTheLastRunGiveWhatFreshRunsGive) {
   EXPECT_GT(recorded, static_cast<int>(n) * 9 / 10);
 }
 
+const Dataset kDatasets[] = {{"cambridge_ma/ASSESSING_ParcelsFY2014.topojson", ""},
+                             {"paris_18e/cadastre-75118-parcelles.json", ""},
+                             {"malibu_ca/parcels.geojson", ""},
+                             {"eatonville_wa/parcels.geojson", "EPSG:2286"},
+                             {"seoul_jamsil/parcels.geojson", ""},
+                             {"rhone_69114/parcelles.json", ""}};
+
+std::string datasetAndStyle(const ::testing::TestParamInfo<std::tuple<Dataset, const char*>>& param) {
+  const std::string n = std::get<0>(param.param).file;
+  return n.substr(0, n.find('/')) + "_" + std::get<1>(param.param);
+}
+
 INSTANTIATE_TEST_SUITE_P(Datasets, RealBlocks,
-                         ::testing::Combine(::testing::Values(Dataset{"cambridge_ma/ASSESSING_ParcelsFY2014.topojson",
-                                                                      ""},
-                                                              Dataset{"paris_18e/cadastre-75118-parcelles.json", ""},
-                                                              Dataset{"malibu_ca/parcels.geojson", ""},
-                                                              Dataset{"eatonville_wa/parcels.geojson", "EPSG:2286"},
-                                                              Dataset{"seoul_jamsil/parcels.geojson", ""},
-                                                              Dataset{"rhone_69114/parcelles.json", ""}),
+                         ::testing::Combine(::testing::ValuesIn(kDatasets),
+                                            ::testing::Values("obb", "skeleton", "offset", "parish")),
+                         datasetAndStyle);
+INSTANTIATE_TEST_SUITE_P(Datasets, RealBlocksReuse,
+                         ::testing::Combine(::testing::ValuesIn(kDatasets),
                                             ::testing::Values("obb", "skeleton", "offset")),
-                         [](const auto& param) {
-                           const std::string n = std::get<0>(param.param).file;
-                           return n.substr(0, n.find('/')) + "_" + std::get<1>(param.param);
-                         });
+                         datasetAndStyle);
 
 TEST(GenerateJob, DerivedBoundsBelowTheRangesAreClampedNotRefused) {
   // eatonville_wa has a block of slivers whose derived A_max is under 1 m2.

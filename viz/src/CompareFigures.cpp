@@ -26,6 +26,32 @@ std::string generatedName(const CompareRequest& request, const CompareResult& r)
   return name + ")";
 }
 
+// The generated parcels on a map: land a style left unassigned has no value
+// (drawn in the no-value grey), the others their value of `q`.
+void fillGenerated(MapPanel& panel, const pipeline::GeneratedParcels& g, const analysis::ParcelQuantity& q) {
+  for (std::size_t i = 0; i < g.parcels.size(); ++i) {
+    panel.shapes.push_back(&g.parcels[i]);
+    panel.values.push_back(g.isUnassigned(i) ? std::nan("") : q.value(g.metrics[i]));
+  }
+}
+
+// "N parcels", with the unassigned land counted apart.
+std::string generatedCount(const pipeline::GeneratedParcels& g) {
+  const std::size_t unassigned = static_cast<std::size_t>(g.unassignedParcels);
+  return std::to_string(g.parcels.size() - unassigned) + " parcels" +
+         (unassigned > 0 ? ", " + std::to_string(unassigned) + " unassigned (grey)" : std::string());
+}
+
+// The values of `q` of the generated parcels, unassigned land left out.
+std::vector<double> generatedSample(const pipeline::GeneratedParcels& g, const analysis::ParcelQuantity& q) {
+  if (g.unassigned.empty()) return analysis::quantitySample(g.metrics, q);
+  std::vector<analysis::ParcelMetrics> assigned;
+  for (std::size_t i = 0; i < g.metrics.size(); ++i) {
+    if (!g.unassigned[i]) assigned.push_back(g.metrics[i]);
+  }
+  return analysis::quantitySample(assigned, q);
+}
+
 std::string inputName(const CompareRequest& request) {
   return std::filesystem::path(request.input.path).filename().string();
 }
@@ -62,7 +88,7 @@ ColourScale quantityScale(const CompareResult& r, const CompareRequest& request,
   // parcels (a slider) leaves the scale, and the observed view, as they were;
   // the generated parcels set it only when no observed parcel has a value.
   std::vector<double> sample = analysis::quantitySample(r.observedLots, q);
-  if (sample.empty()) sample = analysis::quantitySample(r.generated.metrics, q);
+  if (sample.empty()) sample = generatedSample(r.generated, q);
   if (sample.empty()) {
     scale.minimum = 0;
     scale.maximum = 1;
@@ -90,12 +116,9 @@ void renderQuantityMap(const CompareResult& r, const CompareRequest& request, co
     observed.shapes.push_back(&parcels[i].shape);
     observed.values.push_back(q.value(r.observed->analysis.metrics[i]));
   }
-  for (std::size_t i = 0; i < r.generated.parcels.size(); ++i) {
-    generated.shapes.push_back(&r.generated.parcels[i]);
-    generated.values.push_back(q.value(r.generated.metrics[i]));
-  }
+  fillGenerated(generated, r.generated, q);
   observed.title = "Observed: " + std::to_string(observed.shapes.size()) + " parcels";
-  generated.title = "Procedural (" + request.style + "): " + std::to_string(generated.shapes.size()) + " parcels";
+  generated.title = "Procedural (" + request.style + "): " + generatedCount(r.generated);
   std::string what = q.title.substr(0, q.title.find(" ("));
   what[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(what[0])));
   renderMaps("Parcel " + (q.name == "aspect_ratio" ? std::string("aspect ratio") : q.name) + ", observed and " +
@@ -118,10 +141,9 @@ QuantityHistogram quantityHistogram(const CompareResult& r, const CompareRequest
       break;
     }
   }
-  const analysis::SharedHistogram h =
-      made ? *made
-           : analysis::sharedHistogram(analysis::quantitySample(r.observedLots, q),
-                                       analysis::quantitySample(r.generated.metrics, q), bins, quantile);
+  const analysis::SharedHistogram h = made ? *made
+                                           : analysis::sharedHistogram(analysis::quantitySample(r.observedLots, q),
+                                                                       generatedSample(r.generated, q), bins, quantile);
   QuantityHistogram out;
   out.edges = h.edges;
   out.xTitle = q.title;
@@ -297,14 +319,12 @@ std::vector<std::string> drawLeaderboard(const pipeline::Leaderboard& board, con
   for (std::size_t e = 0; e < board.entries.size(); ++e) {
     const auto& g = board.entries[e].result.generated;
     MapPanel& p = panels[e + 1];
-    for (std::size_t i = 0; i < g.parcels.size(); ++i) {
-      p.shapes.push_back(&g.parcels[i]);
-      p.values.push_back(q.value(g.metrics[i]));
-    }
+    fillGenerated(p, g, q);
     std::ostringstream t;
     t.precision(2);
-    t << board.entries[e].style << ": " << g.parcels.size() << ", fit "
-      << pipeline::fitScore(board.entries[e].result.city);
+    t << board.entries[e].style << ": " << g.parcels.size() - static_cast<std::size_t>(g.unassignedParcels)
+      << (g.unassignedParcels > 0 ? " + " + std::to_string(g.unassignedParcels) + " unassigned" : std::string())
+      << ", fit " << pipeline::fitScore(board.entries[e].result.city);
     p.title = t.str();
   }
   const std::string title = "Parcel aspect ratio, observed and every style: " + inputName(request);

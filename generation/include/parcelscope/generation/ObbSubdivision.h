@@ -61,6 +61,11 @@ struct Subdivision {
   bool fallback = false;         ///< another style could not subdivide the block; OBB did
   std::string fallbackReason;    ///< why, when fallback
   int patioParcels = 0;          ///< parcels that are (parts of) inner patios, without street access by design
+  /// The last unassignedParcels parcels (after any patios) are land the style
+  /// left to no parcel (parish: lots without street access, which Parish &
+  /// Muller discard); kept so that the parcels still tile the block. Not
+  /// counted in withoutAccess.
+  int unassignedParcels = 0;
   std::shared_ptr<const ObbSplits> obbSplits;  ///< OBB only, when asked to record them
   /// OBB only: 1 when the block has no holes and a strictly simple ring, 0
   /// when not, -1 when it was not tested (for ObbReuse::blockSimple).

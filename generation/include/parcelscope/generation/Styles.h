@@ -66,7 +66,7 @@ public:
   Subdivision subdivide(const StyleRun& run) const;
 };
 
-/// Every registered style, in the order of --help and the GUI: obb, skeleton, offset, auto.
+/// Every registered style, in the order of --help and the GUI: obb, skeleton, offset, parish, auto.
 const std::vector<const Style*>& styles();
 /// The style called `name`; throws Error(Usage) naming the styles otherwise.
 const Style& style(const std::string& name);
@@ -94,6 +94,7 @@ constexpr double kAutoSkeletonAccessShare = 0.9;
 const Style& obbStyle();
 const Style& skeletonStyle();
 const Style& offsetStyle();
+const Style& parishStyle();
 const Style& autoStyle();
 
 }  // namespace parcelscope::generation

@@ -85,9 +85,19 @@ struct GeneratedParcels {
   /// parcels are not known yet (left at 0). Empty: every parcel fully measured.
   std::vector<std::size_t> contextPending;
   std::int64_t failedBlocks = 0, oversize = 0, withoutAccess = 0;
-  std::int64_t clampedBounds = 0;        ///< per-block bounds moved into the parameter ranges
-  std::int64_t fallbackBlocks = 0;       ///< skeleton blocks subdivided with OBB instead
-  std::int64_t patioParcels = 0;         ///< parcels that are (parts of) patios
+  std::int64_t clampedBounds = 0;   ///< per-block bounds moved into the parameter ranges
+  std::int64_t fallbackBlocks = 0;  ///< skeleton blocks subdivided with OBB instead
+  std::int64_t patioParcels = 0;    ///< parcels that are (parts of) patios
+  /// Per parcel, 1 where it is land the style left unassigned (see
+  /// Subdivision::unassignedParcels): written with role "unassigned", drawn
+  /// in a neutral colour, left out of every comparison. Empty when none is.
+  std::vector<char> unassigned;
+  std::int64_t unassignedParcels = 0;
+  double unassignedArea = 0;  ///< m²
+  bool isUnassigned(std::size_t parcel) const { return !unassigned.empty() && unassigned[parcel]; }
+  /// Indices of the parcels that are not unassigned land, of `parcels` (all
+  /// parcels when empty).
+  std::vector<int> assignedOf(const std::vector<int>& parcels) const;
   std::vector<std::string> blockStyles;  ///< style each entry of `blocks` was subdivided with
   std::vector<std::string> failures;     ///< one line per failed or fallen-back block
   std::uint64_t seed = 0;
