@@ -15,6 +15,7 @@
 
 #include "BlockFailure.h"
 #include "LocalShift.h"
+#include "LotSplit.h"
 #include "PolygonSplit.h"
 #include "PostProcess.h"
 #include "parcelscope/analysis/Metrics.h"
@@ -52,16 +53,12 @@ struct ParishParameters {
 
 ParishParameters parishParametersFrom(const ParameterValues& v) {
   ParishParameters p;
-  if (auto it = v.find("a-max"); it != v.end()) p.aMax = it->second;
-  if (auto it = v.find("parallel-angle"); it != v.end()) p.parallelAngle = it->second;
-  if (auto it = v.find("min-frontage"); it != v.end()) p.minFrontage = it->second;
+  readValue(v, "a-max", p.aMax);
+  readValue(v, "parallel-angle", p.parallelAngle);
+  readValue(v, "min-frontage", p.minFrontage);
   return p;
 }
 
-// Consecutive edges of a ring turning by less than this from the run they
-// continue are one side of the lot: real blocks carry many vertices along a
-// straight street, and a lot's "edge" in the paper's sense is the street front.
-constexpr double kSideTurn = 10.0 * kPi / 180.0;
 // A split must leave every piece at least this share of the lot's area (a cut
 // next to a vertex would otherwise make crumbs) and none above 1 minus it (so
 // every accepted split shrinks the lot and the recursion ends).
@@ -71,59 +68,11 @@ constexpr double kMinPieceShare = 0.02;
 constexpr std::size_t kMaxLots = 200000;
 constexpr std::uint64_t kMaxSplitWork = 400000000;
 
-struct Side {
-  Point a, b;  // first and last vertex of the run
-  double length = 0;
-  Point dir;  // unit, a to b
-};
-
-Point unit(const Point& a, const Point& b) {
-  const double n = norm(b.x - a.x, b.y - a.y);
-  return n > 0 ? Point{(b.x - a.x) / n, (b.y - a.y) / n} : Point{1, 0};
-}
-
-double angleBetween(const Point& u, const Point& v) {
-  return std::atan2(std::fabs(u.x * v.y - u.y * v.x), u.x * v.x + u.y * v.y);
-}
-
-// The sides of a ring: maximal runs of edges each within kSideTurn of the
-// run's chord so far. The runs start at a corner, so none wraps around.
-std::vector<Side> sidesOf(const Ring& ring) {
-  const std::size_t n = ring.size();
-  std::vector<Side> sides;
-  if (n < 3) return sides;
-  auto edgeDir = [&](std::size_t i) { return unit(ring[i], ring[(i + 1) % n]); };
-  std::size_t start = 0;
-  double sharpest = -1;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double turn = angleBetween(edgeDir((i + n - 1) % n), edgeDir(i));
-    if (turn > sharpest) {
-      sharpest = turn;
-      start = i;
-    }
-  }
-  Side run{ring[start], ring[(start + 1) % n], 0, edgeDir(start)};
-  run.length = norm(run.b.x - run.a.x, run.b.y - run.a.y);
-  for (std::size_t k = 1; k <= n; ++k) {
-    const std::size_t i = (start + k) % n;
-    if (k < n && angleBetween(run.dir, edgeDir(i)) < kSideTurn) {
-      run.b = ring[(i + 1) % n];
-      run.dir = unit(run.a, run.b);
-      run.length = norm(run.b.x - run.a.x, run.b.y - run.a.y);
-      continue;
-    }
-    sides.push_back(run);
-    if (k < n) {
-      run = {ring[i], ring[(i + 1) % n], 0, edgeDir(i)};
-      run.length = norm(run.b.x - run.a.x, run.b.y - run.a.y);
-    }
-  }
-  return sides;
-}
-
-struct Line {
-  Point through, dir;
-};
+using detail::angleBetween;
+using detail::Side;
+using detail::sidesOf;
+using detail::SplitLine;
+using detail::unitFrom;
 
 // The split lines of a lot, best first. First the pairs of approximately
 // parallel sides facing each other (opposite directions, overlapping when
@@ -131,11 +80,11 @@ struct Line {
 // the line crosses both at right angles to their mean direction, halfway along
 // their overlap. Then, for lots without such a pair (triangles), the line
 // across each of the three longest sides at its midpoint.
-std::vector<Line> splitLines(const Ring& ring, double parallelAngle) {
+std::vector<SplitLine> splitLines(const Ring& ring, double parallelAngle) {
   const std::vector<Side> sides = sidesOf(ring);
   struct Pair {
     double score;
-    Line line;
+    SplitLine line;
   };
   std::vector<Pair> pairs;
   const double tolerance = parallelAngle * kPi / 180.0;
@@ -143,7 +92,7 @@ std::vector<Line> splitLines(const Ring& ring, double parallelAngle) {
     for (std::size_t j = i + 1; j < sides.size(); ++j) {
       const Side &s = sides[i], &t = sides[j];
       if (angleBetween(s.dir, Point{-t.dir.x, -t.dir.y}) > tolerance) continue;
-      const Point d = unit({0, 0}, {s.dir.x - t.dir.x, s.dir.y - t.dir.y});
+      const Point d = unitFrom({0, 0}, {s.dir.x - t.dir.x, s.dir.y - t.dir.y});
       auto along = [&](const Point& p) { return p.x * d.x + p.y * d.y; };
       const double lo = std::max(std::min(along(s.a), along(s.b)), std::min(along(t.a), along(t.b)));
       const double hi = std::min(std::max(along(s.a), along(s.b)), std::max(along(t.a), along(t.b)));
@@ -153,7 +102,7 @@ std::vector<Line> splitLines(const Ring& ring, double parallelAngle) {
     }
   }
   std::stable_sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) { return a.score > b.score; });
-  std::vector<Line> lines;
+  std::vector<SplitLine> lines;
   for (const Pair& p : pairs) lines.push_back(p.line);
   std::vector<Side> longest = sides;
   std::stable_sort(longest.begin(), longest.end(), [](const Side& a, const Side& b) { return a.length > b.length; });
@@ -163,8 +112,6 @@ std::vector<Line> splitLines(const Ring& ring, double parallelAngle) {
   }
   return lines;
 }
-
-bool validPiece(const Polygon& p) { return (p.holes.empty() && isClearlySimple(p.outer)) || geos::isValid(p); }
 
 class ParishSubdivider {
 public:
@@ -189,7 +136,8 @@ public:
       }
       if (pieces.empty()) {
         (outlineEdges_->sharesAtLeast(lot, p_.minFrontage) ? assigned : unassigned).push_back(std::move(lot));
-        if (assigned.size() + unassigned.size() > kMaxLots) throw OverBudget("work budget: more than 200000 lots");
+        if (assigned.size() + unassigned.size() > kMaxLots)
+          throw detail::WorkBudgetExceeded("work budget: more than 200000 lots");
         continue;
       }
       // Depth first, in the pieces' order: the first piece is finished first.
@@ -200,53 +148,29 @@ public:
     for (Polygon& q : unassigned) out.parcels.push_back(std::move(q));
   }
 
-  struct OverBudget : std::runtime_error {
-    using std::runtime_error::runtime_error;
-  };
-
 private:
   // The pieces of the first admissible split line, or nothing.
   std::vector<Polygon> split(const Polygon& lot, double lotArea) {
     std::size_t vertices = lot.outer.size();
     for (const Ring& h : lot.holes) vertices += h.size();
-    for (const Line& line : splitLines(lot.outer, p_.parallelAngle)) {
+    for (const SplitLine& line : splitLines(lot.outer, p_.parallelAngle)) {
       work_ += vertices;
-      if (work_ > kMaxSplitWork) throw OverBudget("work budget: more than 4e8 vertices visited by split lines");
+      if (work_ > kMaxSplitWork)
+        throw detail::WorkBudgetExceeded("work budget: more than 4e8 vertices visited by split lines");
       std::vector<Polygon> pieces = piecesOf(lot, lotArea, line);
       if (!pieces.empty()) return pieces;
     }
     return {};
   }
 
-  // Floating point first (its pieces kept when they are valid and keep the
-  // lot's area), the exact split otherwise; nothing when a piece is too small
-  // or invalid.
-  static std::vector<Polygon> piecesOf(const Polygon& lot, double lotArea, const Line& line) {
-    detail::SplitPieces split;
-    bool fast = detail::splitByLineFast(lot, line.through, line.dir, split) && !split.pinched;
-    std::vector<Polygon> pieces;
-    if (fast) {
-      pieces = joined(std::move(split));
-      double sum = 0;
-      for (const Polygon& q : pieces) sum += area(q);
-      fast = std::fabs(sum - lotArea) <= 1e-9 * lotArea && std::all_of(pieces.begin(), pieces.end(), validPiece);
-    }
-    if (!fast) {
-      pieces = joined(detail::splitByLine(lot, line.through, line.dir));
-      if (!std::all_of(pieces.begin(), pieces.end(), validPiece)) return {};
-    }
-    if (pieces.size() < 2) return {};
+  // The pieces of the split, or nothing when a piece is too small (see kMinPieceShare).
+  static std::vector<Polygon> piecesOf(const Polygon& lot, double lotArea, const SplitLine& line) {
+    std::vector<Polygon> pieces = detail::splitLot(lot, lotArea, line);
     for (const Polygon& q : pieces) {
       const double share = area(q) / lotArea;
       if (share < kMinPieceShare || share > 1 - kMinPieceShare) return {};
     }
     return pieces;
-  }
-
-  static std::vector<Polygon> joined(detail::SplitPieces&& split) {
-    std::vector<Polygon> parts = std::move(split.left);
-    parts.insert(parts.end(), std::make_move_iterator(split.right.begin()), std::make_move_iterator(split.right.end()));
-    return parts;
   }
 
   const Polygon& block_;
@@ -258,39 +182,15 @@ private:
 
 Subdivision subdivideParish(const Polygon& block, const ParishParameters& p, const ObbParameters& bounds,
                             std::uint64_t seed) {
-  const Point o = detail::exactShiftOrigin(block);
-  Polygon local = detail::translated(block, -o.x, -o.y);
-  Subdivision out;
-  std::string reason;
-  try {
-    if (!normalise(local) || !detail::isValidForSplit(local)) {
-      throw detail::StyleFailure("the block is not a valid polygon with holes");
-    }
+  return detail::runNearOrigin(block, bounds, seed, [&](const Polygon& local, Subdivision& out) {
     if (const double least = area(local) / p.aMax; least > kMaxLots) {
       out.failed = true;
       out.failure = "work budget: area / A_max = " + std::to_string(static_cast<long long>(std::min(least, 1e18))) +
                     " lots, more than " + std::to_string(kMaxLots);
-    } else {
-      ParishSubdivider(local, p).run(out);
-      if (o.x != 0 || o.y != 0) {
-        for (Polygon& parcel : out.parcels) detail::translate(parcel, o.x, o.y);
-      }
-      detail::checkTiling(block, out);
+      return;
     }
-  } catch (const ParishSubdivider::OverBudget& e) {
-    out = Subdivision{};
-    out.failed = true;
-    out.failure = e.what();
-  } catch (const std::exception& e) {
-    detail::rethrowUnlessBlockFailure();
-    reason = e.what();
-  }
-  if (out.failed) {
-    out.parcels = {block};
-    return out;
-  }
-  if (!reason.empty()) out = detail::fallBackToObb(block, bounds, seed, reason);
-  return out;
+    ParishSubdivider(local, p).run(out);
+  });
 }
 
 class ParishStyle : public Style {

@@ -7,6 +7,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "BlockFailure.h"
+#include "LocalShift.h"
+#include "PolygonSplit.h"
 #include "parcelscope/core/Geometry.h"
 #include "parcelscope/generation/ObbSubdivision.h"
 
@@ -38,5 +41,50 @@ int mergeSlivers(const Polygon& block, Subdivision& out, double minFrontage);
 /// The block subdivided by the OBB style, marked as a fallback for `reason`.
 Subdivision fallBackToObb(const Polygon& block, const ObbParameters& bounds, std::uint64_t seed,
                           const std::string& reason);
+
+/// Thrown by a style when a block exceeds its work budget; the message is the
+/// failure recorded (the block comes back whole).
+struct WorkBudgetExceeded : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// How the lot-splitting styles (parish, sexton) run on a block:
+/// `subdivide(local, out)` on the block moved next to the origin
+/// (exactShiftOrigin) once it passed the validity check, then the parcels
+/// moved back and their tiling checked. A block over its work budget
+/// (WorkBudgetExceeded, or `out.failed` set) comes back whole, failed; one the
+/// style cannot subdivide (StyleFailure, an invalid block, CGAL's failed
+/// preconditions) falls back to obb with the reason.
+template <typename Subdivide>
+Subdivision runNearOrigin(const Polygon& block, const ObbParameters& bounds, std::uint64_t seed,
+                          Subdivide&& subdivide) {
+  const Point o = exactShiftOrigin(block);
+  Polygon local = translated(block, -o.x, -o.y);
+  Subdivision out;
+  std::string reason;
+  try {
+    if (!normalise(local) || !isValidForSplit(local)) throw StyleFailure("the block is not a valid polygon with holes");
+    subdivide(static_cast<const Polygon&>(local), out);
+    if (!out.failed) {
+      if (o.x != 0 || o.y != 0) {
+        for (Polygon& parcel : out.parcels) translate(parcel, o.x, o.y);
+      }
+      checkTiling(block, out);
+    }
+  } catch (const WorkBudgetExceeded& e) {
+    out = Subdivision{};
+    out.failed = true;
+    out.failure = e.what();
+  } catch (const std::exception& e) {
+    rethrowUnlessBlockFailure();
+    reason = e.what();
+  }
+  if (out.failed) {
+    out.parcels = {block};
+    return out;
+  }
+  if (!reason.empty()) out = fallBackToObb(block, bounds, seed, reason);
+  return out;
+}
 
 }  // namespace parcelscope::generation::detail

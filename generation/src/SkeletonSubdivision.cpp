@@ -21,6 +21,7 @@
 #include "PolygonSplit.h"
 #include "PostProcess.h"
 #include "Random.h"
+#include "StraightSkeleton.h"
 #include "parcelscope/analysis/Metrics.h"
 #include "parcelscope/core/GeosOps.h"
 
@@ -1376,9 +1377,43 @@ void finish(const Polygon& block, const Point& o, Subdivision& out, double minFr
   }
 }
 
-// The parcels tile the block: valid, and their areas sum to the block's.
-
 }  // namespace
+
+namespace detail {
+
+InnerSkeleton innerSkeleton(const Ring& ring, std::size_t maxEvents) {
+  std::vector<Kc::Point_2> outer;
+  outer.reserve(ring.size());
+  for (const Point& p : ring) outer.emplace_back(p.x, p.y);
+  GuardVisitor guard(maxEvents);
+  SkeletonMaker maker(boost::none, SkeletonTraits(), guard);
+  maker.enter_contour(outer.begin(), outer.end());
+  const auto ss = maker.construct_skeleton();
+  if (guard.overBudget)
+    throw OverBudget("the straight skeleton made more than " + std::to_string(maxEvents) + " events");
+  if (!ss)
+    throw Fallback(guard.broken ? "the straight skeleton came out broken" : "no straight skeleton could be built");
+  InnerSkeleton out;
+  std::unordered_map<const void*, int> index;
+  auto nodeOf = [&](auto v) {
+    auto [it, added] = index.emplace(&*v, static_cast<int>(out.nodes.size()));
+    if (added) {
+      out.nodes.push_back({v->point().x(), v->point().y()});
+      out.time.push_back(v->time());
+    }
+    return it->second;
+  };
+  for (auto h = ss->halfedges_begin(); h != ss->halfedges_end(); ++h) {
+    // Each edge once (from its halfedge of lower address), skeleton nodes only.
+    if (!h->is_bisector() || &*h > &*h->opposite()) continue;
+    const auto a = h->opposite()->vertex(), b = h->vertex();
+    if (a->is_contour() || b->is_contour()) continue;
+    out.edges.emplace_back(nodeOf(a), nodeOf(b));
+  }
+  return out;
+}
+
+}  // namespace detail
 
 struct SkeletonLayout {
   Polygon block;  // as given to subdivideSkeleton

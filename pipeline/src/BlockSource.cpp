@@ -24,9 +24,18 @@ public:
     for (std::size_t b = 0; b < observed.analysis.blocks.size(); ++b) {
       const auto& s = observed.analysis.statistics[b];
       const Block& block = observed.analysis.blocks[b];
+      auto sample = std::make_shared<generation::ObservedSample>();
+      for (int i : block.parcels) {
+        sample->areas.push_back(observed.analysis.metrics[static_cast<std::size_t>(i)].area);
+        sample->widths.push_back(observed.analysis.metrics[static_cast<std::size_t>(i)].width);
+        sample->aspectRatios.push_back(observed.analysis.metrics[static_cast<std::size_t>(i)].aspectRatio);
+      }
+      double blockArea = 0;
+      for (const Polygon& part : block.parts) blockArea += area(part);
       for (std::size_t part = 0; part < block.parts.size(); ++part) {
         in.entries.push_back({block.id, block.parts[part], s.aMin, s.aMax, s.wMin, s.wMax, s.streetAccessShare,
-                              block.key, static_cast<int>(part)});
+                              block.key, static_cast<int>(part), sample,
+                              blockArea > 0 ? area(block.parts[part]) / blockArea : 1.0});
       }
     }
     if (observed.streets) {

@@ -474,6 +474,8 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
                            .set("parcels_without_street_access", r.generated.withoutAccess)
                            .set("unassigned_parcels", r.generated.unassignedParcels)
                            .set("unassigned_area_m2", r.generated.unassignedArea)
+                           .set("blocks_with_target_count", r.generated.blocksWithTarget)
+                           .set("blocks_at_target_count", r.generated.blocksAtTarget)
                            .set("per_block_bounds_clamped", r.generated.clampedBounds)
                            .set("failures", failures));
   run.set("written", writtenLayersJson({{parcelsFile, parcelsWritten}, {"blocks.gpkg", blocksWritten}}));

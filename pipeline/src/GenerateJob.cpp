@@ -203,6 +203,8 @@ Subdivision subdivideEntry(const BlockInputs& inputs, std::size_t entry, const B
     run.previousSeed = previousPlan->seed;
   }
   run.record = record;
+  run.observed = inputs.entries[entry].observed.get();
+  run.observedShare = inputs.entries[entry].observedShare;
   return s.subdivide(run);
 }
 
@@ -300,6 +302,10 @@ GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<Bl
     out.oversize += s.oversize;
     out.withoutAccess += s.withoutAccess;
     out.patioParcels += s.patioParcels;
+    if (s.targetParcels > 0) {
+      ++out.blocksWithTarget;
+      out.blocksAtTarget += static_cast<int>(s.parcels.size()) == s.targetParcels;
+    }
     if (s.unassignedParcels > 0) {
       out.unassigned.resize(out.parcels.size(), 0);
       const std::vector<int>& in = out.blocks[k].parcels;
@@ -429,6 +435,8 @@ JobOutcome writeGenerate(io::OutputDirectory& out, const GenerateRequest& reques
                         .set("patio_parcels", g.patioParcels)
                         .set("unassigned_parcels", g.unassignedParcels)
                         .set("unassigned_area_m2", g.unassignedArea)
+                        .set("blocks_with_target_count", g.blocksWithTarget)
+                        .set("blocks_at_target_count", g.blocksAtTarget)
                         .set("blocks_fallback_obb", g.fallbackBlocks)
                         .set("per_block_bounds_clamped", g.clampedBounds)
                         .set("parcels_with_street_access_measured", withAccess));
@@ -445,14 +453,17 @@ JobOutcome writeGenerate(io::OutputDirectory& out, const GenerateRequest& reques
   io::writeJson(out.stage("run.json"), run);
   out.commit();
   reportProgress(progress, 1.0, "writing");
-  std::string summary = std::to_string(g.blocks.size()) + " blocks of " + g.source->path + " subdivided (" +
-                        request.style + ", seed " + std::to_string(g.seed) + ") into " +
-                        std::to_string(g.parcels.size()) + " parcels\n  " + std::to_string(g.oversize) +
-                        " oversize (no admissible split), " + std::to_string(g.withoutAccess) +
-                        " without street access (" + std::to_string(g.patioParcels) + " patio parcels), " +
-                        (g.unassignedParcels > 0 ? std::to_string(g.unassignedParcels) + " unassigned, " : "") +
-                        std::to_string(g.fallbackBlocks) + " blocks fell back to obb, " +
-                        std::to_string(g.failedBlocks) + " blocks refused";
+  std::string summary =
+      std::to_string(g.blocks.size()) + " blocks of " + g.source->path + " subdivided (" + request.style + ", seed " +
+      std::to_string(g.seed) + ") into " + std::to_string(g.parcels.size()) + " parcels\n  " +
+      std::to_string(g.oversize) + " oversize (no admissible split), " + std::to_string(g.withoutAccess) +
+      " without street access (" + std::to_string(g.patioParcels) + " patio parcels), " +
+      (g.unassignedParcels > 0 ? std::to_string(g.unassignedParcels) + " unassigned, " : "") +
+      (g.blocksWithTarget > 0
+           ? std::to_string(g.blocksAtTarget) + " of " + std::to_string(g.blocksWithTarget) + " blocks at their count, "
+           : "") +
+      std::to_string(g.fallbackBlocks) + " blocks fell back to obb, " + std::to_string(g.failedBlocks) +
+      " blocks refused";
   for (const auto& f : g.failures) summary += "\n  " + f;
   return {run, summary};
 }

@@ -196,15 +196,16 @@ TEST(WorkBudget, NoisyCircleOf100000VerticesObbSubdivides) {
 
 TEST(WorkBudget, PolygonOf90By40DegreesIsKeptWholeByEveryStyle) {
   const Polygon block = continent();
-  for (const char* s : {"obb", "skeleton", "offset", "parish", "auto"}) {
+  for (const char* s : {"obb", "skeleton", "offset", "parish", "sexton", "auto"}) {
     const Outcome o = run(block, s);
     expectWithinBudget(block, o, s);
     EXPECT_TRUE(o.result.failed) << s;
-    EXPECT_EQ(o.result.fallback, std::string(s) != "obb" && std::string(s) != "parish") << s;
+    EXPECT_EQ(o.result.fallback, std::string(s) != "obb" && std::string(s) != "parish" && std::string(s) != "sexton")
+        << s;
   }
   // The small squares of the same layer are subdivided as always.
   const Polygon square = test::rect(1000, 1000, 1080, 1080);
-  for (const char* s : {"obb", "skeleton", "offset", "parish", "auto"}) {
+  for (const char* s : {"obb", "skeleton", "offset", "parish", "sexton", "auto"}) {
     const Outcome o = run(square, s);
     EXPECT_FALSE(o.result.failed || o.result.fallback) << s << ": " << o.result.failure << o.result.fallbackReason;
     EXPECT_GT(o.result.parcels.size(), 4u) << s;
@@ -216,7 +217,7 @@ TEST(WorkBudget, RepairedSelfIntersectingPolygonOf170KmStaysWithinTheBudgetInEve
   const std::vector<Polygon> parts = repairedStar();
   ASSERT_FALSE(parts.empty());
   int kept = 0;
-  for (const char* s : {"obb", "skeleton", "offset", "parish", "auto"}) {
+  for (const char* s : {"obb", "skeleton", "offset", "parish", "sexton", "auto"}) {
     for (std::size_t i = 0; i < parts.size(); ++i) {
       const std::string what = std::string(s) + " part " + std::to_string(i);
       const Outcome o = run(parts[i], s);
@@ -225,7 +226,7 @@ TEST(WorkBudget, RepairedSelfIntersectingPolygonOf170KmStaysWithinTheBudgetInEve
     }
   }
   // Thousands of km² are beyond every style's budget: each keeps it whole.
-  EXPECT_EQ(kept, static_cast<int>(5 * parts.size()));
+  EXPECT_EQ(kept, static_cast<int>(6 * parts.size()));
 }
 
 TEST(WorkBudget, BudgetedOutcomesAreReproducible) {

@@ -70,12 +70,12 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
   parallelFor(n, [&](std::size_t k) {
     results[k] = runBlock(inputs, k, plans[k], minFrontage).subdivision;
     reports[k] = test::checkTiling(inputs.entries[k].shape, results[k].parcels);
-    if ((style == "obb" || style == "parish") && !results[k].failed) {
+    if ((style == "obb" || style == "parish" || style == "sexton") && !results[k].failed) {
       // The access the subdivision decided on is the measured one.
       measuredWithout[k] = test::measuredWithoutAccess(inputs.entries[k].shape, results[k].parcels, minFrontage);
     }
   });
-  int parcels = 0, withoutAccess = 0, failed = 0, oversize = 0, fallbacks = 0, patios = 0;
+  int parcels = 0, withoutAccess = 0, failed = 0, oversize = 0, fallbacks = 0, patios = 0, withTarget = 0, atTarget = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const std::string what =
         std::string(dataset.file) + " " + style + " block " + std::to_string(inputs.entries[k].blockId);
@@ -89,6 +89,8 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
     } else if (style == "parish") {
       // Exactly the lots without street access are left unassigned.
       EXPECT_EQ(measuredWithout[k], results[k].unassignedParcels) << what;
+    } else if (style == "sexton") {
+      EXPECT_EQ(measuredWithout[k], results[k].withoutAccess) << what;
     }
     parcels += static_cast<int>(results[k].parcels.size());
     withoutAccess += results[k].withoutAccess;
@@ -96,6 +98,12 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
     oversize += results[k].oversize;
     fallbacks += results[k].fallback;
     patios += results[k].patioParcels;
+    withTarget += results[k].targetParcels > 0;
+    atTarget += results[k].targetParcels > 0 && static_cast<int>(results[k].parcels.size()) == results[k].targetParcels;
+  }
+  if (withTarget > 0) {
+    std::printf("%s %s: %d of %d blocks at their target count\n", dataset.file, style.c_str(), atTarget, withTarget);
+    EXPECT_GE(atTarget, withTarget * 90 / 100) << dataset.file << " " << style;
   }
   std::printf(
       "%s %s: %zu blocks, %d parcels (%d in patios), %d oversize, %d without street access, "
@@ -206,7 +214,7 @@ std::string datasetAndStyle(const ::testing::TestParamInfo<std::tuple<Dataset, c
 
 INSTANTIATE_TEST_SUITE_P(Datasets, RealBlocks,
                          ::testing::Combine(::testing::ValuesIn(kDatasets),
-                                            ::testing::Values("obb", "skeleton", "offset", "parish")),
+                                            ::testing::Values("obb", "skeleton", "offset", "parish", "sexton")),
                          datasetAndStyle);
 INSTANTIATE_TEST_SUITE_P(Datasets, RealBlocksReuse,
                          ::testing::Combine(::testing::ValuesIn(kDatasets),

@@ -65,6 +65,16 @@ ParameterDescription outputOnly(ParameterDescription description);
 /// Values by parameter name; filled from defaults, then overridden by the user.
 using ParameterValues = std::map<std::string, double>;
 
+/// Sets `target` to the value named `name` in `values`, converted to its
+/// type, when there is one; returns whether there was.
+template <typename T>
+bool readValue(const ParameterValues& values, const std::string& name, T& target) {
+  const auto it = values.find(name);
+  if (it == values.end()) return false;
+  target = static_cast<T>(it->second);
+  return true;
+}
+
 /// Defaults of every description in `descriptions`.
 ParameterValues defaultValues(const std::vector<ParameterDescription>& descriptions);
 

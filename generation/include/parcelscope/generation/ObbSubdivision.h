@@ -66,6 +66,8 @@ struct Subdivision {
   /// Muller discard); kept so that the parcels still tile the block. Not
   /// counted in withoutAccess.
   int unassignedParcels = 0;
+  /// Styles that aim at a number of parcels (sexton): that number; 0 otherwise.
+  int targetParcels = 0;
   std::shared_ptr<const ObbSplits> obbSplits;  ///< OBB only, when asked to record them
   /// OBB only: 1 when the block has no holes and a strictly simple ring, 0
   /// when not, -1 when it was not tested (for ObbReuse::blockSimple).

@@ -15,6 +15,13 @@
 
 namespace parcelscope::generation {
 
+/// A block's observed parcels, for styles that fit them (sexton): their areas
+/// (m²), widths (MBR short side, m) and aspect ratios (MBR long over short
+/// side), as analysis measures them.
+struct ObservedSample {
+  std::vector<double> areas, widths, aspectRatios;
+};
+
 /// One block's run of a style.
 struct StyleRun {
   const Polygon& block;           ///< normalised, local metres
@@ -32,6 +39,10 @@ struct StyleRun {
   std::uint64_t previousSeed = 0;
   /// Keep what a later run may reuse in the outcome (Subdivision::obbSplits, ::skeletonLayout).
   bool record = false;
+  /// The observed parcels of the block this one is part of, when known; null otherwise.
+  const ObservedSample* observed = nullptr;
+  /// This part's share of its block's area (multipart blocks: the sample is the whole block's).
+  double observedShare = 1.0;
 };
 
 /// What a style knows of a block before choosing (for styles that choose
@@ -66,7 +77,7 @@ public:
   Subdivision subdivide(const StyleRun& run) const;
 };
 
-/// Every registered style, in the order of --help and the GUI: obb, skeleton, offset, parish, auto.
+/// Every registered style, in the order of --help and the GUI: obb, skeleton, offset, parish, sexton, auto.
 const std::vector<const Style*>& styles();
 /// The style called `name`; throws Error(Usage) naming the styles otherwise.
 const Style& style(const std::string& name);
@@ -95,6 +106,7 @@ const Style& obbStyle();
 const Style& skeletonStyle();
 const Style& offsetStyle();
 const Style& parishStyle();
+const Style& sextonStyle();
 const Style& autoStyle();
 
 }  // namespace parcelscope::generation

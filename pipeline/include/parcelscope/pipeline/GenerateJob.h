@@ -93,6 +93,9 @@ struct GeneratedParcels {
   /// in a neutral colour, left out of every comparison. Empty when none is.
   std::vector<char> unassigned;
   std::int64_t unassignedParcels = 0;
+  /// Blocks subdivided towards a number of parcels (sexton), and of those the
+  /// blocks that reached it exactly.
+  std::int64_t blocksWithTarget = 0, blocksAtTarget = 0;
   double unassignedArea = 0;  ///< m²
   bool isUnassigned(std::size_t parcel) const { return !unassigned.empty() && unassigned[parcel]; }
   /// Indices of the parcels that are not unassigned land, of `parcels` (all
@@ -118,6 +121,10 @@ struct BlockInputs {
     /// block_key field, else the feature's geometry).
     Key blockKey = 0;
     int part = 0;  ///< which part of a multipart block
+    /// The block's observed parcels (shared by its parts), for styles that fit
+    /// them; null without observed parcels.
+    std::shared_ptr<const generation::ObservedSample> observed;
+    double observedShare = 1.0;  ///< this part's share of its block's area
   };
   std::shared_ptr<const io::ParcelLayer> source;  ///< the input as read (frame, CRS, cleaning report)
   /// The street network the blocks come from (--streets); null otherwise.

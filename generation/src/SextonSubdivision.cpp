@@ -1,0 +1,452 @@
+// sexton: the parcel generation of Sexton & Watson 2010 (sections 3.3.2 to
+// 3.4.1): oblong blocks get a spine along their long axis, cut from end to end;
+// then the largest parcel is split again and again, across a random
+// road-facing side at a normally distributed position, under the paper's
+// constraints, until the block holds its target number of parcels; of many
+// randomized subdivisions the one closest to the block's observed parcels is
+// kept. docs/algorithms/sexton.md gives the choices the paper leaves open.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "BlockFailure.h"
+#include "LocalShift.h"
+#include "LotSplit.h"
+#include "PolygonSplit.h"
+#include "PostProcess.h"
+#include "Random.h"
+#include "StraightSkeleton.h"
+#include "parcelscope/analysis/Comparison.h"
+#include "parcelscope/analysis/Metrics.h"
+#include "parcelscope/analysis/ObservedAnalysis.h"
+#include "parcelscope/core/BoxIndex.h"
+#include "parcelscope/core/GeosOps.h"
+#include "parcelscope/generation/Styles.h"
+
+namespace parcelscope::generation {
+
+namespace {
+
+using detail::Side;
+using detail::SplitLine;
+
+const std::vector<ParameterDescription>& sextonParameterDescriptions() {
+  static const std::vector<ParameterDescription> d = [] {
+    std::vector<ParameterDescription> all;
+    for (const ParameterDescription& p : obbParameterDescriptions()) {
+      if (p.name == "a-min" || p.name == "a-max" || p.name == "w-min" || p.name == "min-frontage" || p.name == "seed") {
+        all.push_back(p);
+      }
+    }
+    all.push_back(integerParameter("parcel-count",
+                                   "sexton: parcels per block; 0: the block's observed count (without observed "
+                                   "parcels: its area over the mean of a-min and a-max)",
+                                   "", 0.0, 1e6, 0.0, "Subdivision"));
+    all.push_back(integerParameter(
+        "tries", "sexton: randomized subdivisions per block; the one closest to the observed parcels is kept", "", 1.0,
+        1000.0, 50.0, "Subdivision"));
+    return all;
+  }();
+  return d;
+}
+
+struct SextonParameters {
+  double aMin = 200, aMax = 800, wMin = 8, minFrontage = 1;
+  int count = 0;  // 0: derived
+  int tries = 50;
+};
+
+SextonParameters sextonParametersFrom(const ParameterValues& v) {
+  SextonParameters p;
+  for (const auto& [name, target] : {std::pair{"a-min", &p.aMin}, std::pair{"a-max", &p.aMax},
+                                     std::pair{"w-min", &p.wMin}, std::pair{"min-frontage", &p.minFrontage}}) {
+    readValue(v, name, *target);
+  }
+  readValue(v, "parcel-count", p.count);
+  readValue(v, "tries", p.tries);
+  return p;
+}
+
+// The paper's constants (section 3.3.2 and 3.4.1).
+constexpr double kOblong = 0.5;                    // blocks narrower than 1:2 (box width / length) get a spine
+constexpr double kSpineTurn = 20.0 * kPi / 180.0;  // spine simplification: summed turning before a new vertex
+constexpr double kMinAreaShare = 0.75;             // of a-min, the smallest parcel a split may make
+constexpr double kSquareEnough = 0.25;             // aspect (width / length) limit of the rectangularity rule
+constexpr double kMinPieceShare = 0.3;             // of the parcel split, each piece's least area
+constexpr double kPositionSd = 0.15;  // of the side's length: spread of the split position about its middle
+constexpr int kAttempts = 10;         // random splits tried on one parcel
+// Blocks whose ring has more vertices get no spine (the skeleton's cost grows
+// with them; the paper builds spines from a coarse raster).
+constexpr std::size_t kMaxSpineVertices = 2000;
+constexpr std::size_t kMaxSkeletonEvents = 500000;
+// The work budget: lots per block, and ring vertices visited by split lines over all tries.
+constexpr std::size_t kMaxLots = 200000;
+constexpr std::uint64_t kMaxSplitWork = 400000000;
+
+// The paper's constraints in force: all; then without limited rectangularity;
+// then without limited variation either. Minimum size and road access always
+// hold. A later level is tried only when no parcel takes a split under the
+// earlier one, so that the block still reaches its target count where its
+// area and frontage allow.
+enum class Relax { None = 0, Rectangularity = 1, Variation = 2 };
+constexpr int kRelaxLevels = 3;
+
+double aspectOf(const Polygon& p) {
+  const OrientedBox b = minimumAreaBox(p.outer);
+  return b.length > 0 ? b.width / b.length : 0;
+}
+
+// The longest path of the inner skeleton (a tree for a ring without holes):
+// the farthest node from any node, then the farthest from it.
+std::vector<Point> longestPath(const detail::InnerSkeleton& s) {
+  const std::size_t n = s.nodes.size();
+  if (n < 2 || s.edges.empty()) return {};
+  std::vector<std::vector<std::pair<int, double>>> next(n);
+  for (const auto& [a, b] : s.edges) {
+    const double l = norm(s.nodes[b].x - s.nodes[a].x, s.nodes[b].y - s.nodes[a].y);
+    next[a].push_back({b, l});
+    next[b].push_back({a, l});
+  }
+  auto farthest = [&](int from, std::vector<int>& parent) {
+    std::vector<double> dist(n, -1);
+    parent.assign(n, -1);
+    std::vector<int> stack{from};
+    dist[from] = 0;
+    int best = from;
+    while (!stack.empty()) {
+      const int u = stack.back();
+      stack.pop_back();
+      if (dist[u] > dist[best]) best = u;
+      for (const auto& [v, l] : next[u]) {
+        if (dist[v] >= 0) continue;
+        dist[v] = dist[u] + l;
+        parent[v] = u;
+        stack.push_back(v);
+      }
+    }
+    return best;
+  };
+  std::vector<int> parent;
+  const int u = farthest(s.edges.front().first, parent);
+  const int v = farthest(u, parent);
+  std::vector<Point> path;
+  for (int k = v; k >= 0; k = parent[k]) path.push_back(s.nodes[k]);
+  return path;
+}
+
+// The paper's simplification: along the spine, a vertex is kept where the
+// turning summed since the last kept one exceeds 20 degrees.
+std::vector<Point> simplifySpine(const std::vector<Point>& path) {
+  if (path.size() < 3) return path;
+  std::vector<Point> out{path.front()};
+  double turning = 0;
+  for (std::size_t i = 1; i + 1 < path.size(); ++i) {
+    turning += detail::angleBetween(detail::unitFrom(path[i - 1], path[i]), detail::unitFrom(path[i], path[i + 1]));
+    if (turning > kSpineTurn) {
+      out.push_back(path[i]);
+      turning = 0;
+    }
+  }
+  out.push_back(path.back());
+  return out;
+}
+
+// Where the ray from `from` along `dir` first meets the ring: the point and
+// the index of the edge; edge -1 when it meets none.
+std::pair<Point, int> rayHit(const Ring& ring, const Point& from, const Point& dir) {
+  double bestT = std::numeric_limits<double>::infinity();
+  int edge = -1;
+  Point hit;
+  const std::size_t n = ring.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point &a = ring[i], &b = ring[(i + 1) % n];
+    const Point e{b.x - a.x, b.y - a.y};
+    const double den = dir.x * e.y - dir.y * e.x;
+    if (den == 0) continue;
+    const Point w{a.x - from.x, a.y - from.y};
+    const double t = (w.x * e.y - w.y * e.x) / den;      // along the ray
+    const double u = (w.x * dir.y - w.y * dir.x) / den;  // along the edge
+    if (t > 0 && u >= 0 && u <= 1 && t < bestT) {
+      bestT = t;
+      edge = static_cast<int>(i);
+      hit = u == 0 ? a : u == 1 ? b : Point{a.x + u * e.x, a.y + u * e.y};
+    }
+  }
+  return {hit, edge};
+}
+
+// The block cut in two along its spine (section 3.3.2): the longest path of
+// its straight skeleton's inner edges (the medial axis the paper thins a
+// raster to find), simplified, its ends carried on along their last segment to
+// the block's contour. Empty when the block is not oblong, has holes, or the
+// cut does not give two valid pieces.
+std::vector<Polygon> spineSplit(const Polygon& block) {
+  if (!block.holes.empty() || block.outer.size() > kMaxSpineVertices) return {};
+  const OrientedBox box = minimumAreaBox(block.outer);
+  if (!(box.width < kOblong * box.length)) return {};
+  // The skeleton of the block's sides (its runs of nearly collinear edges, see
+  // LotSplit.h), as the paper simplifies the block before subdividing:
+  // vertices along a straight street would add skeleton branches into the
+  // corners.
+  Ring coarse;
+  for (const Side& s : detail::sidesOf(block.outer)) coarse.push_back(s.a);
+  if (coarse.size() < 3 || signedArea(coarse) <= 0 || !isClearlySimple(coarse)) coarse = block.outer;
+  std::vector<Point> spine;
+  try {
+    spine = simplifySpine(longestPath(detail::innerSkeleton(coarse, kMaxSkeletonEvents)));
+  } catch (const std::exception&) {
+    detail::rethrowUnlessBlockFailure();
+    return {};  // no skeleton: no spine, the block is split at random only
+  }
+  if (spine.size() < 2) return {};
+  const Ring& ring = block.outer;
+  const auto [h0, i0] = rayHit(ring, spine.front(), detail::unitFrom(spine[1], spine[0]));
+  const auto [h1, i1] = rayHit(ring, spine.back(), detail::unitFrom(spine[spine.size() - 2], spine.back()));
+  if (i0 < 0 || i1 < 0 || i0 == i1) return {};
+  const std::size_t n = ring.size();
+  // One piece runs along the contour from h0 to h1 and back along the spine, the other from h1 to h0.
+  auto piece = [&](const Point& from, int fromEdge, const Point& to, int toEdge, bool spineForward) {
+    Polygon p;
+    p.outer.push_back(from);
+    for (std::size_t k = (static_cast<std::size_t>(fromEdge) + 1) % n;; k = (k + 1) % n) {
+      p.outer.push_back(ring[k]);
+      if (k == static_cast<std::size_t>(toEdge)) break;
+    }
+    p.outer.push_back(to);
+    if (spineForward) {
+      p.outer.insert(p.outer.end(), spine.begin(), spine.end());
+    } else {
+      p.outer.insert(p.outer.end(), spine.rbegin(), spine.rend());
+    }
+    return p;
+  };
+  std::vector<Polygon> pieces = {piece(h0, i0, h1, i1, false), piece(h1, i1, h0, i0, true)};
+  double sum = 0;
+  for (Polygon& p : pieces) {
+    if (!normalise(p) || !p.holes.empty() || !(isClearlySimple(p.outer) || geos::isValid(p))) return {};
+    sum += area(p);
+  }
+  const double a = area(block);
+  if (std::fabs(sum - a) > 1e-9 * a) return {};
+  return pieces;
+}
+
+class SextonSubdivider {
+public:
+  SextonSubdivider(const Polygon& block, const SextonParameters& p) : block_(block), outline_{block.outer, {}}, p_(p) {
+    const Box b = bounds(block);
+    tolerance_ = std::max(1e-6, 1e-9 * (b.width() + b.height()));
+    outlineEdges_ = std::make_unique<analysis::PreparedBoundary>(outline_, tolerance_);
+    frontage_ = std::max(p.minFrontage, 0.5 * p.wMin);
+    const Ring& o = block.outer;
+    std::vector<std::pair<IndexBox, std::size_t>> edges;
+    for (std::size_t i = 0; i < o.size(); ++i) {
+      edges.emplace_back(indexBox(bounds(Ring{o[i], o[(i + 1) % o.size()]}), tolerance_), i);
+    }
+    outlineTree_ = BoxTree<std::size_t>(edges);
+  }
+
+  // One randomized subdivision from `start`, towards `target` parcels.
+  std::vector<Polygon> subdivide(const std::vector<Polygon>& start, std::size_t target, detail::Rng rng) {
+    std::vector<Polygon> parcels = start;
+    std::vector<double> areas;
+    std::vector<std::vector<Side>> road;  // each parcel's road-facing sides
+    for (const Polygon& q : parcels) {
+      areas.push_back(area(q));
+      road.push_back(roadSides(q));
+    }
+    int relaxed = 0;  // once a level is needed, the rest of this subdivision keeps it
+    while (parcels.size() < target) {
+      // The largest parcel first; when it takes no split, random ones; when
+      // none does, again with the constraints relaxed one by one (see Relax).
+      const auto largest = static_cast<std::size_t>(std::max_element(areas.begin(), areas.end()) - areas.begin());
+      bool done = false;
+      for (int round = relaxed * (kAttempts + 1); round < kRelaxLevels * (kAttempts + 1) && !done; ++round) {
+        const int level = round / (kAttempts + 1);
+        const bool first = round % (kAttempts + 1) == 0;
+        const std::size_t pick =
+            first ? largest : static_cast<std::size_t>(rng.uniform() * static_cast<double>(parcels.size()));
+        std::vector<Polygon> pieces;
+        for (int attempt = 0; attempt < (first ? kAttempts : 1) && pieces.empty(); ++attempt) {
+          pieces = trySplit(parcels[pick], areas[pick], road[pick], target + 1 - parcels.size(),
+                            static_cast<Relax>(level), rng);
+        }
+        if (pieces.empty()) continue;
+        relaxed = level;
+        parcels[pick] = std::move(pieces[0]);
+        areas[pick] = area(parcels[pick]);
+        road[pick] = roadSides(parcels[pick]);
+        for (std::size_t k = 1; k < pieces.size(); ++k) {
+          areas.push_back(area(pieces[k]));
+          road.push_back(roadSides(pieces[k]));
+          parcels.push_back(std::move(pieces[k]));
+        }
+        done = true;
+      }
+      if (!done) break;  // no parcel takes an admissible split
+      if (parcels.size() > kMaxLots) throw detail::WorkBudgetExceeded("work budget: more than 200000 parcels");
+    }
+    return parcels;
+  }
+
+  bool hasAccess(const Polygon& p) const { return outlineEdges_->sharesAtLeast(p, p_.minFrontage); }
+
+private:
+  // A random split of `parcel` across one of its road-facing sides, or
+  // nothing when it breaks one of the paper's constraints.
+  std::vector<Polygon> trySplit(const Polygon& parcel, double parcelArea, const std::vector<Side>& road,
+                                std::size_t maxPieces, Relax relax, detail::Rng& rng) {
+    if (road.empty()) return {};
+    const Side& s = road[static_cast<std::size_t>(rng.uniform() * static_cast<double>(road.size()))];
+    const double f = std::clamp(0.5 + kPositionSd * rng.normal(), 0.05, 0.95);
+    const SplitLine line{{s.a.x + f * (s.b.x - s.a.x), s.a.y + f * (s.b.y - s.a.y)}, {-s.dir.y, s.dir.x}};
+    work_ += parcel.outer.size();
+    if (work_ > kMaxSplitWork)
+      throw detail::WorkBudgetExceeded("work budget: more than 4e8 vertices visited by split lines");
+    const double before = relax < Relax::Rectangularity ? aspectOf(parcel) : 0;
+    auto admissible = [&](const std::vector<Polygon>& pieces) {
+      // Two pieces, as the paper's splits make; more, once the constraints
+      // are relaxed, where a concave parcel leaves no line that makes two
+      // (never beyond the target count).
+      if (pieces.size() < 2 || pieces.size() > (relax == Relax::None ? 2 : maxPieces)) return false;
+      for (const Polygon& q : pieces) {
+        const double a = area(q);
+        if (a < kMinAreaShare * p_.aMin) return false;                                  // minimum size
+        if (relax < Relax::Variation && a < kMinPieceShare * parcelArea) return false;  // limited variation
+      }
+      for (const Polygon& q : pieces) {
+        if (relax < Relax::Rectangularity) {  // limited rectangularity
+          const double aspect = aspectOf(q);
+          if (before > kSquareEnough ? aspect < kSquareEnough : aspect <= before) return false;
+        }
+        if (!outlineEdges_->sharesAtLeast(q, frontage_)) return false;  // road access
+      }
+      return true;
+    };
+    // Random lines are many: one the floating-point split cannot make (it meets
+    // a hole) is dropped rather than made exactly, except on parcels without
+    // holes, where that happens only for a line through a vertex, and once the
+    // constraints are relaxed as far as they go.
+    const bool exact = parcel.holes.empty() || relax == Relax::Variation;
+    std::vector<Polygon> pieces = detail::splitLot(parcel, parcelArea, line, exact, admissible);
+    return pieces;
+  }
+
+  // The sides of `parcel` every edge of which lies on the block's outer
+  // contour (its midpoint within the tolerance of a contour edge).
+  std::vector<Side> roadSides(const Polygon& parcel) const {
+    std::vector<Side> road;
+    const Ring& ring = parcel.outer;
+    for (const Side& s : detail::sidesOf(ring)) {
+      bool on = true;
+      for (std::size_t k = 0; k < s.edges && on; ++k) {
+        const Point& a = ring[(s.first + k) % ring.size()];
+        const Point& b = ring[(s.first + k + 1) % ring.size()];
+        on = onOutline({0.5 * (a.x + b.x), 0.5 * (a.y + b.y)});
+      }
+      if (on) road.push_back(s);
+    }
+    return road;
+  }
+
+  bool onOutline(const Point& m) const {
+    namespace bgi = boost::geometry::index;
+    const Ring& o = block_.outer;
+    for (auto it = outlineTree_.qbegin(bgi::intersects(IndexPoint(m.x, m.y))); it != outlineTree_.qend(); ++it) {
+      const std::size_t i = it->second;
+      if (pointSegmentDistance(m, o[i], o[(i + 1) % o.size()]) <= tolerance_) return true;
+    }
+    return false;
+  }
+
+  const Polygon& block_;
+  const Polygon outline_;
+  SextonParameters p_;
+  double tolerance_ = 1e-6;
+  double frontage_ = 1;
+  std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;
+  BoxTree<std::size_t> outlineTree_;  // the outer contour's edges, by index
+  std::uint64_t work_ = 0;
+};
+
+// How far a subdivision is from the block's observed parcels: the KS of area,
+// of width and of aspect ratio (MBR sides, as the metrics measure them) plus
+// the relative count error; the count error alone without observed parcels.
+double distanceTo(const std::vector<Polygon>& parcels, const ObservedSample* observed, std::size_t target) {
+  const double countError =
+      std::fabs(static_cast<double>(parcels.size()) / static_cast<double>(std::max<std::size_t>(1, target)) - 1);
+  if (!observed || observed->areas.empty()) return countError;
+  std::vector<double> areas, widths, aspects;
+  for (const Polygon& p : parcels) {
+    areas.push_back(area(p));
+    const OrientedBox box = minimumAreaBox(p.outer);
+    widths.push_back(box.width);
+    aspects.push_back(box.width > 0 ? box.length / box.width : 0);
+  }
+  double d = countError;
+  for (const auto& [made, seen] : {std::pair{&areas, &observed->areas}, std::pair{&widths, &observed->widths},
+                                   std::pair{&aspects, &observed->aspectRatios}}) {
+    if (!seen->empty()) d += analysis::ksStatistic(*made, *seen);
+  }
+  return d;
+}
+
+Subdivision subdivideSexton(const StyleRun& r) {
+  const SextonParameters p = sextonParametersFrom(r.values);
+  return detail::runNearOrigin(
+      r.block, obbParametersFrom(r.values), r.seed, [&](const Polygon& local, Subdivision& out) {
+        double target = p.count;
+        if (target <= 0 && r.observed && !r.observed->areas.empty()) {
+          target = std::round(static_cast<double>(r.observed->areas.size()) * r.observedShare);
+        } else if (target <= 0) {
+          target = std::round(area(local) / (0.5 * (p.aMin + std::max(p.aMin, p.aMax))));
+        }
+        target = std::max(1.0, target);
+        if (target > static_cast<double>(kMaxLots)) {
+          out.failed = true;
+          out.failure = "work budget: a target of " + std::to_string(static_cast<long long>(std::min(target, 1e18))) +
+                        " parcels, more than " + std::to_string(kMaxLots);
+          return;
+        }
+        const auto wanted = static_cast<std::size_t>(target);
+        std::vector<Polygon> start = spineSplit(local);
+        // More spine pieces than parcels wanted: the spine is dropped (3.4.1).
+        if (start.empty() || start.size() > wanted) start = {local};
+        SextonSubdivider subdivider(local, p);
+        double best = std::numeric_limits<double>::infinity();
+        for (int t = 0; t < std::max(1, p.tries); ++t) {
+          std::vector<Polygon> parcels = subdivider.subdivide(
+              start, wanted, detail::Rng{detail::splitmix64(r.seed ^ (0x5E7701ULL + static_cast<std::uint64_t>(t)))});
+          const double d = distanceTo(parcels, r.observed, wanted);
+          if (d < best) {
+            best = d;
+            out.parcels = std::move(parcels);
+          }
+        }
+        out.targetParcels = static_cast<int>(wanted);
+        for (const Polygon& q : out.parcels) out.withoutAccess += !subdivider.hasAccess(q);
+      });
+}
+
+class SextonStyle : public Style {
+public:
+  std::string name() const override { return "sexton"; }
+  std::string description() const override {
+    return "spine along oblong blocks, then random splits of the largest parcel across a road-facing side to the "
+           "observed count, best of many tries (Sexton & Watson 2010)";
+  }
+  const std::vector<ParameterDescription>& parameters() const override { return sextonParameterDescriptions(); }
+  Subdivision run(const StyleRun& r) const override { return subdivideSexton(r); }
+};
+
+}  // namespace
+
+const Style& sextonStyle() {
+  static const SextonStyle s;
+  return s;
+}
+
+}  // namespace parcelscope::generation

@@ -1,0 +1,124 @@
+// The sexton style (Sexton & Watson 2010): a spine along oblong blocks, then
+// constrained random splits of the largest parcel to a target count, best of
+// many tries against the observed parcels.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "RandomShapes.h"
+#include "TestUtil.h"
+#include "TilingCheck.h"
+#include "parcelscope/generation/Styles.h"
+
+namespace parcelscope::generation {
+namespace {
+
+Subdivision sexton(const Polygon& block, ParameterValues values, std::uint64_t seed = 1,
+                   const ObservedSample* observed = nullptr) {
+  ParameterValues all = styleValues(sextonStyle(), {});
+  for (const auto& [name, v] : values) all[name] = v;
+  StyleRun run{block, all, seed, {}};
+  run.observed = observed;
+  return sextonStyle().subdivide(run);
+}
+
+TEST(Sexton, AnOblongBlockIsCutAlongItsSpineFromEndToEnd) {
+  // 120 x 40 (1:3): the spine runs along the middle; two parcels wanted: the two halves.
+  const Polygon block = test::rect(0, 0, 120, 40);
+  const Subdivision s = sexton(block, {{"parcel-count", 2}, {"a-min", 10}, {"w-min", 1}});
+  ASSERT_EQ(s.parcels.size(), 2u);
+  for (const Polygon& p : s.parcels) {
+    const Box b = bounds(p);
+    EXPECT_NEAR(b.width(), 120, 1e-9);
+    EXPECT_NEAR(b.height(), 20, 1e-9);
+  }
+  // A square block has no spine: its first split is across a side.
+  const Subdivision q = sexton(test::rect(0, 0, 60, 60), {{"parcel-count", 2}, {"a-min", 10}, {"w-min", 1}});
+  ASSERT_EQ(q.parcels.size(), 2u);
+  for (const Polygon& p : q.parcels) EXPECT_NEAR(bounds(p).height() * bounds(p).width(), area(p), 1e-6);
+}
+
+TEST(Sexton, ReachesTheTargetCountWithStreetAccessAndThePapersConstraints) {
+  const Polygon block = test::rect(0, 0, 160, 50);
+  const Subdivision s = sexton(block, {{"parcel-count", 16}, {"a-min", 200}, {"w-min", 6}}, 3);
+  EXPECT_TILES(block, s.parcels, "160 x 50");
+  EXPECT_EQ(s.parcels.size(), 16u);
+  EXPECT_EQ(s.targetParcels, 16);
+  EXPECT_EQ(s.withoutAccess, 0);
+  EXPECT_EQ(test::measuredWithoutAccess(block, s.parcels, 3.0), 0);  // frontage >= w-min / 2
+  for (const Polygon& p : s.parcels) EXPECT_GE(area(p), 0.75 * 200 * (1 - 1e-9));
+  // The same seed, the same parcels; another seed, others.
+  const Subdivision again = sexton(block, {{"parcel-count", 16}, {"a-min", 200}, {"w-min", 6}}, 3);
+  ASSERT_EQ(again.parcels.size(), s.parcels.size());
+  for (std::size_t i = 0; i < s.parcels.size(); ++i) EXPECT_TRUE(sameVertices(again.parcels[i], s.parcels[i]));
+  const Subdivision other = sexton(block, {{"parcel-count", 16}, {"a-min", 200}, {"w-min", 6}}, 4);
+  bool differs = other.parcels.size() != s.parcels.size();
+  for (std::size_t i = 0; !differs && i < s.parcels.size(); ++i)
+    differs = !sameVertices(other.parcels[i], s.parcels[i]);
+  EXPECT_TRUE(differs);
+}
+
+TEST(Sexton, OfManyTriesKeepsTheOneClosestToTheObservedParcels) {
+  // Observed: 8 equal lots of 20 x 50 m. More tries can only bring the kept
+  // subdivision closer (the first tries are among them).
+  const Polygon block = test::rect(0, 0, 160, 50);
+  ObservedSample observed;
+  observed.areas.assign(8, 1000.0);
+  observed.widths.assign(8, 20.0);
+  observed.aspectRatios.assign(8, 2.5);
+  const Subdivision one = sexton(block, {{"tries", 1}, {"a-min", 400}, {"w-min", 10}}, 5, &observed);
+  const Subdivision many = sexton(block, {{"tries", 60}, {"a-min", 400}, {"w-min", 10}}, 5, &observed);
+  EXPECT_EQ(one.targetParcels, 8);
+  // The style's distance: KS of area, width and aspect ratio (MBR) against
+  // the observed values, plus the relative count error.
+  auto distance = [&](const Subdivision& s) {
+    auto ks = [](const std::vector<double>& x, double v) {  // against a sample of one repeated value
+      std::size_t below = 0, above = 0;
+      for (double e : x) {
+        below += e < v - 1e-6;
+        above += e > v + 1e-6;
+      }
+      return static_cast<double>(std::max(below, above)) / static_cast<double>(x.size());
+    };
+    std::vector<double> a, w, r;
+    for (const Polygon& p : s.parcels) {
+      const OrientedBox box = minimumAreaBox(p.outer);
+      a.push_back(area(p));
+      w.push_back(box.width);
+      r.push_back(box.length / box.width);
+    }
+    return std::fabs(static_cast<double>(s.parcels.size()) / 8 - 1) + ks(a, 1000) + ks(w, 20) + ks(r, 2.5);
+  };
+  EXPECT_LE(distance(many), distance(one));
+  EXPECT_EQ(many.parcels.size(), 8u);
+}
+
+// Random shapes: a tiling, valid, reproducible, every parcel with access
+// where the block was split, and the target reached on nearly all.
+TEST(Sexton, RandomShapesTileAndMostReachTheirTarget) {
+  std::mt19937_64 rng(20261128);
+  int shapes = 0, atTarget = 0;
+  for (int i = 0; i < 70 / test::kSanitizerDivisor; ++i, ++shapes) {
+    const Polygon block = test::randomShape(rng, i % test::kShapeKinds);
+    const ObbParameters b = test::randomBounds(rng, area(block));
+    const std::uint64_t seed = rng();
+    const ParameterValues values = {{"a-min", b.aMin}, {"a-max", b.aMax}, {"w-min", b.wMin}, {"tries", 5}};
+    const Subdivision s = sexton(block, values, seed);
+    const std::string what = "shape " + std::to_string(i) + " kind " + std::to_string(i % test::kShapeKinds);
+    ASSERT_FALSE(s.failed) << what << ": " << s.failure;
+    EXPECT_FALSE(s.fallback) << what << ": " << s.fallbackReason;
+    EXPECT_TILES(block, s.parcels, what);
+    EXPECT_GE(s.targetParcels, 1) << what;
+    atTarget += static_cast<int>(s.parcels.size()) == s.targetParcels;
+    const Subdivision again = sexton(block, values, seed);
+    ASSERT_EQ(again.parcels.size(), s.parcels.size()) << what;
+    for (std::size_t k = 0; k < s.parcels.size(); ++k) {
+      EXPECT_TRUE(sameVertices(again.parcels[k], s.parcels[k])) << what << " parcel " << k;
+    }
+  }
+  std::printf("%d random shapes, %d at their target count\n", shapes, atTarget);
+  EXPECT_GE(atTarget, shapes * 9 / 10);
+}
+
+}  // namespace
+}  // namespace parcelscope::generation
