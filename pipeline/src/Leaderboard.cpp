@@ -120,6 +120,13 @@ Table leaderboardBlockTable(const Leaderboard& board) {
   return t;
 }
 
+std::vector<LayoutMeasures> layoutRows(const Leaderboard& board) {
+  const LayoutContext context = layoutContext(*board.observed);
+  std::vector<LayoutMeasures> rows = {observedLayout(context, *board.observed)};
+  for (const LeaderboardEntry& e : board.entries) rows.push_back(generatedLayout(context, e.result.generated, e.style));
+  return rows;
+}
+
 namespace {
 JobOutcome writeLeaderboard(io::OutputDirectory& out, const CompareRequest& request, const ProgressFn& progress,
                             const LeaderboardRenderer& draw) {
@@ -129,7 +136,8 @@ JobOutcome writeLeaderboard(io::OutputDirectory& out, const CompareRequest& requ
   const Table table = leaderboardTable(board);
   io::writeCsv(out.stage("leaderboard.csv"), table);
   io::writeCsv(out.stage("leaderboard_blocks.csv"), leaderboardBlockTable(board));
-  std::vector<std::string> outputs = {"leaderboard.csv", "leaderboard_blocks.csv"};
+  std::vector<std::string> outputs = {"leaderboard.csv", "leaderboard_blocks.csv", "layout.csv"};
+  io::writeCsv(out.stage("layout.csv"), layoutTable(layoutRows(board)));
   if (draw && compareValue(request, "figures") != 0) {
     for (const std::string& name : draw(board, request, [&](const std::string& n) { return out.stage(n); })) {
       outputs.push_back(name);

@@ -96,11 +96,52 @@ TEST(Leaderboard, UnassignedLandIsCountedAndWrittenButNotCompared) {
   }
 }
 
+// Yang et al. 2013's section 7 measures: the land shares add up, densities
+// are counts over the study area, and the street measures come with streets.
+TEST(Leaderboard, LayoutMeasuresAddUpOverTheStudyArea) {
+  CompareRequest request = sampleRequest();
+  request.streets = io::StreetReadOptions{};
+  request.streets->path = std::string(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_streets.geojson";
+  request.streets->widthField = "width";
+  const Leaderboard board = leaderboard(request);
+  const std::vector<LayoutMeasures> rows = layoutRows(board);
+  ASSERT_EQ(rows.size(), board.entries.size() + 1);
+  const LayoutContext c = layoutContext(*board.observed);
+  ASSERT_GT(c.streetArea, 0);
+  EXPECT_NEAR(c.studyArea, c.blockArea + c.streetArea, 1e-6 * c.studyArea);
+  EXPECT_GT(c.intersections, 0);
+  for (const LayoutMeasures& m : rows) {
+    EXPECT_NEAR(m.streetShare + m.parcelShare + m.otherShare, 100.0, 1e-6) << m.layout;
+    EXPECT_GT(m.streetShare, 0) << m.layout;
+    EXPECT_NEAR(m.blocksPerKm2, static_cast<double>(board.observed->analysis.blocks.size()) / (c.studyArea / 1e6),
+                1e-9 * m.blocksPerKm2);
+    EXPECT_LE(m.boundaryMin, m.boundaryAvg);
+    EXPECT_LE(m.boundaryAvg, m.boundaryMax);
+    EXPECT_GT(m.streetLengthPerKm2, 0) << m.layout;
+    EXPECT_GE(m.meanPArea, 1.0) << m.layout;  // a parcel never fills more than its box
+  }
+  const auto& blockOf = board.observed->analysis.blockOf;
+  const auto lots = static_cast<double>(std::count_if(blockOf.begin(), blockOf.end(), [](int b) { return b >= 0; }));
+  EXPECT_NEAR(rows[0].parcelsPerKm2 * c.studyArea / 1e6, lots, 1e-6 * lots);
+  for (std::size_t e = 0; e < board.entries.size(); ++e) {
+    const GeneratedParcels& g = board.entries[e].result.generated;
+    const double assigned = static_cast<double>(g.parcels.size()) - static_cast<double>(g.unassignedParcels);
+    EXPECT_NEAR(rows[e + 1].parcelsPerKm2 * c.studyArea / 1e6, assigned, 1e-6 * assigned) << board.entries[e].style;
+    // Generated parcels tile the blocks: only parish leaves block land to no parcel.
+    if (board.entries[e].style == "parish") {
+      EXPECT_NEAR(rows[e + 1].otherShare, 100 * g.unassignedArea / c.studyArea, 1e-6);
+      EXPECT_GT(rows[e + 1].otherShare, 1.0);
+    } else {
+      EXPECT_LT(rows[e + 1].otherShare, 1e-6) << board.entries[e].style;
+    }
+  }
+}
+
 TEST(Leaderboard, WritesItsTablesAndRunRecordWhole) {
   test::TempDir dir;
   const std::string out = dir.file("board");
   runLeaderboard(sampleRequest(), out);
-  for (const char* f : {"leaderboard.csv", "leaderboard_blocks.csv", "run.json"}) {
+  for (const char* f : {"leaderboard.csv", "leaderboard_blocks.csv", "layout.csv", "run.json"}) {
     EXPECT_TRUE(std::filesystem::exists(out + "/" + f)) << f;
   }
   const std::string csv = test::slurpFile(out + "/leaderboard.csv");

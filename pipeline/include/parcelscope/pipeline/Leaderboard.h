@@ -9,6 +9,7 @@
 
 #include "parcelscope/core/Table.h"
 #include "parcelscope/pipeline/CompareJob.h"
+#include "parcelscope/pipeline/LayoutMeasures.h"
 
 namespace parcelscope::pipeline {
 
@@ -48,6 +49,10 @@ Table leaderboardTable(const Leaderboard& board);
 /// leaderboard_blocks.csv: one row per observed block: block_id, block_key,
 /// observed_parcels, fit_<style> for each style, best_style.
 Table leaderboardBlockTable(const Leaderboard& board);
+
+/// layout.csv's rows: the observed layout, then each style's (Yang et al.
+/// 2013's section 7 measures, LayoutMeasures.h).
+std::vector<LayoutMeasures> layoutRows(const Leaderboard& board);
 
 /// What draws the leaderboard's figure (viz supplies it): small multiples of
 /// the aspect-ratio maps, observed first, then each style; `stage` turns a
