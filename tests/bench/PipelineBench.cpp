@@ -4,6 +4,7 @@
 // 2) OBB subdivision of every block. 3) The whole `compare` job, stage by stage
 // (figures only when an X server answers: run under scripts/with-xvfb.sh).
 // 4) The application's session update and its procedural view's geometry.
+// 5) Each style's time per block.
 //   build/release/tests/bench/parcelscope_bench
 //   scripts/with-xvfb.sh build/release/tests/bench/parcelscope_bench --benchmark_filter=Compare
 #include <benchmark/benchmark.h>
@@ -310,6 +311,54 @@ void SkeletonSubdivisionPerBlock(benchmark::State& state) {
   }
 }
 BENCHMARK(SkeletonSubdivisionPerBlock)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
+
+// Each concrete style on every cambridge_ma block (the ROAD features left
+// out), with the block's plan as generate() makes it (derived bounds, seed,
+// street widths, the observed parcels for sexton), one block at a time
+// (single thread). Counters: median, 90th percentile and mean per block.
+void StylePerBlock(benchmark::State& state, const char* style) {
+  if (!haveData(state)) return;
+  namespace gen = parcelscope::generation;
+  parcelscope::io::ReadOptions in;
+  in.path = kCambridge;
+  in.where = "ML <> 'ROAD'";
+  const auto d =
+      parcelscope::pipeline::loadObserved(in, parcelscope::defaultValues(parcelscope::analysis::analysisParameters()));
+  const auto [inputs, plans] = plannedBlocks(d, style);
+  const gen::Style& s = gen::style(style);
+  static const gen::StreetWidths kNone;
+  std::size_t parcels = 0;
+  std::vector<double> ms;
+  for (auto _ : state) {
+    parcels = 0;
+    ms.clear();
+    for (std::size_t k = 0; k < inputs.entries.size(); ++k) {
+      gen::StyleRun run{inputs.entries[k].shape, plans[k].values, plans[k].seed,
+                        s.usesStreetWidths() ? inputs.widths[k] : kNone};
+      run.observed = inputs.entries[k].observed.get();
+      run.observedShare = inputs.entries[k].observedShare;
+      const auto t0 = std::chrono::steady_clock::now();
+      parcels += s.subdivide(run).parcels.size();
+      ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+  }
+  std::vector<double> sorted = ms;
+  std::sort(sorted.begin(), sorted.end());
+  double sum = 0;
+  for (double x : ms) sum += x;
+  state.counters["blocks"] = static_cast<double>(ms.size());
+  state.counters["parcels"] = static_cast<double>(parcels);
+  if (!sorted.empty()) {
+    state.counters["median_ms"] = sorted[sorted.size() / 2];
+    state.counters["p90_ms"] = sorted[sorted.size() * 9 / 10];
+    state.counters["mean_ms"] = sum / static_cast<double>(sorted.size());
+  }
+}
+BENCHMARK_CAPTURE(StylePerBlock, obb, "obb")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(StylePerBlock, skeleton, "skeleton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(StylePerBlock, offset, "offset")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(StylePerBlock, parish, "parish")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(StylePerBlock, sexton, "sexton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 
 }  // namespace
 
