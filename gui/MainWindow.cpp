@@ -55,6 +55,7 @@
 #include <tuple>
 #include <utility>
 
+#include "LeaderboardDialog.h"
 #include "MapView.h"
 #include "ParameterPanel.h"
 #include "parcelscope/analysis/Comparison.h"
@@ -555,6 +556,9 @@ void MainWindow::buildMenus() {
   });
   file->addSeparator();
   file->addAction("&Quit", this, &QWidget::close, QKeySequence::Quit);
+  QMenu* analysis = menuBar()->addMenu("&Analysis");
+  leaderboardAction_ = analysis->addAction("Compare every &style...", this, [this] { showLeaderboard(); });
+  leaderboardAction_->setEnabled(false);
   QMenu* view = menuBar()->addMenu("&View");
   view->setToolTipsVisible(true);
   QAction* outlines = view->addAction("Parcel &outlines");
@@ -763,6 +767,18 @@ void MainWindow::exportParcels(const QString& path) {
   exportWith("generated parcels exported to " + path, [&] {
     pipeline::exportParcels(*controller_.finalResult(), path.toStdString(), {controller_.finalRequest().input.path});
   });
+}
+
+LeaderboardDialog* MainWindow::showLeaderboard() {
+  if (!controller_.finalResult()) {
+    showError("nothing to compare yet: open a dataset first");
+    return nullptr;
+  }
+  if (leaderboard_) leaderboard_->close();  // one at a time; a closed one stops and goes
+  leaderboard_ = new LeaderboardDialog(controller_.finalRequest(), this);
+  leaderboard_->setAttribute(Qt::WA_DeleteOnClose);
+  leaderboard_->show();
+  return leaderboard_;
 }
 
 void MainWindow::exportWith(const QString& done, const std::function<void()>& write) {
@@ -1457,6 +1473,7 @@ void MainWindow::updateActions() {
   // setEnabled does nothing when the state is unchanged, so this costs nothing per update.
   const bool result = controller_.finalResult() != nullptr;
   saveSessionAction_->setEnabled(result);
+  leaderboardAction_->setEnabled(result);
   exportMenu_->menuAction()->setEnabled(result);
   for (QAction* a : exportMenu_->actions()) a->setEnabled(result);
   zoomToExtentAction_->setEnabled(extent_.has_value() && controller_.shownResult() != nullptr);

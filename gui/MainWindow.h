@@ -8,6 +8,7 @@
 #include <QElapsedTimer>
 #include <QImage>
 #include <QMainWindow>
+#include <QPointer>
 #include <QString>
 #include <QStringList>
 #include <QThread>
@@ -44,6 +45,7 @@ class vtkGenericOpenGLRenderWindow;
 namespace parcelscope::gui {
 
 class ChartStyle;
+class LeaderboardDialog;
 class MapView;
 class ParameterPanel;
 
@@ -72,6 +74,11 @@ public:
   void exportFigure(const QString& name, const QString& path, int width = 1800, int height = 900);
   void exportTables(const QString& folder);
   void exportParcels(const QString& path);
+
+  /// Analysis > Compare every style: the leaderboard of every style on the
+  /// open input with the current parameters (`compare --style all`), made in
+  /// the background in its own window; null when nothing is open yet.
+  LeaderboardDialog* showLeaderboard();
 
   /// Sets one parameter as the user would (explicit from now on) and regenerates.
   void setParameter(const std::string& name, double value);
@@ -214,6 +221,8 @@ private:
 
   QThread thread_;
   SessionWorker* worker_;
+  QPointer<LeaderboardDialog> leaderboard_;
+  QAction* leaderboardAction_ = nullptr;
   pipeline::Controller controller_;
   std::map<qint64, QElapsedTimer> started_;
   std::map<qint64, QElapsedTimer> completeStarted_;  ///< views drawn, numbers not complete yet

@@ -128,10 +128,8 @@ std::vector<LayoutMeasures> layoutRows(const Leaderboard& board) {
 }
 
 namespace {
-JobOutcome writeLeaderboard(io::OutputDirectory& out, const CompareRequest& request, const ProgressFn& progress,
-                            const LeaderboardRenderer& draw) {
-  const auto started = std::chrono::steady_clock::now();
-  const Leaderboard board = leaderboard(request, scaledProgress(progress, 0.0, 0.9));
+JobOutcome writeLeaderboard(io::OutputDirectory& out, const Leaderboard& board, const CompareRequest& request,
+                            const ProgressFn& progress, const LeaderboardRenderer& draw, double seconds) {
   reportProgress(progress, 0.9, "writing");
   const Table table = leaderboardTable(board);
   io::writeCsv(out.stage("leaderboard.csv"), table);
@@ -150,8 +148,7 @@ JobOutcome writeLeaderboard(io::OutputDirectory& out, const CompareRequest& requ
   Json styles = Json::object();
   for (const LeaderboardEntry& e : board.entries) styles.set(e.style, e.seconds);
   run.set("seconds_per_style", styles);
-  run.set("timing_s", Json::object().set(
-                          "total", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()));
+  run.set("timing_s", Json::object().set("total", seconds));
   Json list = Json::array();
   for (const std::string& o : outputs) list.push(o);
   run.set("outputs", list);
@@ -177,7 +174,24 @@ JobOutcome runLeaderboard(const CompareRequest& request, const std::string& outD
   if (request.streets) inputs.push_back(request.streets->path);
   io::OutputDirectory out(outDir, inputs);
   try {
-    return writeLeaderboard(out, request, progress, draw);
+    const auto started = std::chrono::steady_clock::now();
+    const Leaderboard board = leaderboard(request, scaledProgress(progress, 0.0, 0.9));
+    return writeLeaderboard(out, board, request, progress, draw,
+                            std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+  } catch (const Error& e) {
+    throw out.explain(e);
+  }
+}
+
+JobOutcome saveLeaderboard(const Leaderboard& board, const CompareRequest& request, const std::string& outDir,
+                           const LeaderboardRenderer& draw) {
+  std::vector<std::string> inputs = {request.input.path};
+  if (request.streets) inputs.push_back(request.streets->path);
+  io::OutputDirectory out(outDir, inputs);
+  double seconds = 0;
+  for (const LeaderboardEntry& e : board.entries) seconds += e.seconds;
+  try {
+    return writeLeaderboard(out, board, request, {}, draw, seconds);
   } catch (const Error& e) {
     throw out.explain(e);
   }

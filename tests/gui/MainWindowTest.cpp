@@ -12,6 +12,7 @@
 #include <QDir>
 #include <QDoubleSpinBox>
 #include <QDragEnterEvent>
+#include <QFileInfo>
 #include <QGroupBox>
 #include <QLabel>
 #include <QMenu>
@@ -49,13 +50,16 @@
 #include <fstream>
 #include <sstream>
 
+#include "LeaderboardDialog.h"
 #include "MainWindow.h"
 #include "MapView.h"
 #include "ParameterPanel.h"
 #include "parcelscope/analysis/Comparison.h"
 #include "parcelscope/core/Keys.h"
+#include "parcelscope/generation/Styles.h"
 #include "parcelscope/io/Writers.h"
 #include "parcelscope/pipeline/CompareJob.h"
+#include "parcelscope/pipeline/Leaderboard.h"
 #include "parcelscope/pipeline/StreetsJob.h"
 #include "viz/ImageCheck.h"
 
@@ -975,6 +979,34 @@ private slots:
   // Streets opened with the parcels: the blocks are the street network's (the
   // command line's --streets gives the same parcels), the centre lines are
   // drawn over both views, and removing them brings the parcel blocks back.
+  // Analysis > Compare every style: the command line's leaderboard (the same
+  // library call on the same request), shown and saved as `compare --style all`.
+  void leaderboardShowsEveryStyleAsTheCommandLine() {
+    QVERIFY(settle());
+    parcelscope::gui::LeaderboardDialog* dialog = window_->showLeaderboard();
+    QVERIFY(dialog);
+    QSignalSpy finished(dialog, &parcelscope::gui::LeaderboardDialog::finished);
+    QVERIFY(finished.wait(120000));
+    QVERIFY2(dialog->board(), qPrintable(dialog->error()));
+    const auto expected = parcelscope::pipeline::leaderboard(window_->controller().finalRequest());
+    const parcelscope::Table t = parcelscope::pipeline::leaderboardTable(expected);
+    QTableWidget* shown = dialog->styles();
+    QCOMPARE(shown->rowCount(), static_cast<int>(parcelscope::generation::styles().size()));
+    const auto fit = static_cast<int>(t.column("fit"));
+    for (int r = 0; r < shown->rowCount(); ++r) {
+      QCOMPARE(shown->item(r, 0)->text(), QString::fromStdString(std::get<std::string>(t.rows[r][0])));
+      QCOMPARE(shown->item(r, fit)->text(), QString::number(std::get<double>(t.rows[r][fit]), 'g', 3));
+    }
+    QCOMPARE(dialog->layout()->rowCount(), shown->rowCount() + 1);  // the observed layout first
+    const QString out = dir_.filePath("leaderboard");
+    QVERIFY2(dialog->save(out), qPrintable(dialog->error()));
+    for (const char* f : {"leaderboard.csv", "leaderboard_blocks.csv", "layout.csv", "leaderboard.png", "run.json"}) {
+      QVERIFY2(QFileInfo::exists(out + "/" + f), f);
+    }
+    dialog->close();
+    QTRY_VERIFY(!window_->findChild<parcelscope::gui::LeaderboardDialog*>());
+  }
+
   void streetsOpenedWithTheParcelsGiveTheirBlocksAndAreDrawn() {
     window_->openSample();
     QVERIFY(settle());

@@ -68,4 +68,9 @@ using LeaderboardRenderer =
 JobOutcome runLeaderboard(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress = {},
                           const LeaderboardRenderer& draw = {});
 
+/// Writes a leaderboard already made (the application's) into `outDir` as
+/// runLeaderboard does; run.json's total time is the styles' time.
+JobOutcome saveLeaderboard(const Leaderboard& board, const CompareRequest& request, const std::string& outDir,
+                           const LeaderboardRenderer& draw = {});
+
 }  // namespace parcelscope::pipeline
