@@ -8,6 +8,7 @@
 #include "TermProgress.h"
 #include "parcelscope/analysis/Comparison.h"
 #include "parcelscope/core/Error.h"
+#include "parcelscope/pipeline/Calibrate.h"
 #include "parcelscope/pipeline/CompareJob.h"
 #include "parcelscope/pipeline/CompareSession.h"
 #include "parcelscope/pipeline/GenerateJob.h"
@@ -28,9 +29,11 @@ const char* kOverview =
     "  stats     read observed parcels, build blocks, write per-parcel metrics,\n"
     "            per-block statistics and generator parameters\n"
     "  blocks    build the road graph of street centre lines and its blocks\n"
-    "  generate  subdivide blocks into procedural parcels (OBB, skeleton or offset style)\n"
+    "  generate  subdivide blocks into procedural parcels (obb, skeleton, offset, parish,\n"
+    "            sexton or auto style)\n"
     "  compare   generate parcels in the blocks of observed ones and compare the two sets:\n"
     "            per-block and city-wide tables, distances, layers and figures\n"
+    "  calibrate give each block the style closest to its observed parcels (a session file)\n"
     "  inspect   print one observed parcel's attributes, metrics and block statistics\n"
     "  metrics   print the table of parcel metrics (Markdown, as in docs/user/metrics.md)\n"
     "  version   print the version\n"
@@ -178,8 +181,9 @@ int dispatch(const std::vector<std::string>& args) {
   if (args[0] == "generate") return generateCommand(rest);
   if (args[0] == "compare") return compareCommand(rest);
   if (args[0] == "inspect") return inspectCommand(rest);
+  if (args[0] == "calibrate") return calibrateCommand(rest);
   throw usageError("unknown command '" + args[0] +
-                   "' (commands: stats, blocks, generate, compare, inspect, metrics, version)");
+                   "' (commands: stats, blocks, generate, compare, calibrate, inspect, metrics, version)");
 }
 
 int metricsCommand(const std::vector<std::string>& args) {
@@ -372,6 +376,34 @@ int compareCommand(const std::vector<std::string>& args) {
     return reportOutcome(viz::runLeaderboard(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
   }
   return reportOutcome(viz::runCompare(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
+}
+
+int calibrateCommand(const std::vector<std::string>& args) {
+  auto flags = joined(inputFlags(), streetFlags("streets-"));
+  flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
+  flags.push_back({"quiet", "no progress or summary on stderr", false});
+  const auto params = joined(pipeline::compareParameters(), pipeline::streetParameters());
+  if (wantsHelp(args)) {
+    std::fputs(usageText("parcelscope calibrate INPUT [--k 2] [--seed N] [options] --out DIR", flags, params).c_str(),
+               stdout);
+    std::fputs(
+        "\nRuns every style on INPUT's blocks (as 'compare --style all') and gives each block the style\n"
+        "whose parcels come closest to its observed ones: KS area + KS width + KS aspect ratio +\n"
+        "|n_generated / n_observed - 1|. Writes DIR/session.json (for 'compare --session' and the\n"
+        "application), calibration.csv (per block: style and distance before and after, the\n"
+        "cross-validated choice), leaderboard.csv and run.json (city-wide measures before, after and\n"
+        "cross-validated: a rule fitted on half of the blocks, measured on the other half).\n",
+        stdout);
+    return 0;
+  }
+  const Args a(args, flags, params);
+  pipeline::CompareRequest request;
+  request.input = readOptions(a);
+  request.parameters = a.parameters();
+  request.explicitParameters = givenParameters(a, params);
+  request.style = "auto";
+  if (auto streets = streetsOf(a)) request.streets = std::move(streets);
+  return reportOutcome(pipeline::runCalibrate(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
 }
 
 int inspectCommand(const std::vector<std::string>& args) {

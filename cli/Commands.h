@@ -13,5 +13,6 @@ int blocksCommand(const std::vector<std::string>& args);
 int generateCommand(const std::vector<std::string>& args);
 int compareCommand(const std::vector<std::string>& args);
 int inspectCommand(const std::vector<std::string>& args);
+int calibrateCommand(const std::vector<std::string>& args);
 
 }  // namespace parcelscope::cli

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "SampleRequest.h"
 #include "TestUtil.h"
 #include "parcelscope/generation/Styles.h"
 #include "parcelscope/pipeline/Leaderboard.h"
@@ -13,15 +14,7 @@
 namespace parcelscope::pipeline {
 namespace {
 
-CompareRequest sampleRequest() {
-  CompareRequest r;
-  r.input.path = std::string(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_town.geojson";
-  r.input.where = "use <> 'ROW'";
-  r.style = "all";
-  r.parameters = defaultValues(compareParameters());
-  r.parameters["figures"] = 0;
-  return r;
-}
+CompareRequest sampleRequest() { return test::sampleCompareRequest("all"); }
 
 TEST(Leaderboard, EachStyleIsWhatItsOwnCompareGivesAndEachBlockGetsItsBestFit) {
   const CompareRequest request = sampleRequest();

@@ -1,0 +1,66 @@
+#pragma once
+// `parcelscope calibrate`: per block, the style whose parcels come closest to
+// the block's observed parcels (issue "realism"), kept in a session file that
+// `compare --session`, `generate` and the application read; and a
+// cross-validated score, so that a choice that only memorises is seen: a rule
+// fitted on half of the city's blocks (nearest neighbours in block features)
+// measured on the other half, beside the paper's rule (style auto, k as given).
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "parcelscope/core/Table.h"
+#include "parcelscope/pipeline/Leaderboard.h"
+
+namespace parcelscope::pipeline {
+
+/// How close a set of generated parcels is to the observed ones, city-wide or
+/// over some blocks: KS of area, width and aspect ratio over their parcels,
+/// and the median over the blocks of |n_generated / n_observed - 1|.
+struct FitMeasures {
+  double ksArea = NAN, ksWidth = NAN, ksAspectRatio = NAN;
+  double medianCountError = NAN;
+  std::int64_t blocks = 0;
+};
+
+/// One observed block's calibration.
+struct BlockCalibration {
+  std::int64_t blockId = -1;
+  Key blockKey = 0;
+  std::int64_t observedParcels = 0;
+  std::string styleBefore;  ///< the paper's rule (the auto style's choice)
+  double distanceBefore = NAN;
+  std::string styleAfter;  ///< the style of least distance
+  double distanceAfter = NAN;
+  int half = 0;                ///< cross-validation half (0 or 1, from the block key)
+  std::string stylePredicted;  ///< the fitted rule's style, fitted on the other half
+};
+
+struct Calibration {
+  Leaderboard board;                     ///< every style on every block (the request's parameters)
+  std::vector<BlockCalibration> blocks;  ///< per observed block
+  CompareRequest session;                ///< the request with each block's style as an override
+  FitMeasures before, after;             ///< every block: the paper's rule, the calibrated styles
+  /// Cross-validation: on each half, the rule fitted on the other half and the
+  /// paper's rule; the two halves' measures, parcels pooled.
+  FitMeasures crossFitted, crossPaper;
+  std::map<std::string, std::int64_t> stylesChosen;  ///< blocks per calibrated style
+};
+
+/// A block's distance to its observed parcels: KS area + KS width + KS aspect
+/// ratio (a KS that cannot be measured counts 1) + |n_generated / n_observed - 1|.
+double calibrationDistance(const analysis::Comparison& c);
+
+/// Runs every concrete style on `request`'s blocks (request.style is ignored)
+/// and calibrates. Throws as compare().
+Calibration calibrate(const CompareRequest& request, const ProgressFn& progress = {});
+
+/// calibration.csv: one row per observed block.
+Table calibrationTable(const Calibration& c);
+
+/// calibrate() and its outputs in `outDir`, all at once: session.json,
+/// calibration.csv, leaderboard.csv, run.json.
+JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress = {});
+
+}  // namespace parcelscope::pipeline

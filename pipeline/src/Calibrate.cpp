@@ -1,0 +1,301 @@
+#include "parcelscope/pipeline/Calibrate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <numeric>
+#include <sstream>
+
+#include "parcelscope/analysis/Comparison.h"
+#include "parcelscope/core/Error.h"
+#include "parcelscope/core/Keys.h"
+#include "parcelscope/io/OutputDirectory.h"
+#include "parcelscope/io/Writers.h"
+#include "parcelscope/pipeline/CompareSession.h"
+#include "parcelscope/pipeline/StreetsJob.h"
+
+namespace parcelscope::pipeline {
+
+double calibrationDistance(const analysis::Comparison& c) {
+  double d = 0;
+  for (analysis::ComparedMetric m : analysis::kComparedMetrics) {
+    const double ks = c.distances(m).ks;
+    d += std::isfinite(ks) ? ks : 1.0;
+  }
+  if (c.observed.parcels > 0) {
+    d += std::fabs(static_cast<double>(c.generated.parcels) / static_cast<double>(c.observed.parcels) - 1);
+  }
+  return d;
+}
+
+namespace {
+
+// The generated parcels (unassigned land left out) of each leaderboard entry
+// in each observed block: [entry][block].
+std::vector<std::vector<std::vector<int>>> parcelsByBlock(const Leaderboard& board) {
+  const analysis::ObservedAnalysis& a = board.observed->analysis;
+  std::map<Key, std::size_t> blockOf;
+  for (std::size_t b = 0; b < a.blocks.size(); ++b) blockOf.emplace(a.blocks[b].key, b);
+  std::vector<std::vector<std::vector<int>>> out(board.entries.size(), std::vector<std::vector<int>>(a.blocks.size()));
+  for (std::size_t e = 0; e < board.entries.size(); ++e) {
+    const GeneratedParcels& g = board.entries[e].result.generated;
+    for (std::size_t k = 0; k < g.blocks.size(); ++k) {
+      const auto it = blockOf.find(g.blockKeys[k]);
+      if (it == blockOf.end()) continue;  // a street block without observed parcels
+      const std::vector<int> assigned = g.assignedOf(g.blocks[k].parcels);
+      auto& to = out[e][it->second];
+      to.insert(to.end(), assigned.begin(), assigned.end());
+    }
+  }
+  return out;
+}
+
+// The measures over the blocks `blocks`, block b's parcels made by entry `entryOf[b]`.
+FitMeasures measure(const Leaderboard& board, const std::vector<std::vector<std::vector<int>>>& parcels,
+                    const std::vector<std::size_t>& blocks, const std::vector<std::size_t>& entryOf) {
+  const analysis::ObservedAnalysis& a = board.observed->analysis;
+  std::array<std::vector<double>, 3> observed, generated;
+  auto add = [](std::array<std::vector<double>, 3>& to, const analysis::ParcelMetrics& m) {
+    to[0].push_back(m.area);
+    to[1].push_back(m.width);
+    to[2].push_back(m.aspectRatio);
+  };
+  std::vector<double> countErrors;
+  for (std::size_t b : blocks) {
+    for (int i : a.blocks[b].parcels) add(observed, a.metrics[static_cast<std::size_t>(i)]);
+    const GeneratedParcels& g = board.entries[entryOf[b]].result.generated;
+    for (int i : parcels[entryOf[b]][b]) add(generated, g.metrics[static_cast<std::size_t>(i)]);
+    if (!a.blocks[b].parcels.empty()) {
+      countErrors.push_back(std::fabs(
+          static_cast<double>(parcels[entryOf[b]][b].size()) / static_cast<double>(a.blocks[b].parcels.size()) - 1));
+    }
+  }
+  FitMeasures f;
+  f.blocks = static_cast<std::int64_t>(blocks.size());
+  f.ksArea = analysis::ksStatistic(observed[0], generated[0]);
+  f.ksWidth = analysis::ksStatistic(observed[1], generated[1]);
+  f.ksAspectRatio = analysis::ksStatistic(observed[2], generated[2]);
+  if (!countErrors.empty()) {
+    std::nth_element(countErrors.begin(), countErrors.begin() + static_cast<long>(countErrors.size() / 2),
+                     countErrors.end());
+    f.medianCountError = countErrors[countErrors.size() / 2];
+  }
+  return f;
+}
+
+// What the fitted rule knows of a block before any style runs: its size and
+// shape, and its observed parcels' street access, mean area and count.
+constexpr std::size_t kFeatures = 6;
+std::array<double, kFeatures> featuresOf(const ObservedData& d, std::size_t b) {
+  const Block& block = d.analysis.blocks[b];
+  const analysis::BlockStatistics& s = d.analysis.statistics[b];
+  const Polygon* largest = &block.parts.front();
+  double total = 0;
+  for (const Polygon& p : block.parts) {
+    total += area(p);
+    if (area(p) > area(*largest)) largest = &p;
+  }
+  const OrientedBox box = minimumAreaBox(largest->outer);
+  const double hull = std::fabs(signedArea(convexHull(largest->outer)));
+  return {std::log10(std::max(total, 1.0)),       box.length > 0 ? box.width / box.length : 1.0,
+          hull > 0 ? area(*largest) / hull : 1.0, s.streetAccessShare,
+          std::log10(std::max(s.meanArea, 1.0)),  std::log10(std::max(1, s.parcelCount))};
+}
+
+// The style (entry index) of the `k` nearest training blocks in standardised
+// features, by majority (ties: the nearest's).
+constexpr std::size_t kNeighbours = 5;
+std::size_t predict(const std::array<double, kFeatures>& x, const std::vector<std::array<double, kFeatures>>& train,
+                    const std::vector<std::size_t>& labels, const std::array<double, kFeatures>& scale) {
+  std::vector<std::pair<double, std::size_t>> near;
+  for (std::size_t i = 0; i < train.size(); ++i) {
+    double d = 0;
+    for (std::size_t f = 0; f < kFeatures; ++f) d += std::pow((x[f] - train[i][f]) / scale[f], 2);
+    near.emplace_back(d, i);
+  }
+  const std::size_t k = std::min(kNeighbours, near.size());
+  std::partial_sort(near.begin(), near.begin() + static_cast<long>(k), near.end());
+  std::map<std::size_t, int> votes;
+  for (std::size_t i = 0; i < k; ++i) ++votes[labels[near[i].second]];
+  std::size_t best = labels[near.front().second];
+  for (const auto& [label, n] : votes) {
+    if (n > votes[best]) best = label;
+  }
+  return best;
+}
+
+}  // namespace
+
+Calibration calibrate(const CompareRequest& request, const ProgressFn& progress) {
+  Calibration c;
+  c.board = leaderboard(request, scaledProgress(progress, 0.0, 0.95));
+  reportProgress(progress, 0.95, "calibrating");
+  const Leaderboard& board = c.board;
+  const analysis::ObservedAnalysis& a = board.observed->analysis;
+  std::size_t paper = board.entries.size();
+  std::vector<std::size_t> candidates;
+  for (std::size_t e = 0; e < board.entries.size(); ++e) {
+    if (board.entries[e].style == generation::autoStyle().name()) {
+      paper = e;
+    } else {
+      candidates.push_back(e);
+    }
+  }
+  if (paper == board.entries.size() || candidates.empty()) throw std::logic_error("calibrate: the styles are missing");
+
+  const std::size_t n = a.blocks.size();
+  std::map<Key, std::string> paperStyle;  // the style auto chose per block
+  {
+    const GeneratedParcels& g = board.entries[paper].result.generated;
+    for (std::size_t k = 0; k < g.blocks.size(); ++k) paperStyle.emplace(g.blockKeys[k], g.blockStyles[k]);
+  }
+  std::vector<std::size_t> best(n), before(n, paper), all(n);
+  std::iota(all.begin(), all.end(), 0);
+  c.blocks.resize(n);
+  for (std::size_t b = 0; b < n; ++b) {
+    BlockCalibration& bc = c.blocks[b];
+    bc.blockId = a.blocks[b].id;
+    bc.blockKey = a.blocks[b].key;
+    bc.observedParcels = static_cast<std::int64_t>(a.blocks[b].parcels.size());
+    bc.half = static_cast<int>(bc.blockKey % 2);
+    auto distance = [&](std::size_t e) { return calibrationDistance(board.entries[e].result.blocks[b].comparison); };
+    const auto chosen = paperStyle.find(bc.blockKey);
+    bc.styleBefore = chosen != paperStyle.end() ? chosen->second : board.entries[paper].style;
+    bc.distanceBefore = distance(paper);
+    best[b] = candidates.front();
+    for (std::size_t e : candidates) {
+      if (distance(e) < distance(best[b])) best[b] = e;  // ties: the earlier style
+    }
+    bc.styleAfter = board.entries[best[b]].style;
+    bc.distanceAfter = distance(best[b]);
+    ++c.stylesChosen[bc.styleAfter];
+  }
+  const auto parcels = parcelsByBlock(board);
+  c.before = measure(board, parcels, all, before);
+  c.after = measure(board, parcels, all, best);
+
+  // Cross-validation: each half's styles predicted from the other half's best styles.
+  std::vector<std::array<double, kFeatures>> features(n);
+  for (std::size_t b = 0; b < n; ++b) features[b] = featuresOf(*board.observed, b);
+  std::vector<std::size_t> predicted(n, candidates.front());
+  for (int half = 0; half < 2; ++half) {
+    std::vector<std::array<double, kFeatures>> train;
+    std::vector<std::size_t> labels;
+    for (std::size_t b = 0; b < n; ++b) {
+      if (c.blocks[b].half != half) {
+        train.push_back(features[b]);
+        labels.push_back(best[b]);
+      }
+    }
+    if (train.empty()) continue;
+    std::array<double, kFeatures> mean{}, scale{};
+    for (const auto& x : train) {
+      for (std::size_t f = 0; f < kFeatures; ++f) mean[f] += x[f] / static_cast<double>(train.size());
+    }
+    for (const auto& x : train) {
+      for (std::size_t f = 0; f < kFeatures; ++f)
+        scale[f] += std::pow(x[f] - mean[f], 2) / static_cast<double>(train.size());
+    }
+    for (double& s : scale) s = s > 0 ? std::sqrt(s) : 1.0;
+    for (std::size_t b = 0; b < n; ++b) {
+      if (c.blocks[b].half == half) predicted[b] = predict(features[b], train, labels, scale);
+    }
+  }
+  for (std::size_t b = 0; b < n; ++b) c.blocks[b].stylePredicted = board.entries[predicted[b]].style;
+  c.crossFitted = measure(board, parcels, all, predicted);
+  c.crossPaper = c.before;
+
+  c.session = request;
+  if (c.session.style == "all") c.session.style = generation::autoStyle().name();
+  // A session file takes relative paths from its own folder: these are absolute.
+  c.session.input.path = std::filesystem::absolute(request.input.path).lexically_normal().string();
+  if (c.session.streets) {
+    c.session.streets->path = std::filesystem::absolute(request.streets->path).lexically_normal().string();
+  }
+  c.session.overridesById.clear();
+  for (const BlockCalibration& bc : c.blocks) c.session.overrides[bc.blockKey].style = bc.styleAfter;
+  return c;
+}
+
+Table calibrationTable(const Calibration& c) {
+  Table t;
+  using T = Column::Type;
+  t.columns = {{"block_id", T::Integer, ""},   {"block_key", T::String, ""},    {"observed_parcels", T::Integer, ""},
+               {"half", T::Integer, ""},       {"style_before", T::String, ""}, {"distance_before", T::Real, ""},
+               {"style_after", T::String, ""}, {"distance_after", T::Real, ""}, {"style_predicted", T::String, ""}};
+  for (const BlockCalibration& b : c.blocks) {
+    t.rows.push_back({b.blockId, keyText(b.blockKey), b.observedParcels, std::int64_t(b.half), b.styleBefore,
+                      b.distanceBefore, b.styleAfter, b.distanceAfter, b.stylePredicted});
+  }
+  return t;
+}
+
+namespace {
+
+Json fitJson(const FitMeasures& f) {
+  return Json::object()
+      .set("blocks", f.blocks)
+      .set("ks_area", f.ksArea)
+      .set("ks_width", f.ksWidth)
+      .set("ks_aspect_ratio", f.ksAspectRatio)
+      .set("median_count_error", f.medianCountError);
+}
+
+std::string fitText(const FitMeasures& f) {
+  std::ostringstream s;
+  s.precision(3);
+  s << "KS area " << f.ksArea << ", width " << f.ksWidth << ", aspect ratio " << f.ksAspectRatio
+    << ", median |n/n_obs - 1| " << f.medianCountError;
+  return s.str();
+}
+
+}  // namespace
+
+JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress) {
+  std::vector<std::string> inputs = {request.input.path};
+  if (request.streets) inputs.push_back(request.streets->path);
+  io::OutputDirectory out(outDir, inputs);
+  try {
+    const Calibration c = calibrate(request, scaledProgress(progress, 0.0, 0.95));
+    reportProgress(progress, 0.95, "writing");
+    io::writeJson(out.stage("session.json"), sessionJson(c.session));
+    io::writeCsv(out.stage("calibration.csv"), calibrationTable(c));
+    io::writeCsv(out.stage("leaderboard.csv"), leaderboardTable(c.board));
+    Json run = runRecord("calibrate", request.parameters);
+    addObservedRecord(run, *c.board.observed);
+    if (c.board.observed->streets) run.set("streets", streetRecord(*c.board.observed->streets));
+    Json chosen = Json::object();
+    for (const auto& [style, blocks] : c.stylesChosen) chosen.set(style, blocks);
+    run.set("calibration",
+            Json::object()
+                .set("distance", "per block: KS area + KS width + KS aspect ratio + |n_generated / n_observed - 1|")
+                .set("before", fitJson(c.before).set("rule", "style auto with the run's k (the paper's rule)"))
+                .set("after", fitJson(c.after).set("rule", "each block's style of least distance"))
+                .set("styles_chosen", chosen)
+                .set("cross_validation",
+                     Json::object()
+                         .set("halves", "blocks split by block key parity")
+                         .set("fitted_rule",
+                              "the style most of the 5 nearest blocks of the other half fit best, in standardised "
+                              "features: log10 block area, block width / length, convexity, observed street access "
+                              "share, log10 observed mean parcel area, log10 observed parcel count")
+                         .set("fitted", fitJson(c.crossFitted))
+                         .set("paper", fitJson(c.crossPaper))));
+    run.set("outputs",
+            Json::array().push("session.json").push("calibration.csv").push("leaderboard.csv").push("run.json"));
+    io::writeJson(out.stage("run.json"), run);
+    out.commit();
+    reportProgress(progress, 1.0, "writing");
+    std::ostringstream s;
+    s << "calibrated " << c.blocks.size() << " blocks of " << c.board.observed->layer.path
+      << "\n  before (auto): " << fitText(c.before) << "\n  after: " << fitText(c.after)
+      << "\n  cross-validated (fitted on one half, measured on the other): " << fitText(c.crossFitted)
+      << "\n  styles chosen:";
+    for (const auto& [style, blocks] : c.stylesChosen) s << " " << style << " " << blocks;
+    return {run, s.str()};
+  } catch (const Error& e) {
+    throw out.explain(e);
+  }
+}
+
+}  // namespace parcelscope::pipeline
