@@ -85,52 +85,35 @@ LeaderboardDialog::LeaderboardDialog(const pipeline::CompareRequest& request, QW
     if (!folder.isEmpty()) save(folder);
   });
 
-  thread_ = QThread::create([this] {
-    std::shared_ptr<pipeline::Leaderboard> board;
-    QString error;
-    try {
-      board = std::make_shared<pipeline::Leaderboard>(pipeline::leaderboard(request_, [this](double fraction,
-                                                                                             const std::string& stage) {
-        QMetaObject::invokeMethod(
-            this, [this, fraction, s = QString::fromStdString(stage)] { progress(fraction, s); }, Qt::QueuedConnection);
-        return !cancelled_.load();
-      }));
-    } catch (const Error& e) {
-      error = e.kind() == Error::Kind::Cancelled ? QString("cancelled") : QString::fromStdString(e.what());
-    } catch (const std::exception& e) {
-      error = QString::fromStdString(e.what());
-    }
-    QMetaObject::invokeMethod(
-        this, [this, board, error] { done(board, error); }, Qt::QueuedConnection);
-  });
-  thread_->start();
+  task_ = new BackgroundTask(
+      [this](const ProgressFn& progress) {
+        made_ = std::make_shared<pipeline::Leaderboard>(pipeline::leaderboard(request_, progress));
+      },
+      this);
+  connect(task_, &BackgroundTask::progress, this, &LeaderboardDialog::progress);
+  connect(task_, &BackgroundTask::finished, this, &LeaderboardDialog::done);
 }
 
-LeaderboardDialog::~LeaderboardDialog() {
-  cancelled_ = true;
-  if (thread_) {
-    thread_->wait();
-    delete thread_;
-  }
-}
+// The task (a child) ends first: QObject deletes children before this object's members go.
+LeaderboardDialog::~LeaderboardDialog() { delete task_; }
 
 void LeaderboardDialog::cancel() {
-  cancelled_ = true;
+  task_->cancel();
   status_->setText("Cancelling...");
   cancel_->setEnabled(false);
 }
 
 void LeaderboardDialog::progress(double fraction, const QString& stage) {
-  if (cancelled_) return;
+  if (!cancel_->isEnabled()) return;  // cancelled
   bar_->setValue(static_cast<int>(1000 * fraction));
   status_->setText("Running every style on the same blocks: " + stage);
 }
 
-void LeaderboardDialog::done(std::shared_ptr<pipeline::Leaderboard> board, const QString& error) {
+void LeaderboardDialog::done(const QString& error) {
   cancel_->setEnabled(false);
-  bar_->setValue(board ? 1000 : bar_->value());
   error_ = error;
-  board_ = std::move(board);
+  if (error.isEmpty()) board_ = std::move(made_);
+  bar_->setValue(board_ ? 1000 : bar_->value());
   if (board_) {
     fill(styles_, pipeline::leaderboardTable(*board_));
     fill(layout_, pipeline::layoutTable(pipeline::layoutRows(*board_)));

@@ -6,10 +6,10 @@
 // of Yang et al. 2013) and saved as the command line writes it.
 #include <QDialog>
 #include <QString>
-#include <QThread>
 
-#include <atomic>
 #include <memory>
+
+#include "BackgroundTask.h"
 
 #include "parcelscope/pipeline/Leaderboard.h"
 
@@ -33,7 +33,7 @@ public:
   /// (as `compare --style all --out FOLDER`); false, with error() set, when it cannot.
   bool save(const QString& folder);
 
-  bool running() const { return thread_ != nullptr && thread_->isRunning(); }
+  bool running() const { return task_->running(); }
   /// The leaderboard once made; null before, or after a failure or Cancel.
   const pipeline::Leaderboard* board() const { return board_.get(); }
   QString error() const { return error_; }
@@ -46,13 +46,13 @@ signals:
 
 private:
   void progress(double fraction, const QString& stage);
-  void done(std::shared_ptr<pipeline::Leaderboard> board, const QString& error);
+  void done(const QString& error);
 
   pipeline::CompareRequest request_;
+  std::shared_ptr<pipeline::Leaderboard> made_;  ///< written by the task's thread, read once it ended
   std::shared_ptr<const pipeline::Leaderboard> board_;
   QString error_;
-  std::atomic<bool> cancelled_{false};
-  QThread* thread_ = nullptr;
+  BackgroundTask* task_;
   QLabel* status_;
   QProgressBar* bar_;
   QPushButton* cancel_;

@@ -22,6 +22,7 @@
 #include <QMimeData>
 #include <QPainter>
 #include <QProgressBar>
+#include <QProgressDialog>
 #include <QPushButton>
 #include <QRegularExpression>
 #include <QScreen>
@@ -55,6 +56,7 @@
 #include <tuple>
 #include <utility>
 
+#include "BackgroundTask.h"
 #include "LeaderboardDialog.h"
 #include "MapView.h"
 #include "ParameterPanel.h"
@@ -62,6 +64,7 @@
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
 #include "parcelscope/io/ParcelReader.h"
+#include "parcelscope/pipeline/Calibrate.h"
 #include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/pipeline/Inspect.h"
 #include "parcelscope/pipeline/StreetsJob.h"
@@ -559,6 +562,8 @@ void MainWindow::buildMenus() {
   QMenu* analysis = menuBar()->addMenu("&Analysis");
   leaderboardAction_ = analysis->addAction("Compare every &style...", this, [this] { showLeaderboard(); });
   leaderboardAction_->setEnabled(false);
+  fitAction_ = analysis->addAction("&Fit to observed", this, [this] { fitToObserved(); });
+  fitAction_->setEnabled(false);
   QMenu* view = menuBar()->addMenu("&View");
   view->setToolTipsVisible(true);
   QAction* outlines = view->addAction("Parcel &outlines");
@@ -779,6 +784,56 @@ LeaderboardDialog* MainWindow::showLeaderboard() {
   leaderboard_->setAttribute(Qt::WA_DeleteOnClose);
   leaderboard_->show();
   return leaderboard_;
+}
+
+void MainWindow::fitToObserved() {
+  if (!controller_.finalResult()) return showError("nothing to fit yet: open a dataset first");
+  if (fitTask_) return;
+  const pipeline::CompareRequest request = controller_.finalRequest();
+  auto made = std::make_shared<pipeline::Calibration>();
+  fitSummary_.clear();
+  fitTask_ = new BackgroundTask(
+      [request, made](const ProgressFn& progress) { *made = pipeline::calibrate(request, progress); }, this);
+  auto* dialog = new QProgressDialog("Fitting each block's style to its observed parcels...", "Cancel", 0, 1000, this);
+  dialog->setAttribute(Qt::WA_DeleteOnClose);
+  dialog->setMinimumDuration(300);
+  connect(dialog, &QProgressDialog::canceled, this, [this] { cancelFit(); });
+  connect(fitTask_, &BackgroundTask::progress, dialog, [dialog](double fraction, const QString& stage) {
+    dialog->setValue(static_cast<int>(1000 * fraction));
+    dialog->setLabelText("Fitting each block's style to its observed parcels: " + stage);
+  });
+  connect(fitTask_, &BackgroundTask::finished, this, [this, made, dialog](const QString& error) {
+    dialog->close();
+    fitTask_->deleteLater();
+    fitTask_ = nullptr;
+    updateActions();
+    if (error == "cancelled") {
+      status_->setText("fit to observed cancelled");
+      return;
+    }
+    if (!error.isEmpty()) return showError(error);
+    controller_.setOverrides(made->session.overrides);
+    auto text = [](const pipeline::FitMeasures& f) {
+      return QString("KS area %1, width %2, aspect ratio %3")
+          .arg(f.ksArea, 0, 'f', 3)
+          .arg(f.ksWidth, 0, 'f', 3)
+          .arg(f.ksAspectRatio, 0, 'f', 3);
+    };
+    QStringList chosen;
+    for (const auto& [style, blocks] : made->stylesChosen)
+      chosen << QString("%1 %2").arg(QString::fromStdString(style)).arg(blocks);
+    fitSummary_ = QString(
+                      "Fitted each block's style to its observed parcels (%1). Before: %2. After: %3. "
+                      "Cross-validated: %4. Each block's style is now its override.")
+                      .arg(chosen.join(", "), text(made->before), text(made->after), text(made->crossFitted));
+    showNotice(fitSummary_);
+    submit();
+  });
+  updateActions();
+}
+
+void MainWindow::cancelFit() {
+  if (fitTask_) fitTask_->cancel();
 }
 
 void MainWindow::exportWith(const QString& done, const std::function<void()>& write) {
@@ -1474,6 +1529,7 @@ void MainWindow::updateActions() {
   const bool result = controller_.finalResult() != nullptr;
   saveSessionAction_->setEnabled(result);
   leaderboardAction_->setEnabled(result);
+  fitAction_->setEnabled(result && !fitTask_);
   exportMenu_->menuAction()->setEnabled(result);
   for (QAction* a : exportMenu_->actions()) a->setEnabled(result);
   zoomToExtentAction_->setEnabled(extent_.has_value() && controller_.shownResult() != nullptr);

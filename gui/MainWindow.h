@@ -45,6 +45,7 @@ class vtkGenericOpenGLRenderWindow;
 namespace parcelscope::gui {
 
 class ChartStyle;
+class BackgroundTask;
 class LeaderboardDialog;
 class MapView;
 class ParameterPanel;
@@ -79,6 +80,18 @@ public:
   /// open input with the current parameters (`compare --style all`), made in
   /// the background in its own window; null when nothing is open yet.
   LeaderboardDialog* showLeaderboard();
+  /// Analysis > Fit to observed: `parcelscope calibrate` on the open input
+  /// (in the background, with progress and Cancel); when it ends, every block
+  /// gets the style of least distance to its observed parcels as its override
+  /// (saved with the session) and the views update; fitSummary() then says
+  /// what changed (empty when it failed or was cancelled: see lastError()).
+  void fitToObserved();
+  /// The text the last Fit to observed showed (before and after measures).
+  QString fitSummary() const { return fitSummary_; }
+  /// A Fit to observed is under way.
+  bool fitting() const { return fitTask_ != nullptr; }
+  /// Cancels the Fit to observed under way.
+  void cancelFit();
 
   /// Sets one parameter as the user would (explicit from now on) and regenerates.
   void setParameter(const std::string& name, double value);
@@ -223,6 +236,9 @@ private:
   SessionWorker* worker_;
   QPointer<LeaderboardDialog> leaderboard_;
   QAction* leaderboardAction_ = nullptr;
+  QAction* fitAction_ = nullptr;
+  BackgroundTask* fitTask_ = nullptr;
+  QString fitSummary_;
   pipeline::Controller controller_;
   std::map<qint64, QElapsedTimer> started_;
   std::map<qint64, QElapsedTimer> completeStarted_;  ///< views drawn, numbers not complete yet

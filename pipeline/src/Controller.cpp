@@ -102,6 +102,12 @@ void Controller::overrideBlock(const Block& block, const BlockOverride& blockOve
   edited();
 }
 
+void Controller::setOverrides(const BlockOverrides& overrides) {
+  request_.overrides = overrides;
+  request_.overridesById.clear();
+  edited();
+}
+
 void Controller::clearOverride(const Block& block) {
   request_.overrides.erase(block.key);
   request_.overridesById.erase(block.id);

@@ -58,6 +58,7 @@
 #include "parcelscope/core/Keys.h"
 #include "parcelscope/generation/Styles.h"
 #include "parcelscope/io/Writers.h"
+#include "parcelscope/pipeline/Calibrate.h"
 #include "parcelscope/pipeline/CompareJob.h"
 #include "parcelscope/pipeline/Leaderboard.h"
 #include "parcelscope/pipeline/StreetsJob.h"
@@ -1005,6 +1006,27 @@ private slots:
     }
     dialog->close();
     QTRY_VERIFY(!window_->findChild<parcelscope::gui::LeaderboardDialog*>());
+  }
+
+  // Analysis > Fit to observed: calibrate's choice per block becomes each
+  // block's override, and the views show what `compare --session` of
+  // calibrate's session.json gives.
+  void fitToObservedGivesEachBlockItsCalibratedStyle() {
+    QVERIFY(settle());
+    const auto expected = parcelscope::pipeline::calibrate(window_->controller().finalRequest());
+    window_->fitToObserved();
+    QVERIFY(window_->fitting());
+    QTRY_VERIFY_WITH_TIMEOUT(!window_->fitting(), 120000);
+    QVERIFY(settle());
+    QVERIFY2(window_->lastError().isEmpty(), qPrintable(window_->lastError()));
+    QVERIFY(window_->notice().contains("After:"));
+    const auto& overrides = window_->request().overrides;
+    QCOMPARE(overrides.size(), expected.session.overrides.size());
+    for (const auto& [key, o] : expected.session.overrides) QCOMPARE(overrides.at(key).style, o.style);
+    QCOMPARE(window_->result()->city.area.ks, expected.after.ksArea);
+    QVERIFY(window_->unsavedOverrides());
+    window_->openSample();  // back to no overrides for the tests that follow
+    QVERIFY(settle());
   }
 
   void streetsOpenedWithTheParcelsGiveTheirBlocksAndAreDrawn() {

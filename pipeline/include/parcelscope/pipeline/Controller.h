@@ -97,6 +97,8 @@ public:
   /// parameters, by its key; an override of the same block by id (from a
   /// version 1 session file) goes.
   void overrideBlock(const Block& block, const BlockOverride& blockOverride);
+  /// Replaces every override by `overrides` (by key), as a calibration gives them.
+  void setOverrides(const BlockOverrides& overrides);
   /// Removes the override of `block`, by key and by id.
   void clearOverride(const Block& block);
   bool overridden(const Block& block) const;
