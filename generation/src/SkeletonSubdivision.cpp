@@ -312,10 +312,20 @@ void dropMicroFeatures(Polygon& p, double eps) {
   for (Ring& h : p.holes) dropMicroFeatures(h, eps);
 }
 
+// A block's outline prepared for the access test, with the outline itself
+// (the prepared edges point into it).
+struct PreparedOutline {
+  Polygon outline;
+  std::unique_ptr<analysis::PreparedBoundary> edges;
+};
+
 class SkeletonBuilder {
 public:
+  // `outlineEdges`: the block's outline prepared for the access test, made
+  // here when empty (it depends on the block alone: every try and every run
+  // on the same block shares it).
   SkeletonBuilder(const Polygon& block, const SkeletonParameters& p, const detail::Rng& rng, const StreetWidths& widths,
-                  double chordTolerance, bool exactOnly)
+                  double chordTolerance, bool exactOnly, std::shared_ptr<const PreparedOutline>& outlineEdges)
       : block_(block),
         outline_{block.outer, {}},
         p_(p),
@@ -332,7 +342,13 @@ public:
     const double expected = perimeter(outline_) / (0.5 * (p.bounds.wMin + p.bounds.wMax));
     parcels_.reserve(16 + (expected < kMaxStripParcels ? static_cast<std::size_t>(2.0 * expected) : 0));
     accessTolerance_ = std::max(1e-6, 1e-9 * size_);
-    outlineEdges_ = std::make_unique<analysis::PreparedBoundary>(outline_, accessTolerance_);
+    if (!outlineEdges) {
+      auto prepared = std::make_shared<PreparedOutline>();
+      prepared->outline = outline_;
+      prepared->edges = std::make_unique<analysis::PreparedBoundary>(prepared->outline, accessTolerance_);
+      outlineEdges = std::move(prepared);
+    }
+    outlineEdges_ = outlineEdges;
     target_ = 0.5 * (p.bounds.wMin + p.bounds.wMax);
   }
 
@@ -1138,7 +1154,9 @@ private:
   }
 
   // ---- 5. post-processing -----------------------------------------------------
-  bool hasAccess(const Polygon& piece) const { return outlineEdges_->sharesAtLeast(piece, p_.bounds.minFrontage); }
+  bool hasAccess(const Polygon& piece) const {
+    return outlineEdges_->edges->sharesAtLeast(piece, p_.bounds.minFrontage);
+  }
 
   bool rounded(const PWH& exactShape, Polygon& out) const {
     if (!detail::toDouble(exactShape, out)) return false;
@@ -1347,7 +1365,7 @@ private:
   bool fast_ = false;  // steps 4 and 5 on the floating-point route
   const std::vector<std::vector<Ring>>* fastRegions_ = nullptr;
   double size_ = 0, reach_ = 0, accessTolerance_ = 0, target_ = 0, maxTime_ = 0;
-  std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;  // outline_, for the access test
+  std::shared_ptr<const PreparedOutline> outlineEdges_;  // outline_, for the access test
   std::vector<Edge> edges_;
   std::vector<int> ringStart_;
   std::vector<SkVertex> vertices_;
@@ -1406,6 +1424,9 @@ struct SkeletonLayout {
   SkeletonParameters parameters;
   std::array<LayoutAttempt, std::size(kChordTolerances)> attempts;  // by try
   bool blockValid = false;  // the block passed the validity check (not made again for it)
+  // The block's outline (in the coordinates the builder works in) prepared
+  // for the access test, kept for the next run on the same block.
+  std::shared_ptr<const PreparedOutline> outlineEdges;
 };
 
 namespace {
@@ -1442,6 +1463,7 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
   auto layout = std::make_shared<SkeletonLayout>();
   const SkeletonLayout* previous = reuse.previous;
   const bool sameBlockAsBefore = previous && sameBlock(previous->block, block);
+  if (sameBlockAsBefore) layout->outlineEdges = previous->outlineEdges;
   if (sameBlockAsBefore && sameStreetWidths(previous->widths, streetWidths)) {
     layout->attempts = previous->attempts;
     // The skeleton (step 1) depends on the block and widths alone; the strips
@@ -1469,7 +1491,7 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
       try {
         out = Subdivision{};
         SkeletonBuilder(local, p, detail::Rng{detail::splitmix64(seed ^ 0x5EC0DE)}, streetWidths,
-                        kChordTolerances[attempt], reuse.exactOnly)
+                        kChordTolerances[attempt], reuse.exactOnly, layout->outlineEdges)
             .run(out, layout->attempts[attempt], reuse.record);
         break;
       } catch (const SkeletonFolds&) {
