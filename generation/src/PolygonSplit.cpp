@@ -590,13 +590,27 @@ bool samePoint(const Point& a, const Point& b) { return a.x == b.x && a.y == b.y
 struct DirectedEdge {
   Point from, to;
 };
+// An edge by its ends in pointLess order, and its direction.
+struct KeyedEdge {
+  Point lo, hi;
+  bool forward;  // from lo to hi
+};
+void addEdge(std::vector<KeyedEdge>& edges, const Point& from, const Point& to) {
+  if (pointLess(from, to)) {
+    edges.push_back({from, to, true});
+  } else {
+    edges.push_back({to, from, false});
+  }
+}
 }  // namespace
 
 bool joinRingsFast(const std::vector<const Ring*>& parts, double tolerance, std::vector<Ring>& out) {
   if (!(tolerance >= 0) || !std::isfinite(tolerance)) return false;
   // Every vertex, by x, to find those lying on an edge.
   thread_local std::vector<Point> points;
-  thread_local std::vector<DirectedEdge> edges;
+  thread_local std::vector<KeyedEdge> edges;
+  thread_local std::vector<DirectedEdge> kept;
+  thread_local std::vector<char> used;
   thread_local std::vector<std::pair<double, Point>> inside;
   points.clear();
   edges.clear();
@@ -633,32 +647,26 @@ bool joinRingsFast(const std::vector<const Ring*>& parts, double tolerance, std:
       Point from = a;
       for (const auto& [along, p] : inside) {
         if (samePoint(p, from)) continue;
-        edges.push_back({from, p});
+        addEdge(edges, from, p);
         from = p;
       }
-      edges.push_back({from, b});
+      addEdge(edges, from, b);
     }
   }
   // Coinciding edges: in opposite directions they cancel; in the same
   // direction, or more than two, the parts overlap.
-  auto key = [](const DirectedEdge& e) {
-    return pointLess(e.from, e.to) ? std::make_pair(e.from, e.to) : std::make_pair(e.to, e.from);
-  };
-  std::sort(edges.begin(), edges.end(), [&](const DirectedEdge& x, const DirectedEdge& y) {
-    const auto kx = key(x), ky = key(y);
-    if (!samePoint(kx.first, ky.first)) return pointLess(kx.first, ky.first);
-    return pointLess(kx.second, ky.second);
+  std::sort(edges.begin(), edges.end(), [](const KeyedEdge& x, const KeyedEdge& y) {
+    if (!samePoint(x.lo, y.lo)) return pointLess(x.lo, y.lo);
+    return pointLess(x.hi, y.hi);
   });
-  std::vector<DirectedEdge> kept;
+  kept.clear();
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t j = i + 1;
-    const auto ki = key(edges[i]);
-    while (j < edges.size() && samePoint(key(edges[j]).first, ki.first) && samePoint(key(edges[j]).second, ki.second)) {
-      ++j;
-    }
+    const KeyedEdge& ki = edges[i];
+    while (j < edges.size() && samePoint(edges[j].lo, ki.lo) && samePoint(edges[j].hi, ki.hi)) ++j;
     if (j - i == 1) {
-      kept.push_back(edges[i]);
-    } else if (j - i != 2 || samePoint(edges[i].from, edges[i + 1].from)) {
+      kept.push_back(ki.forward ? DirectedEdge{ki.lo, ki.hi} : DirectedEdge{ki.hi, ki.lo});
+    } else if (j - i != 2 || edges[i].forward == edges[i + 1].forward) {
       return false;
     }
     i = j;
@@ -669,7 +677,7 @@ bool joinRingsFast(const std::vector<const Ring*>& parts, double tolerance, std:
   for (std::size_t i = 1; i < kept.size(); ++i) {
     if (samePoint(kept[i - 1].from, kept[i].from)) return false;  // two ways on: a pinch
   }
-  std::vector<char> used(kept.size(), 0);
+  used.assign(kept.size(), 0);
   std::vector<Ring> rings;
   double ringsArea = 0;
   for (std::size_t first = 0; first < kept.size(); ++first) {

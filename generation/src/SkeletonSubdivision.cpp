@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <deque>
 #include <limits>
 #include <map>
 #include <memory>
@@ -243,7 +244,9 @@ struct Strip {
 };
 
 struct Candidate {
-  PWH shape;     // exact route
+  // Exact route (held apart: an empty PWH allocates, and vectors of
+  // candidates move rather than copy them as they grow).
+  std::unique_ptr<PWH> shape;
   Polygon fast;  // floating-point route: the shape as cut and joined in doubles (no holes)
   Polygon rounded;
   double area = 0;
@@ -310,10 +313,20 @@ void dropMicroFeatures(Polygon& p, double eps) {
   for (Ring& h : p.holes) dropMicroFeatures(h, eps);
 }
 
+// A block's outline prepared for the access test, with the outline itself
+// (the prepared edges point into it).
+struct PreparedOutline {
+  Polygon outline;
+  std::unique_ptr<analysis::PreparedBoundary> edges;
+};
+
 class SkeletonBuilder {
 public:
+  // `outlineEdges`: the block's outline prepared for the access test, made
+  // here when empty (it depends on the block alone: every try and every run
+  // on the same block shares it).
   SkeletonBuilder(const Polygon& block, const SkeletonParameters& p, const detail::Rng& rng, const StreetWidths& widths,
-                  double chordTolerance, bool exactOnly)
+                  double chordTolerance, bool exactOnly, std::shared_ptr<const PreparedOutline>& outlineEdges)
       : block_(block),
         outline_{block.outer, {}},
         p_(p),
@@ -330,7 +343,13 @@ public:
     const double expected = perimeter(outline_) / (0.5 * (p.bounds.wMin + p.bounds.wMax));
     parcels_.reserve(16 + (expected < kMaxStripParcels ? static_cast<std::size_t>(2.0 * expected) : 0));
     accessTolerance_ = std::max(1e-6, 1e-9 * size_);
-    outlineEdges_ = std::make_unique<analysis::PreparedBoundary>(outline_, accessTolerance_);
+    if (!outlineEdges) {
+      auto prepared = std::make_shared<PreparedOutline>();
+      prepared->outline = outline_;
+      prepared->edges = std::make_unique<analysis::PreparedBoundary>(prepared->outline, accessTolerance_);
+      outlineEdges = std::move(prepared);
+    }
+    outlineEdges_ = outlineEdges;
     target_ = 0.5 * (p.bounds.wMin + p.bounds.wMax);
   }
 
@@ -1001,8 +1020,8 @@ private:
   }
 
   // splitByLineFast of a ring, its pieces certified strictly simple.
-  static void splitFast(const Ring& ring, const Point& through, const Point& dir, detail::SplitPieces& split) {
-    if (!detail::splitByLineFast(Polygon{ring, {}}, through, dir, split) || split.pinched) throw NeedExact{};
+  static void splitFast(const Polygon& ring, const Point& through, const Point& dir, detail::SplitPieces& split) {
+    if (!detail::splitByLineFast(ring, through, dir, split) || split.pinched) throw NeedExact{};
     for (const auto* side : {&split.left, &split.right}) {
       for (const Polygon& q : *side) {
         if (!q.holes.empty() || !detail::splitPieceIsSimple(q.outer, bounds(q.outer), through, dir)) throw NeedExact{};
@@ -1021,13 +1040,26 @@ private:
   // slice() on the floating-point route.
   void sliceFast(const Strip& s) {
     const std::vector<double> cuts = cutPositions(s.start, s.end);
-    std::vector<std::vector<Ring>> pieces(cuts.size() + 1);
+    // The pieces between cuts: a region's part a cut misses is used where it
+    // is (and copied once, if it is a piece on its own); the cuts' pieces are
+    // held in `made` (a deque: they stay in place).
+    struct Part {
+      const Ring* ring;
+      Ring* made;  // ring, when it is one of the cuts' pieces
+    };
+    std::vector<std::vector<Part>> pieces(cuts.size() + 1);
+    std::deque<Ring> made;
+    const auto keep = [&](Ring&& r) {
+      made.push_back(std::move(r));
+      return Part{&made.back(), &made.back()};
+    };
     double at = 0;
     std::size_t before = 0;  // cuts before the current edge
-    std::vector<Ring> rest, next;
+    std::vector<Part> rest, next;
     for (int g : s.edges) {
       const Edge& e = edges_[g];
-      rest = (*fastRegions_)[g];
+      rest.clear();
+      for (const Ring& r : (*fastRegions_)[g]) rest.push_back({&r, nullptr});
       std::size_t k = before;
       const Point inward{e.a.y - e.b.y, e.b.x - e.a.x};
       for (; k < cuts.size() && cuts[k] < at + e.length; ++k) {
@@ -1035,22 +1067,26 @@ private:
         const double t = std::clamp((cuts[k] - at) / e.length, 0.0, 1.0);
         const Point o{e.a.x + (e.b.x - e.a.x) * t, e.a.y + (e.b.y - e.a.y) * t};
         next.clear();
-        for (const Ring& r : rest) {
+        for (const Part& r : rest) {
           detail::SplitPieces split;
-          splitFast(r, o, inward, split);
-          for (Polygon& q : split.left) pieces[k].push_back(std::move(q.outer));
-          for (Polygon& q : split.right) next.push_back(std::move(q.outer));
+          splitFast(r.made ? Polygon{std::move(*r.made), {}} : Polygon{*r.ring, {}}, o, inward, split);
+          for (Polygon& q : split.left) pieces[k].push_back(keep(std::move(q.outer)));
+          for (Polygon& q : split.right) next.push_back(keep(std::move(q.outer)));
         }
         rest.swap(next);
       }
-      for (Ring& r : rest) pieces[k].push_back(std::move(r));
+      pieces[k].insert(pieces[k].end(), rest.begin(), rest.end());
       before = k;
       at += e.length;
     }
     std::vector<const Ring*> parts;
-    for (const std::vector<Ring>& r : pieces) {
+    for (const std::vector<Part>& r : pieces) {
+      if (r.size() == 1) {
+        addFastCandidate(r[0].made ? std::move(*r[0].made) : *r[0].ring);
+        continue;
+      }
       parts.clear();
-      for (const Ring& q : r) parts.push_back(&q);
+      for (const Part& q : r) parts.push_back(q.ring);
       for (Ring& u : joinFast(parts)) addFastCandidate(std::move(u));
     }
   }
@@ -1059,20 +1095,20 @@ private:
   void singleRowFast() {
     const OrientedBox box = minimumAreaBox(block_.outer);
     const Point u = box.u, across{-u.y, u.x};
-    std::vector<Ring> rest{block_.outer}, next;
+    std::vector<Polygon> rest{Polygon{block_.outer, {}}}, next;
     const double start = -0.5 * box.length;
     for (double c : cutPositions(start, -start)) {
       const Point o{box.center.x + u.x * c, box.center.y + u.y * c};
       next.clear();
-      for (const Ring& r : rest) {
+      for (const Polygon& r : rest) {
         detail::SplitPieces split;
         splitFast(r, o, across, split);
         for (Polygon& q : split.left) addFastCandidate(std::move(q.outer));
-        for (Polygon& q : split.right) next.push_back(std::move(q.outer));
+        for (Polygon& q : split.right) next.push_back(std::move(q));
       }
       rest.swap(next);
     }
-    for (Ring& r : rest) addFastCandidate(std::move(r));
+    for (Polygon& r : rest) addFastCandidate(std::move(r.outer));
   }
 
   void backRegionsFast() {
@@ -1119,7 +1155,9 @@ private:
   }
 
   // ---- 5. post-processing -----------------------------------------------------
-  bool hasAccess(const Polygon& piece) const { return outlineEdges_->sharesAtLeast(piece, p_.bounds.minFrontage); }
+  bool hasAccess(const Polygon& piece) const {
+    return outlineEdges_->edges->sharesAtLeast(piece, p_.bounds.minFrontage);
+  }
 
   bool rounded(const PWH& exactShape, Polygon& out) const {
     if (!detail::toDouble(exactShape, out)) return false;
@@ -1128,8 +1166,8 @@ private:
   }
 
   bool makeCandidate(PWH shape, Candidate& c) const {
-    c.shape = std::move(shape);
-    if (!rounded(c.shape, c.rounded)) return false;
+    c.shape = std::make_unique<PWH>(std::move(shape));
+    if (!rounded(*c.shape, c.rounded)) return false;
     c.area = area(c.rounded);
     c.access = hasAccess(c.rounded);
     c.triangular = triangular(c.rounded);
@@ -1174,7 +1212,7 @@ private:
         if (fast_) {
           const Point mid{0.5 * (x.x + y.x), 0.5 * (x.y + y.y)}, inward{x.y - y.y, y.x - x.x};
           detail::SplitPieces split;
-          splitFast(parcels_[i].fast.outer, mid, inward, split);
+          splitFast(parcels_[i].fast, mid, inward, split);
           if (split.left.size() != 1 || split.right.size() != 1) break;
           if (!makeFastCandidate(std::move(split.left[0].outer), l) ||
               !makeFastCandidate(std::move(split.right[0].outer), r)) {
@@ -1183,8 +1221,8 @@ private:
         } else {
           const K::Point_2 mid(0.5 * (x.x + y.x), 0.5 * (x.y + y.y));
           const K::Vector_2 inward(x.y - y.y, y.x - x.x);
-          const Region left = detail::clipLeft(parcels_[i].shape, mid, inward, reach_);
-          const Region right = detail::clipLeft(parcels_[i].shape, mid, -inward, reach_);
+          const Region left = detail::clipLeft(*parcels_[i].shape, mid, inward, reach_);
+          const Region right = detail::clipLeft(*parcels_[i].shape, mid, -inward, reach_);
           if (left.size() != 1 || right.size() != 1) break;
           if (!makeCandidate(left[0], l) || !makeCandidate(right[0], r)) break;
         }
@@ -1249,7 +1287,7 @@ private:
           std::vector<Ring> u = joinFast({&parcels_[worst].fast.outer, &parcels_[j].fast.outer});
           if (u.size() != 1 || !makeFastCandidate(std::move(u[0]), c)) continue;
         } else {
-          const Region u = detail::join({parcels_[worst].shape, parcels_[j].shape});
+          const Region u = detail::join({*parcels_[worst].shape, *parcels_[j].shape});
           // One piece, whose holes are the block's (not two parcels closing around a third).
           if (u.size() != 1 || !makeCandidate(u[0], c) || !holesAreTheBlocks(c.rounded)) continue;
         }
@@ -1274,7 +1312,7 @@ private:
               analysis::sharedBoundaryLength(parcels_[i].rounded, shape, accessTolerance_) <= 0) {
             continue;
           }
-          const Region u = detail::join({patio, parcels_[i].shape});
+          const Region u = detail::join({patio, *parcels_[i].shape});
           if (u.size() != 1) continue;
           patio = u[0];
           joined = true;
@@ -1290,8 +1328,8 @@ private:
   }
 
   void emit(Subdivision& out) {
-    for (const Candidate& c : parcels_) {
-      out.parcels.push_back(c.rounded);
+    for (Candidate& c : parcels_) {
+      out.parcels.push_back(std::move(c.rounded));  // the last use of the candidates
       if (!c.access) ++out.withoutAccess;
       if (c.area > p_.bounds.aMax) ++out.oversize;
     }
@@ -1328,7 +1366,7 @@ private:
   bool fast_ = false;  // steps 4 and 5 on the floating-point route
   const std::vector<std::vector<Ring>>* fastRegions_ = nullptr;
   double size_ = 0, reach_ = 0, accessTolerance_ = 0, target_ = 0, maxTime_ = 0;
-  std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;  // outline_, for the access test
+  std::shared_ptr<const PreparedOutline> outlineEdges_;  // outline_, for the access test
   std::vector<Edge> edges_;
   std::vector<int> ringStart_;
   std::vector<SkVertex> vertices_;
@@ -1421,6 +1459,9 @@ struct SkeletonLayout {
   SkeletonParameters parameters;
   std::array<LayoutAttempt, std::size(kChordTolerances)> attempts;  // by try
   bool blockValid = false;  // the block passed the validity check (not made again for it)
+  // The block's outline (in the coordinates the builder works in) prepared
+  // for the access test, kept for the next run on the same block.
+  std::shared_ptr<const PreparedOutline> outlineEdges;
 };
 
 namespace {
@@ -1457,6 +1498,7 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
   auto layout = std::make_shared<SkeletonLayout>();
   const SkeletonLayout* previous = reuse.previous;
   const bool sameBlockAsBefore = previous && sameBlock(previous->block, block);
+  if (sameBlockAsBefore) layout->outlineEdges = previous->outlineEdges;
   if (sameBlockAsBefore && sameStreetWidths(previous->widths, streetWidths)) {
     layout->attempts = previous->attempts;
     // The skeleton (step 1) depends on the block and widths alone; the strips
@@ -1484,7 +1526,7 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
       try {
         out = Subdivision{};
         SkeletonBuilder(local, p, detail::Rng{detail::splitmix64(seed ^ 0x5EC0DE)}, streetWidths,
-                        kChordTolerances[attempt], reuse.exactOnly)
+                        kChordTolerances[attempt], reuse.exactOnly, layout->outlineEdges)
             .run(out, layout->attempts[attempt], reuse.record);
         break;
       } catch (const SkeletonFolds&) {

@@ -933,6 +933,13 @@ double drawingTolerance(double metresPerPixel) {
   return std::exp2(std::floor(std::log2(0.5 * metresPerPixel)));
 }
 
+// Orders `parts` (indices into `all`) by their count of shapes, the largest
+// first (ties by index).
+void largestFirst(const std::array<LayerPart, kLayerParts>& all, std::vector<std::size_t>& parts) {
+  std::stable_sort(parts.begin(), parts.end(),
+                   [&](std::size_t a, std::size_t b) { return all[a].members.size() > all[b].members.size(); });
+}
+
 struct MapLayer::Impl {
   std::array<LayerPart, kLayerParts> parts;
   std::vector<const Polygon*> drawn;  // the last setShapes's shapes
@@ -1014,7 +1021,9 @@ void MapLayer::setShapes(const std::vector<const Polygon*>& shapes, const std::v
     p.values = std::move(partValues);
     stale.push_back(i);
   }
-  // The parts share nothing: they are triangulated side by side.
+  // The parts share nothing: they are triangulated side by side, the largest
+  // first, so that no thread is left with a large part at the end.
+  largestFirst(m.parts, stale);
   parallelFor(stale.size(), [&](std::size_t i) { m.parts[stale[i]].rebuild(shapes, m.metresPerPixel, m.tolerance); });
   m.rebuilt = stale.size();
   m.drawn = shapes;
@@ -1027,9 +1036,12 @@ void MapLayer::setMetresPerPixel(double metresPerPixel) {
   if (tolerance != m.tolerance) {
     // Another level of detail: every part is built again for it.
     m.tolerance = tolerance;
-    parallelFor(m.parts.size(), [&](std::size_t i) {
-      if (!m.parts[i].members.empty()) m.parts[i].rebuild(m.drawn, metresPerPixel, tolerance);
-    });
+    std::vector<std::size_t> all;
+    for (std::size_t i = 0; i < m.parts.size(); ++i) {
+      if (!m.parts[i].members.empty()) all.push_back(i);
+    }
+    largestFirst(m.parts, all);
+    parallelFor(all.size(), [&](std::size_t i) { m.parts[all[i]].rebuild(m.drawn, metresPerPixel, tolerance); });
     return;
   }
   for (LayerPart& p : m.parts) p.selectOutlines(metresPerPixel, false);
