@@ -31,11 +31,19 @@ struct BlockCalibration {
   std::int64_t observedParcels = 0;
   std::string styleBefore;  ///< the paper's rule (the auto style's choice)
   double distanceBefore = NAN;
-  std::string styleAfter;  ///< the style of least distance
+  /// The calibrated style: from the style of least distance (or the paper's
+  /// rule's, when that is better city-wide), changed where that lowers the
+  /// city's cityObjective() (see calibrate()).
+  std::string styleAfter;
   double distanceAfter = NAN;
   int half = 0;                ///< cross-validation half (0 or 1, from the block key)
   std::string stylePredicted;  ///< the fitted rule's style, fitted on the other half
 };
+
+/// The measures over the observed blocks `blocks`, block b's parcels those
+/// leaderboard entry `entryOf[b]` made.
+FitMeasures fitMeasures(const Leaderboard& board, const std::vector<std::size_t>& blocks,
+                        const std::vector<std::size_t>& entryOf);
 
 struct Calibration {
   Leaderboard board;                     ///< every style on every block (the request's parameters)
@@ -52,8 +60,15 @@ struct Calibration {
 /// ratio (a KS that cannot be measured counts 1) + |n_generated / n_observed - 1|.
 double calibrationDistance(const analysis::Comparison& c);
 
+/// KS area + KS width + KS aspect ratio + median count error: what the
+/// calibration lowers city-wide.
+double cityObjective(const FitMeasures& f);
+
 /// Runs every concrete style on `request`'s blocks (request.style is ignored)
-/// and calibrates. Throws as compare().
+/// and calibrates: each block first takes its style of least distance; when
+/// the paper's rule scores better city-wide, the blocks start from its choice
+/// instead; then, twice over the blocks, a block's style is changed wherever
+/// that lowers cityObjective(). Throws as compare().
 Calibration calibrate(const CompareRequest& request, const ProgressFn& progress = {});
 
 /// calibration.csv: one row per observed block.
