@@ -129,6 +129,50 @@ std::size_t predict(const std::array<double, kFeatures>& x, const std::vector<st
 
 }  // namespace
 
+namespace {
+
+// The calibration of the blocks `blocks` (entries of `choice` elsewhere are
+// left): from the better, over those blocks, of `choice` (the per-block
+// optimum) and the paper's rule, then passes over the blocks changing a
+// block's style wherever that lowers cityObjective() over those blocks. The
+// per-block optimum need not add up to a city-wide one: a block's KS is
+// measured on a few parcels.
+std::vector<std::size_t> refineChoice(const Leaderboard& board,
+                                      const std::vector<std::vector<std::vector<int>>>& parcels,
+                                      const std::vector<std::size_t>& blocks,
+                                      const std::vector<std::size_t>& candidates,
+                                      const std::vector<std::size_t>& paperChoice, std::vector<std::size_t> choice,
+                                      const ProgressFn& progress) {
+  if (cityObjective(measure(board, parcels, blocks, paperChoice)) <
+      cityObjective(measure(board, parcels, blocks, choice))) {
+    for (std::size_t b : blocks) choice[b] = paperChoice[b];
+  }
+  double current = cityObjective(measure(board, parcels, blocks, choice));
+  for (int pass = 0; pass < kRefinePasses; ++pass) {
+    bool changed = false;
+    for (std::size_t b : blocks) {
+      reportProgress(progress, 0.95, "calibrating");
+      const std::size_t kept = choice[b];
+      std::size_t chosen = kept;
+      for (std::size_t e : candidates) {
+        if (e == kept) continue;
+        choice[b] = e;
+        const double o = cityObjective(measure(board, parcels, blocks, choice));
+        if (o < current - 1e-12) {
+          current = o;
+          chosen = e;
+        }
+      }
+      choice[b] = chosen;
+      changed = changed || chosen != kept;
+    }
+    if (!changed) break;
+  }
+  return choice;
+}
+
+}  // namespace
+
 double cityObjective(const FitMeasures& f) {
   return f.ksArea + f.ksWidth + f.ksAspectRatio + (std::isfinite(f.medianCountError) ? f.medianCountError : 0);
 }
@@ -184,46 +228,18 @@ Calibration calibrate(const CompareRequest& request, const ProgressFn& progress)
   }
   const auto parcels = parcelsByBlock(board);
   c.before = measure(board, parcels, all, before);
-  // The per-block optimum need not add up to a city-wide one (a block's KS is
-  // measured on a few parcels): a pass over the blocks changes a block's style
-  // wherever that lowers the city's objective.
-  const auto objective = cityObjective;
-  // From the better of the per-block optimum and the paper's rule (auto's
-  // choice is one of the candidates, with the same parcels), so that the
-  // result is never worse than the paper's rule.
-  {
-    std::vector<std::size_t> paperChoice(n);
-    for (std::size_t b = 0; b < n; ++b) {
-      paperChoice[b] = best[b];
-      for (std::size_t e : candidates) {
-        if (board.entries[e].style == c.blocks[b].styleBefore) paperChoice[b] = e;
-      }
-    }
-    if (objective(measure(board, parcels, all, paperChoice)) < objective(measure(board, parcels, all, best))) {
-      best = paperChoice;
+  const std::vector<std::size_t> perBlock = best;
+  std::vector<std::size_t> paperChoice(n);  // auto's choice is one of the candidates, with the same parcels
+  for (std::size_t b = 0; b < n; ++b) {
+    paperChoice[b] = best[b];
+    for (std::size_t e : candidates) {
+      if (board.entries[e].style == c.blocks[b].styleBefore) paperChoice[b] = e;
     }
   }
-  double current = objective(measure(board, parcels, all, best));
-  for (int pass = 0; pass < kRefinePasses; ++pass) {
-    bool changed = false;
-    for (std::size_t b = 0; b < n; ++b) {
-      reportProgress(progress, 0.95, "calibrating");
-      const std::size_t kept = best[b];
-      std::size_t chosen = kept;
-      for (std::size_t e : candidates) {
-        if (e == kept) continue;
-        best[b] = e;
-        const double o = objective(measure(board, parcels, all, best));
-        if (o < current - 1e-12) {
-          current = o;
-          chosen = e;
-        }
-      }
-      best[b] = chosen;
-      changed = changed || chosen != kept;
-    }
-    if (!changed) break;
-  }
+  auto refine = [&](const std::vector<std::size_t>& blocks, std::vector<std::size_t> choice) {
+    return refineChoice(board, parcels, blocks, candidates, paperChoice, std::move(choice), progress);
+  };
+  best = refine(all, best);
   for (std::size_t b = 0; b < n; ++b) {
     BlockCalibration& bc = c.blocks[b];
     --c.stylesChosen[bc.styleAfter];
@@ -236,20 +252,26 @@ Calibration calibrate(const CompareRequest& request, const ProgressFn& progress)
   }
   c.after = measure(board, parcels, all, best);
 
-  // Cross-validation: each half's styles predicted from the other half's best styles.
+  // Cross-validation: each half's styles predicted from the other half's calibrated styles.
   std::vector<std::array<double, kFeatures>> features(n);
   for (std::size_t b = 0; b < n; ++b) features[b] = featuresOf(*board.observed, b);
   std::vector<std::size_t> predicted(n, candidates.front());
   for (int half = 0; half < 2; ++half) {
     std::vector<std::array<double, kFeatures>> train;
     std::vector<std::size_t> labels;
+    // The other half's styles calibrated on that half alone: nothing of this
+    // half's parcels goes into its labels.
+    std::vector<std::size_t> trainBlocks;
     for (std::size_t b = 0; b < n; ++b) {
-      if (c.blocks[b].half != half) {
-        train.push_back(features[b]);
-        labels.push_back(best[b]);
-      }
+      if (c.blocks[b].half != half) trainBlocks.push_back(b);
     }
-    if (train.empty()) continue;
+    if (trainBlocks.empty()) continue;
+    const std::vector<std::size_t> trained = refine(trainBlocks, perBlock);
+    for (std::size_t b : trainBlocks) {
+      train.push_back(features[b]);
+      labels.push_back(trained[b]);
+      c.blocks[b].styleHalf = board.entries[trained[b]].style;
+    }
     std::array<double, kFeatures> mean{}, scale{};
     for (const auto& x : train) {
       for (std::size_t f = 0; f < kFeatures; ++f) mean[f] += x[f] / static_cast<double>(train.size());
@@ -284,10 +306,11 @@ Table calibrationTable(const Calibration& c) {
   using T = Column::Type;
   t.columns = {{"block_id", T::Integer, ""},   {"block_key", T::String, ""},    {"observed_parcels", T::Integer, ""},
                {"half", T::Integer, ""},       {"style_before", T::String, ""}, {"distance_before", T::Real, ""},
-               {"style_after", T::String, ""}, {"distance_after", T::Real, ""}, {"style_predicted", T::String, ""}};
+               {"style_after", T::String, ""}, {"distance_after", T::Real, ""}, {"style_predicted", T::String, ""},
+               {"style_half", T::String, ""}};
   for (const BlockCalibration& b : c.blocks) {
     t.rows.push_back({b.blockId, keyText(b.blockKey), b.observedParcels, std::int64_t(b.half), b.styleBefore,
-                      b.distanceBefore, b.styleAfter, b.distanceAfter, b.stylePredicted});
+                      b.distanceBefore, b.styleAfter, b.distanceAfter, b.stylePredicted, b.styleHalf});
   }
   return t;
 }
@@ -338,7 +361,8 @@ JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir
                      Json::object()
                          .set("halves", "blocks split by block key parity")
                          .set("fitted_rule",
-                              "the style most of the 5 nearest blocks of the other half fit best, in standardised "
+                              "the style most of the 5 nearest blocks of the other half got from that half's own "
+                              "calibration, in standardised "
                               "features: log10 block area, block width / length, convexity, observed street access "
                               "share, log10 observed mean parcel area, log10 observed parcel count")
                          .set("fitted", fitJson(c.crossFitted))

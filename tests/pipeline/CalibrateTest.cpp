@@ -87,10 +87,11 @@ TEST(Calibrate, TheCrossValidatedRuleIsMeasuredOnTheHalfItWasNotFittedOn) {
   EXPECT_GT(halves[1], 0);
   EXPECT_EQ(c.crossFitted.blocks, static_cast<std::int64_t>(c.blocks.size()));
   EXPECT_EQ(c.crossPaper.ksArea, c.before.ksArea);
-  // Every predicted style is the best style of some block of the other half.
+  // Every predicted style is the style some block of the other half got from
+  // that half's own calibration.
   for (const BlockCalibration& b : c.blocks) {
     bool seen = false;
-    for (const BlockCalibration& o : c.blocks) seen = seen || (o.half != b.half && o.styleAfter == b.stylePredicted);
+    for (const BlockCalibration& o : c.blocks) seen = seen || (o.half != b.half && o.styleHalf == b.stylePredicted);
     EXPECT_TRUE(seen) << b.blockId;
   }
 }

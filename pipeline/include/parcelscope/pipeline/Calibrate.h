@@ -38,6 +38,7 @@ struct BlockCalibration {
   double distanceAfter = NAN;
   int half = 0;                ///< cross-validation half (0 or 1, from the block key)
   std::string stylePredicted;  ///< the fitted rule's style, fitted on the other half
+  std::string styleHalf;       ///< the style its half calibrated alone gave it (the other half's labels)
 };
 
 /// The measures over the observed blocks `blocks`, block b's parcels those
