@@ -403,7 +403,7 @@ int calibrateCommand(const std::vector<std::string>& args) {
   request.explicitParameters = givenParameters(a, params);
   request.style = "auto";
   if (auto streets = streetsOf(a)) request.streets = std::move(streets);
-  return reportOutcome(pipeline::runCalibrate(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
+  return reportOutcome(viz::runCalibrate(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
 }
 
 int inspectCommand(const std::vector<std::string>& args) {

@@ -173,6 +173,17 @@ std::vector<std::size_t> refineChoice(const Leaderboard& board,
 
 }  // namespace
 
+std::vector<analysis::ParcelMetrics> generatedMetrics(const Leaderboard& board,
+                                                      const std::vector<std::size_t>& entryOf) {
+  const auto parcels = parcelsByBlock(board);
+  std::vector<analysis::ParcelMetrics> out;
+  for (std::size_t b = 0; b < entryOf.size(); ++b) {
+    const GeneratedParcels& g = board.entries[entryOf[b]].result.generated;
+    for (int i : parcels[entryOf[b]][b]) out.push_back(g.metrics[static_cast<std::size_t>(i)]);
+  }
+  return out;
+}
+
 double cityObjective(const FitMeasures& f) {
   return f.ksArea + f.ksWidth + f.ksAspectRatio + (std::isfinite(f.medianCountError) ? f.medianCountError : 0);
 }
@@ -251,6 +262,8 @@ Calibration calibrate(const CompareRequest& request, const ProgressFn& progress)
     it = it->second == 0 ? c.stylesChosen.erase(it) : std::next(it);
   }
   c.after = measure(board, parcels, all, best);
+  c.entryBefore = before;
+  c.entryAfter = best;
 
   // Cross-validation: each half's styles predicted from the other half's calibrated styles.
   std::vector<std::array<double, kFeatures>> features(n);
@@ -336,7 +349,8 @@ std::string fitText(const FitMeasures& f) {
 
 }  // namespace
 
-JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress) {
+JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress,
+                        const CalibrationRenderer& draw) {
   std::vector<std::string> inputs = {request.input.path};
   if (request.streets) inputs.push_back(request.streets->path);
   io::OutputDirectory out(outDir, inputs);
@@ -346,6 +360,12 @@ JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir
     io::writeJson(out.stage("session.json"), sessionJson(c.session));
     io::writeCsv(out.stage("calibration.csv"), calibrationTable(c));
     io::writeCsv(out.stage("leaderboard.csv"), leaderboardTable(c.board));
+    Json outputs = Json::array().push("session.json").push("calibration.csv").push("leaderboard.csv");
+    if (draw && compareValue(request, "figures") != 0) {
+      for (const std::string& name : draw(c, request, [&](const std::string& n) { return out.stage(n); })) {
+        outputs.push(name);
+      }
+    }
     Json run = runRecord("calibrate", request.parameters);
     addObservedRecord(run, *c.board.observed);
     if (c.board.observed->streets) run.set("streets", streetRecord(*c.board.observed->streets));
@@ -367,8 +387,7 @@ JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir
                               "share, log10 observed mean parcel area, log10 observed parcel count")
                          .set("fitted", fitJson(c.crossFitted))
                          .set("paper", fitJson(c.crossPaper))));
-    run.set("outputs",
-            Json::array().push("session.json").push("calibration.csv").push("leaderboard.csv").push("run.json"));
+    run.set("outputs", outputs.push("run.json"));
     io::writeJson(out.stage("run.json"), run);
     out.commit();
     reportProgress(progress, 1.0, "writing");

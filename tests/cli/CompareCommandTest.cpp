@@ -472,6 +472,31 @@ TEST(CompareCommand, SessionFileRerunsWithItsOverrides) {
   EXPECT_FALSE(test::sameGeometries(withOverride, written(c)));
 }
 
+// calibrate: its session file through compare gives the calibrated measures,
+// and its figures (per-block fit map, histograms before and after) are drawn.
+TEST(CalibrateCommand, SessionReproducesTheCalibratedCityAndFiguresAreDrawn) {
+  TempDir dir;
+  const std::string out = dir.file("cal"), again = dir.file("again");
+  CliRun r = runCli("calibrate " + kSampleArgs + " --out '" + out + "' --quiet");
+  ASSERT_EQ(r.code, 0) << r.output;
+  CPLJSONDocument run;
+  ASSERT_TRUE(run.Load(out + "/run.json"));
+  const double ksArea = run.GetRoot().GetDouble("calibration/after/ks_area", -1);
+  ASSERT_GE(ksArea, 0);
+  EXPECT_LE(ksArea, run.GetRoot().GetDouble("calibration/before/ks_area", -1) + 1e-12);
+  for (const char* name :
+       {"map_fit", "hist_calibration_area", "hist_calibration_width", "hist_calibration_aspect_ratio"}) {
+    const test::Image image = test::readPng(out + "/figures/" + name + ".png");
+    EXPECT_GT(test::ink(image).share, 0.03) << name << " looks blank";
+    EXPECT_NE(test::slurp(out + "/figures/" + name + ".svg").find("<svg"), std::string::npos) << name;
+  }
+  r = runCli("compare --session '" + out + "/session.json' --figures 0 --out '" + again + "' --quiet");
+  ASSERT_EQ(r.code, 0) << r.output;
+  CPLJSONDocument summary;
+  ASSERT_TRUE(summary.Load(again + "/summary.json"));
+  EXPECT_NEAR(summary.GetRoot().GetDouble("ks/area", -1), ksArea, 1e-9) << summary.SaveAsString();
+}
+
 TEST(CompareCommand, MetricDrawsItsMapAndHistogram) {
   TempDir dir;
   const std::string out = dir.file("out");

@@ -339,6 +339,82 @@ std::vector<std::string> drawLeaderboard(const pipeline::Leaderboard& board, con
   return {"leaderboard.png", "leaderboard.svg"};
 }
 
+std::vector<std::string> drawCalibration(const pipeline::Calibration& c, const CompareRequest& request,
+                                         const std::function<std::string(const std::string&)>& stage) {
+  requireDisplay();
+  const analysis::ObservedAnalysis& a = c.board.observed->analysis;
+  std::vector<std::string> written;
+  // The blocks by their distance, before and after, on one scale.
+  std::vector<MapPanel> panels(2);
+  double top = 0;
+  for (std::size_t b = 0; b < c.blocks.size() && b < a.blocks.size(); ++b) {
+    for (const Polygon& part : a.blocks[b].parts) {
+      panels[0].shapes.push_back(&part);
+      panels[0].values.push_back(c.blocks[b].distanceBefore);
+      panels[1].shapes.push_back(&part);
+      panels[1].values.push_back(c.blocks[b].distanceAfter);
+    }
+    top = std::max(top, c.blocks[b].distanceBefore);
+  }
+  char title[160];
+  std::snprintf(title, sizeof title, "Before (the paper's rule, auto): city KS area %.3f, width %.3f, aspect %.3f",
+                c.before.ksArea, c.before.ksWidth, c.before.ksAspectRatio);
+  panels[0].title = title;
+  std::snprintf(title, sizeof title, "Calibrated: city KS area %.3f, width %.3f, aspect %.3f", c.after.ksArea,
+                c.after.ksWidth, c.after.ksAspectRatio);
+  panels[1].title = title;
+  ColourScale scale;
+  scale.kind = ColourScale::Kind::Sequential;
+  scale.minimum = 0;
+  scale.maximum = std::max(top, 1e-9);
+  scale.title = "Block distance to its observed parcels (KS area + width + aspect ratio + count error)";
+  const std::string mapTitle = "Per-block fit before and after calibration: " + inputName(request);
+  FigureOutput map;
+  map.png = stage("figures/map_fit.png");
+  renderMaps(mapTitle, panels, scale, map);
+  writeVectorMaps(mapTitle, panels, scale, map.width, map.height, stage("figures/map_fit.svg"));
+  written.insert(written.end(), {"figures/map_fit.png", "figures/map_fit.svg"});
+
+  // Observed, before and after, on the bins of observed and before.
+  std::vector<analysis::ParcelMetrics> observed;
+  for (std::size_t i = 0; i < a.metrics.size(); ++i) {
+    if (a.blockOf[i] >= 0) observed.push_back(a.metrics[i]);
+  }
+  const auto before = pipeline::generatedMetrics(c.board, c.entryBefore);
+  const auto after = pipeline::generatedMetrics(c.board, c.entryAfter);
+  const int bins = static_cast<int>(value(request, "bins"));
+  const double quantile = value(request, "histogram-quantile");
+  for (const char* name : {"area", "width", "aspect_ratio"}) {
+    const analysis::ParcelQuantity& q = analysis::parcelQuantity(name);
+    const std::vector<double> o = analysis::quantitySample(observed, q), b = analysis::quantitySample(before, q),
+                              f = analysis::quantitySample(after, q);
+    const analysis::SharedHistogram h = analysis::sharedHistogram(o, b, bins, quantile);
+    if (h.edges.size() < 2) continue;
+    std::vector<int> counts(h.edges.size() - 1, 0);
+    for (double v : f) {
+      const auto bin = std::upper_bound(h.edges.begin(), h.edges.end(), v) - h.edges.begin() - 1;
+      ++counts[static_cast<std::size_t>(std::clamp<long>(bin, 0, static_cast<long>(counts.size()) - 1))];
+    }
+    const std::vector<HistogramSeries> series = {{"observed", h.a, {0.84, 0.19, 0.15}},
+                                                 {"before (auto)", h.b, {0.55, 0.55, 0.55}},
+                                                 {"calibrated", counts, {0.17, 0.40, 0.75}}};
+    const std::string file = std::string("figures/hist_calibration_") + name;
+    FigureOutput out;
+    out.png = stage(file + ".png");
+    out.vector = stage(file + ".svg");
+    renderHistogram("Parcel " + std::string(name == std::string("aspect_ratio") ? "aspect ratio" : name) +
+                        ": observed, before and after calibration (last bin: every value above)",
+                    q.title, "parcels", h.edges, series, out);
+    written.insert(written.end(), {file + ".png", file + ".svg"});
+  }
+  return written;
+}
+
+pipeline::JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir,
+                                  const ProgressFn& progress) {
+  return pipeline::runCalibrate(request, outDir, progress, drawCalibration);
+}
+
 pipeline::JobOutcome runLeaderboard(const CompareRequest& request, const std::string& outDir,
                                     const ProgressFn& progress) {
   return pipeline::runLeaderboard(request, outDir, progress, drawLeaderboard);

@@ -55,7 +55,14 @@ struct Calibration {
   /// paper's rule; the two halves' measures, parcels pooled.
   FitMeasures crossFitted, crossPaper;
   std::map<std::string, std::int64_t> stylesChosen;  ///< blocks per calibrated style
+  /// Per observed block, the leaderboard entry of its style: the paper's rule, calibrated.
+  std::vector<std::size_t> entryBefore, entryAfter;
 };
+
+/// The generated parcels' metrics (unassigned land left out), each observed
+/// block's from leaderboard entry `entryOf[block]`.
+std::vector<analysis::ParcelMetrics> generatedMetrics(const Leaderboard& board,
+                                                      const std::vector<std::size_t>& entryOf);
 
 /// A block's distance to its observed parcels: KS area + KS width + KS aspect
 /// ratio (a KS that cannot be measured counts 1) + |n_generated / n_observed - 1|.
@@ -75,8 +82,17 @@ Calibration calibrate(const CompareRequest& request, const ProgressFn& progress 
 /// calibration.csv: one row per observed block.
 Table calibrationTable(const Calibration& c);
 
+/// What draws the calibration's figures (viz supplies it): `stage` turns a
+/// name relative to the output folder into the path to write; returns the
+/// names written.
+using CalibrationRenderer =
+    std::function<std::vector<std::string>(const Calibration& calibration, const CompareRequest& request,
+                                           const std::function<std::string(const std::string&)>& stage)>;
+
 /// calibrate() and its outputs in `outDir`, all at once: session.json,
-/// calibration.csv, leaderboard.csv, run.json.
-JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress = {});
+/// calibration.csv, leaderboard.csv, run.json and the figures `draw` makes
+/// (none when null or figures = 0).
+JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress = {},
+                        const CalibrationRenderer& draw = {});
 
 }  // namespace parcelscope::pipeline

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "parcelscope/pipeline/Calibrate.h"
 #include "parcelscope/pipeline/CompareJob.h"
 #include "parcelscope/pipeline/Leaderboard.h"
 #include "parcelscope/viz/Figures.h"
@@ -71,6 +72,18 @@ const pipeline::FigureRenderer& compareFigureRenderer();
 /// leaderboard.svg (vector paths). Returns the names written.
 std::vector<std::string> drawLeaderboard(const pipeline::Leaderboard& board, const CompareRequest& request,
                                          const std::function<std::string(const std::string&)>& stage);
+
+/// The calibration's figures: `figures/map_fit.png` (+ .svg), the blocks
+/// coloured by their distance to their observed parcels before (the paper's
+/// rule) and after calibration; `figures/hist_calibration_QUANTITY.png` (+
+/// .svg) for area, width and aspect ratio: observed, before and after on
+/// shared bins. Returns the names written.
+std::vector<std::string> drawCalibration(const pipeline::Calibration& calibration, const CompareRequest& request,
+                                         const std::function<std::string(const std::string&)>& stage);
+
+/// pipeline::runCalibrate with drawCalibration.
+pipeline::JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir,
+                                  const ProgressFn& progress = {});
 
 /// pipeline::runLeaderboard with drawLeaderboard.
 pipeline::JobOutcome runLeaderboard(const CompareRequest& request, const std::string& outDir,
