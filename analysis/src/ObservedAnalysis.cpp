@@ -33,6 +33,10 @@ const std::vector<ParameterDescription>& analysisParameters() {
                     "Parcels whose boundaries come this close belong to one block; gaps narrower than this are "
                     "closed in the block outline",
                     "m", 0.0, 50.0, 1.0, "Blocks"),
+      enumParameter("derive",
+                    "How block bounds come from observed parcels: paper (mean -/+ k standard deviations, "
+                    "Vanegas et al. 2012) or robust (median -/+ k x 1.4826 MAD)",
+                    {"paper", "robust"}, "paper", "Bounds"),
       minFrontageParameter(),
       booleanParameter("detect-right-of-way",
                        "Detect parcels that are streets (holes holding parcels, or network shape) and keep them "
@@ -50,12 +54,32 @@ AnalysisOptions analysisOptionsFrom(const ParameterValues& v) {
   };
   o.blockTolerance = get("block-tolerance", o.blockTolerance);
   o.k = get("k", o.k);
+  o.robustBounds = get("derive", 0.0) != 0.0;
   o.minFrontage = get("min-frontage", o.minFrontage);
   o.detectRightOfWay = get("detect-right-of-way", 1.0) != 0.0;
   return o;
 }
 
 namespace {
+
+// 1 / Phi^-1(3/4): the MAD of normal data times this is its standard deviation.
+constexpr double kMadToSd = 1.4826;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  const std::size_t h = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(h), v.end());
+  if (v.size() % 2 == 1) return v[h];
+  return 0.5 * (v[h] + *std::max_element(v.begin(), v.begin() + static_cast<long>(h)));
+}
+
+double medianAbsoluteDeviation(const std::vector<double>& v) {
+  const double m = median(v);
+  std::vector<double> d;
+  d.reserve(v.size());
+  for (double x : v) d.push_back(std::fabs(x - m));
+  return median(std::move(d));
+}
 
 double mean(const std::vector<double>& v) {
   return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
@@ -131,19 +155,27 @@ constexpr double kNetworkWidthRatio = 6.0;
 
 }  // namespace
 
-BlockStatistics blockStatistics(const std::vector<double>& areas, const std::vector<double>& widths, double k) {
+BlockStatistics blockStatistics(const std::vector<double>& areas, const std::vector<double>& widths,
+                                const BoundsRule& rule) {
   BlockStatistics s;
   s.parcelCount = static_cast<int>(areas.size());
   s.meanArea = mean(areas);
   s.sdArea = sampleSd(areas, s.meanArea);
   s.meanWidth = mean(widths);
   s.sdWidth = sampleSd(widths, s.meanWidth);
-  s.aMax = s.meanArea + k * s.sdArea;
-  s.wMax = s.meanWidth + k * s.sdWidth;
-  const double aFloor = std::max(0.1 * s.meanArea, 1.0);
-  const double wFloor = std::max(0.1 * s.meanWidth, 0.5);
-  s.aMin = s.meanArea - k * s.sdArea;
-  s.wMin = s.meanWidth - k * s.sdWidth;
+  const double k = rule.k;
+  // Centre and spread of the bounds: the paper's mean and standard deviation,
+  // or the median and the MAD scaled to match s for normal data.
+  const double aCentre = rule.robust ? median(areas) : s.meanArea;
+  const double aSpread = rule.robust ? kMadToSd * medianAbsoluteDeviation(areas) : s.sdArea;
+  const double wCentre = rule.robust ? median(widths) : s.meanWidth;
+  const double wSpread = rule.robust ? kMadToSd * medianAbsoluteDeviation(widths) : s.sdWidth;
+  s.aMax = aCentre + k * aSpread;
+  s.wMax = wCentre + k * wSpread;
+  const double aFloor = std::max(0.1 * aCentre, 1.0);
+  const double wFloor = std::max(0.1 * wCentre, 0.5);
+  s.aMin = aCentre - k * aSpread;
+  s.wMin = wCentre - k * wSpread;
   if (s.aMin < aFloor) {
     s.aMin = std::min(aFloor, s.aMax);
     s.aMinClamped = true;
@@ -297,7 +329,7 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
       areas.push_back(out.metrics[i].area);
       widths.push_back(out.metrics[i].width);
     }
-    BlockStatistics s = blockStatistics(areas, widths, options.k);
+    BlockStatistics s = blockStatistics(areas, widths, options.bounds());
     s.blockId = block.id;
     for (const Polygon& part : block.parts) s.blockArea += area(part);
     s.streetAccessShare = static_cast<double>(withAccess) / static_cast<double>(block.parcels.size());
@@ -313,7 +345,7 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
   return out;
 }
 
-void rederiveBlockBounds(ObservedAnalysis& a, double k) {
+void rederiveBlockBounds(ObservedAnalysis& a, const BoundsRule& rule) {
   a.clampedAMin = a.clampedWMin = 0;
   for (std::size_t b = 0; b < a.blocks.size(); ++b) {
     if (a.blocks[b].parcels.empty()) continue;  // a street block without parcels keeps the run's bounds
@@ -324,7 +356,7 @@ void rederiveBlockBounds(ObservedAnalysis& a, double k) {
     }
     const BlockStatistics old = a.statistics[b];
     BlockStatistics& s = a.statistics[b];
-    s = blockStatistics(areas, widths, k);
+    s = blockStatistics(areas, widths, rule);
     s.blockId = old.blockId;
     s.blockArea = old.blockArea;
     s.streetAccessShare = old.streetAccessShare;

@@ -148,8 +148,9 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
 
   // Observed data: read and analysed again only when the blocks would differ.
   const bool reload = !s.observed || !sameInput(s.request.input, request.input) || !sameBlocks(s.request, request);
-  const double k = compareValue(request, "k");
-  const bool rederive = !reload && compareValue(s.request, "k") != k;
+  const analysis::BoundsRule rule(compareValue(request, "k"), compareValue(request, "derive") != 0);
+  const bool rederive =
+      !reload && analysis::BoundsRule(compareValue(s.request, "k"), compareValue(s.request, "derive") != 0) != rule;
   std::shared_ptr<const pipeline::ObservedData> observed = s.observed;
   double readSeconds = 0, blockSeconds = 0;
   if (reload) {
@@ -162,7 +163,7 @@ CompareSession::Update CompareSession::update(const CompareRequest& request, con
     observed = std::move(loaded);
   } else if (rederive) {
     auto copy = std::make_shared<pipeline::ObservedData>(*observed);
-    analysis::rederiveBlockBounds(copy->analysis, k);
+    analysis::rederiveBlockBounds(copy->analysis, rule);
     observed = std::move(copy);
   }
   pipeline::BlockInputs fresh;

@@ -124,7 +124,8 @@ StreetNetwork buildStreetNetwork(const io::StreetReadOptions& streets, const Par
   }
 }
 
-std::int64_t assignToStreetBlocks(ObservedData& observed, std::shared_ptr<const StreetNetwork> network, double k) {
+std::int64_t assignToStreetBlocks(ObservedData& observed, std::shared_ptr<const StreetNetwork> network,
+                                  const analysis::BoundsRule& rule) {
   analysis::ObservedAnalysis& a = observed.analysis;
   const auto& blocks = network->blocks.blocks;
   std::vector<std::pair<IndexBox, int>> boxes;
@@ -206,7 +207,7 @@ std::int64_t assignToStreetBlocks(ObservedData& observed, std::shared_ptr<const 
       s.aMin = s.aMax = s.wMin = s.wMax = NAN;
       s.streetAccessShare = NAN;
     } else {
-      s = analysis::blockStatistics(areas, widths, k);
+      s = analysis::blockStatistics(areas, widths, rule);
       s.streetAccessShare = static_cast<double>(withAccess) / static_cast<double>(block.parcels.size());
     }
     s.blockId = block.id;
@@ -227,7 +228,7 @@ ObservedData loadObservedInStreetBlocks(const io::ReadOptions& input, const io::
       buildStreetNetwork(*streets, parameters, &data, scaledProgress(progress, 0.6, 0.95)));
   StreetNetwork* timed = network.get();
   timed->timings.start("assign parcels");
-  data.outsideStreetBlocks = assignToStreetBlocks(data, network, analysis::analysisOptionsFrom(parameters).k);
+  data.outsideStreetBlocks = assignToStreetBlocks(data, network, analysis::analysisOptionsFrom(parameters).bounds());
   timed->timings.stop();
   reportProgress(progress, 1.0, "street blocks");
   return data;
@@ -342,7 +343,7 @@ JobOutcome writeBlocks(io::OutputDirectory& out, const io::StreetReadOptions& st
   for (const analysis::StreetBlock& b : network.blocks.blocks) outlines.push_back({b.shape});
   const ObservedData* withParcels = nullptr;
   if (parcels) {
-    assignToStreetBlocks(observed, shared, analysis::analysisOptionsFrom(parameters).k);
+    assignToStreetBlocks(observed, shared, analysis::analysisOptionsFrom(parameters).bounds());
     withParcels = &observed;
   }
   const io::LayerWrite blocksWritten = io::writePolygonLayer(out.stage("blocks.gpkg"), "blocks", outlines,

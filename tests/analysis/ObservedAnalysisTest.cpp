@@ -47,6 +47,28 @@ TEST(BlockStatistics, LowerBoundsAreClampedAndFlagged) {
   EXPECT_DOUBLE_EQ(one.aMin, 50);
 }
 
+// --derive robust: median -/+ k x 1.4826 MAD, which one large lot does not
+// pull up; the statistics reported stay the mean and standard deviation.
+TEST(BlockStatistics, RobustBoundsComeFromMedianAndMad) {
+  const std::vector<double> areas = {100, 200, 300, 400, 10000}, widths = {8, 10, 12, 14, 60};
+  const BlockStatistics paper = blockStatistics(areas, widths, BoundsRule(2.0, false));
+  const BlockStatistics robust = blockStatistics(areas, widths, BoundsRule(2.0, true));
+  // median 300, MAD = median(200, 100, 0, 100, 9700) = 100
+  EXPECT_DOUBLE_EQ(robust.aMax, 300 + 2 * 1.4826 * 100);
+  EXPECT_DOUBLE_EQ(robust.aMin, 30);  // 300 - 296.5, below 10 % of the median: clamped there
+  EXPECT_TRUE(robust.aMinClamped);
+  // widths: median 12, MAD = median(4, 2, 0, 2, 48) = 2
+  EXPECT_DOUBLE_EQ(robust.wMax, 12 + 2 * 1.4826 * 2);
+  EXPECT_GT(paper.aMax, 10000);
+  EXPECT_DOUBLE_EQ(robust.meanArea, paper.meanArea);
+  EXPECT_DOUBLE_EQ(robust.sdArea, paper.sdArea);
+  // An even count takes the mean of the two middle values.
+  EXPECT_DOUBLE_EQ(blockStatistics({100, 200, 300, 400}, {1, 2, 3, 4}, BoundsRule(0.0, true)).aMax, 250);
+  // The parameter selects it.
+  EXPECT_TRUE(analysisOptionsFrom({{"derive", 1}}).bounds().robust);
+  EXPECT_FALSE(analysisOptionsFrom({}).bounds().robust);
+}
+
 TEST(ObservedAnalysis, TouchingAndNearlyTouchingLotsFormBlocks) {
   // A 2 x 2 block of 10 m lots with a 0.5 m digitising gap, and a lone lot 30 m away.
   const auto parcels = parcelsOf(

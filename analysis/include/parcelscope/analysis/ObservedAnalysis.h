@@ -13,12 +13,28 @@
 
 namespace parcelscope::analysis {
 
+/// How a block's bounds are derived from its observed parcels' areas and widths.
+struct BoundsRule {
+  double k = 2.0;
+  /// false (`--derive paper`): the paper's A-bar -/+ k s_A, W-bar -/+ k s_W
+  /// (mean and sample standard deviation); true (`--derive robust`): median
+  /// -/+ k x 1.4826 MAD (the MAD scaled to s for normal data), which skewed
+  /// areas and a few corner or through lots do not pull up.
+  bool robust = false;
+  BoundsRule(double kValue = 2.0, bool robustSpread = false) : k(kValue), robust(robustSpread) {}  // NOLINT
+  bool operator==(const BoundsRule& o) const { return k == o.k && robust == o.robust; }
+  bool operator!=(const BoundsRule& o) const { return !(*this == o); }
+};
+
 struct AnalysisOptions {
   /// Parcels whose boundaries come within this distance (m) belong to one block;
   /// the block outline is closed over gaps narrower than it.
   double blockTolerance = 1.0;
   /// k of A_min = A-bar - k s_A etc.
   double k = 2.0;
+  /// Bounds from median and MAD instead of mean and standard deviation (BoundsRule::robust).
+  bool robustBounds = false;
+  BoundsRule bounds() const { return {k, robustBounds}; }
   /// Frontage (m) a parcel needs to count as having street access.
   double minFrontage = 1.0;
   /// Detect right-of-way parcels (streets stored as parcels) and keep them out of blocks.
@@ -64,7 +80,8 @@ struct BlockStatistics {
 
 /// Per-block statistics and the derived generator bounds; `widths` and `areas`
 /// are the block's parcels' values. Precondition: at least one value.
-BlockStatistics blockStatistics(const std::vector<double>& areas, const std::vector<double>& widths, double k);
+BlockStatistics blockStatistics(const std::vector<double>& areas, const std::vector<double>& widths,
+                                const BoundsRule& rule);
 
 struct ObservedAnalysis {
   std::vector<ParcelMetrics> metrics;       ///< one per parcel
@@ -84,9 +101,9 @@ struct ObservedAnalysis {
 ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const AnalysisOptions& options,
                                 const ProgressFn& progress = {});
 
-/// Derives every block's statistics and bounds again with another k; the
+/// Derives every block's statistics and bounds again with another rule; the
 /// blocks, metrics, block areas and street-access shares stay as they are.
-void rederiveBlockBounds(ObservedAnalysis& analysis, double k);
+void rederiveBlockBounds(ObservedAnalysis& analysis, const BoundsRule& rule);
 
 /// Metrics of parcels whose blocks are already known (generated parcels):
 /// shape metrics, neighbours (>= 1 m of shared boundary within `tolerance`) and

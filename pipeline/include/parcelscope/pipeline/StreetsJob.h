@@ -51,7 +51,8 @@ StreetNetwork buildStreetNetwork(const io::StreetReadOptions& streets, const Par
 /// (NaN, so that the run's values apply, for a block without parcels). The
 /// blocks' keys are the street blocks' keys; `observed.streets` keeps `network`.
 /// Returns the number of lots left outside every street block.
-std::int64_t assignToStreetBlocks(ObservedData& observed, std::shared_ptr<const StreetNetwork> network, double k);
+std::int64_t assignToStreetBlocks(ObservedData& observed, std::shared_ptr<const StreetNetwork> network,
+                                  const analysis::BoundsRule& rule);
 
 /// Reads observed parcels as loadObserved does and, with `streets`, regroups
 /// them into street blocks (assignToStreetBlocks) built with `parameters`.
