@@ -30,40 +30,50 @@ bool isSliver(const Polygon& p) {
 
 }  // namespace
 
+long mergeIntoNeighbour(std::vector<Polygon>& parcels, std::size_t i,
+                        const std::function<bool(const Polygon&)>& eligible,
+                        const std::function<bool(const Polygon&)>& acceptUnion) {
+  const Polygon& piece = parcels[i];
+  // The neighbour sharing the most boundary: the union's perimeter is the
+  // two perimeters less twice the shared length.
+  const Box box = bounds(piece).expanded(kMinParcelWidth);
+  const double piecePerimeter = perimeter(piece);
+  std::size_t best = parcels.size();
+  double bestShared = 0;
+  std::optional<Polygon> bestUnion;
+  for (std::size_t j = 0; j < parcels.size(); ++j) {
+    if (j == i || !box.intersects(bounds(parcels[j])) || (eligible && !eligible(parcels[j]))) continue;
+    std::optional<Polygon> u = geos::unionIfOne(parcels[j], piece);
+    if (!u || (acceptUnion && !acceptUnion(*u))) continue;
+    const double shared = 0.5 * (perimeter(parcels[j]) + piecePerimeter - perimeter(*u));
+    if (shared > bestShared) {
+      best = j;
+      bestShared = shared;
+      bestUnion = std::move(u);
+    }
+  }
+  if (!bestUnion) return -1;
+  parcels[best] = std::move(*bestUnion);
+  parcels.erase(parcels.begin() + static_cast<long>(i));
+  return static_cast<long>(best);
+}
+
 int mergeSlivers(const Polygon& block, Subdivision& out, double minFrontage) {
   int left = 0;
   const Polygon outline{block.outer, {}};
   for (std::size_t i = 0; i < out.parcels.size();) {
-    const Polygon& sliver = out.parcels[i];
-    if (!isSliver(sliver)) {
+    if (!isSliver(out.parcels[i])) {
       ++i;
       continue;
     }
-    // The neighbour sharing the most boundary: the union's perimeter is the
-    // two perimeters less twice the shared length.
-    const Box box = bounds(sliver).expanded(kMinParcelWidth);
-    const double sliverPerimeter = perimeter(sliver);
-    std::size_t best = out.parcels.size();
-    double bestShared = 0;
-    std::optional<Polygon> bestUnion;
-    for (std::size_t j = 0; j < out.parcels.size(); ++j) {
-      if (j == i || !box.intersects(bounds(out.parcels[j]))) continue;
-      std::optional<Polygon> u = geos::unionIfOne(out.parcels[j], sliver);
-      if (!u) continue;
-      const double shared = 0.5 * (perimeter(out.parcels[j]) + sliverPerimeter - perimeter(*u));
-      if (shared > bestShared) {
-        best = j;
-        bestShared = shared;
-        bestUnion = std::move(u);
-      }
-    }
-    if (!bestUnion) {
+    const Polygon sliver = out.parcels[i];  // merged away below
+    const std::size_t firstUnassigned = out.parcels.size() - static_cast<std::size_t>(out.unassignedParcels);
+    const std::size_t firstPatio = firstUnassigned - static_cast<std::size_t>(out.patioParcels);
+    if (mergeIntoNeighbour(out.parcels, i) < 0) {
       ++left;
       ++i;
       continue;
     }
-    const std::size_t firstUnassigned = out.parcels.size() - static_cast<std::size_t>(out.unassignedParcels);
-    const std::size_t firstPatio = firstUnassigned - static_cast<std::size_t>(out.patioParcels);
     if (i >= firstUnassigned) {
       --out.unassignedParcels;
     } else if (i >= firstPatio) {
@@ -72,8 +82,6 @@ int mergeSlivers(const Polygon& block, Subdivision& out, double minFrontage) {
                analysis::sharedBoundaryLength(sliver, outline, kMinParcelWidth) < minFrontage) {
       --out.withoutAccess;
     }
-    out.parcels[best] = std::move(*bestUnion);
-    out.parcels.erase(out.parcels.begin() + static_cast<long>(i));
   }
   return left;
 }

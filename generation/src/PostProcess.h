@@ -4,8 +4,10 @@
 // the OBB style, with the reason, when a style cannot subdivide a block. A
 // new style calls these instead of writing its own.
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "BlockFailure.h"
 #include "LocalShift.h"
@@ -29,6 +31,17 @@ void checkTiling(const Polygon& block, const Subdivision& out);
 /// numerical crumbs of a cut passing next to a vertex (a triangle of 1e-13 m²
 /// has no use as a parcel, and collapses once mapped back to degrees).
 constexpr double kMinParcelWidth = 1e-3;  // m
+
+/// Merges parcels[i] into the neighbour sharing the longest boundary with it
+/// (of those `eligible` accepts, all without it) when their union is one valid
+/// polygon: the neighbour becomes the union and parcels[i] is erased, the
+/// others keeping their order. Returns the neighbour's index before the
+/// erase, or -1 when no neighbour takes it. With `acceptUnion`, only unions
+/// it accepts are taken (e.g. those that stay valid once moved back from
+/// near the origin).
+long mergeIntoNeighbour(std::vector<Polygon>& parcels, std::size_t i,
+                        const std::function<bool(const Polygon&)>& eligible = {},
+                        const std::function<bool(const Polygon&)>& acceptUnion = {});
 
 /// Merges every sliver (see kMinParcelWidth) into the neighbouring parcel it
 /// shares the longest boundary with, when their union is one valid polygon.

@@ -10,8 +10,8 @@ namespace parcelscope::generation {
 
 const std::vector<const Style*>& styles() {
   // The registry: one line per style.
-  static const std::vector<const Style*> all = {&obbStyle(),    &skeletonStyle(), &offsetStyle(),
-                                                &parishStyle(), &sextonStyle(),   &autoStyle()};
+  static const std::vector<const Style*> all = {&obbStyle(),    &skeletonStyle(), &offsetStyle(), &parishStyle(),
+                                                &sextonStyle(), &templateStyle(), &autoStyle()};
   return all;
 }
 

@@ -477,6 +477,7 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
                            .set("blocks_with_target_count", r.generated.blocksWithTarget)
                            .set("blocks_at_target_count", r.generated.blocksAtTarget)
                            .set("per_block_bounds_clamped", r.generated.clampedBounds)
+                           .set("blocks_by_template", variantCounts(r.generated.blocksByVariant))
                            .set("failures", failures));
   run.set("written", writtenLayersJson({{parcelsFile, parcelsWritten}, {"blocks.gpkg", blocksWritten}}));
   run.set("timing_s", timing);

@@ -299,6 +299,7 @@ GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<Bl
     out.blockIds.push_back(id);
     out.blockKeys.push_back(inputs.entries[k].blockKey);
     out.blockStyles.push_back(s.fallback ? "obb" : plans[k].style);
+    if (!s.variant.empty()) ++out.blocksByVariant[s.variant];
     out.oversize += s.oversize;
     out.withoutAccess += s.withoutAccess;
     out.patioParcels += s.patioParcels;
@@ -317,8 +318,8 @@ GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<Bl
     }
     if (s.fallback) {
       ++out.fallbackBlocks;
-      out.failures.push_back("block " + std::to_string(id) + ": skeleton not usable (" + s.fallbackReason +
-                             "), subdivided with obb");
+      out.failures.push_back("block " + std::to_string(id) + ": " + plans[k].style + " not usable (" +
+                             s.fallbackReason + "), subdivided with obb");
     }
     if (s.failed) {
       ++out.failedBlocks;
@@ -326,6 +327,12 @@ GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<Bl
     }
   }
   return out;
+}
+
+Json variantCounts(const std::map<std::string, std::int64_t>& blocksByVariant) {
+  Json counts = Json::object();
+  for (const auto& [variant, n] : blocksByVariant) counts.set(variant, n);
+  return counts;
 }
 
 GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& progress) {
@@ -446,6 +453,7 @@ JobOutcome writeGenerate(io::OutputDirectory& out, const GenerateRequest& reques
     if (n > 0) styleCounts.set(name, static_cast<std::int64_t>(n));
   }
   run.set("blocks_by_style", styleCounts);
+  if (!g.blocksByVariant.empty()) run.set("blocks_by_template", variantCounts(g.blocksByVariant));
   if (g.streets) run.set("streets", streetRecord(*g.streets));
   run.set("failures", failures);
   run.set("written", writtenLayersJson({{"parcels.gpkg", written}}));

@@ -314,7 +314,7 @@ BENCHMARK(SkeletonSubdivisionPerBlock)->Unit(benchmark::kMillisecond)->UseRealTi
 
 // Each concrete style on every cambridge_ma block (the ROAD features left
 // out), with the block's plan as generate() makes it (derived bounds, seed,
-// street widths, the observed parcels for sexton), one block at a time
+// street widths, the observed parcels for sexton and template), one block at a time
 // (single thread). Counters: median, 90th percentile and mean per block.
 void StylePerBlock(benchmark::State& state, const char* style) {
   if (!haveData(state)) return;
@@ -359,6 +359,7 @@ BENCHMARK_CAPTURE(StylePerBlock, skeleton, "skeleton")->Unit(benchmark::kMillise
 BENCHMARK_CAPTURE(StylePerBlock, offset, "offset")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 BENCHMARK_CAPTURE(StylePerBlock, parish, "parish")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 BENCHMARK_CAPTURE(StylePerBlock, sexton, "sexton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK_CAPTURE(StylePerBlock, template, "template")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 
 }  // namespace
 

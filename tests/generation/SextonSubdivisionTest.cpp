@@ -6,6 +6,7 @@
 #include <random>
 
 #include "RandomShapes.h"
+#include "StyleRun.h"
 #include "TestUtil.h"
 #include "TilingCheck.h"
 #include "parcelscope/generation/Styles.h"
@@ -13,13 +14,9 @@
 namespace parcelscope::generation {
 namespace {
 
-Subdivision sexton(const Polygon& block, ParameterValues values, std::uint64_t seed = 1,
+Subdivision sexton(const Polygon& block, const ParameterValues& values, std::uint64_t seed = 1,
                    const ObservedSample* observed = nullptr) {
-  ParameterValues all = styleValues(sextonStyle(), {});
-  for (const auto& [name, v] : values) all[name] = v;
-  StyleRun run{block, all, seed, {}};
-  run.observed = observed;
-  return sextonStyle().subdivide(run);
+  return test::runStyle(sextonStyle(), block, values, seed, observed);
 }
 
 TEST(Sexton, AnOblongBlockIsCutAlongItsSpineFromEndToEnd) {

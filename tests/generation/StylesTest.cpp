@@ -22,14 +22,14 @@ TEST(Styles, EachStyleIsRegisteredOnceWithItsParametersAndTheListsFollowTheRegis
     for (const auto& d : s->parameters()) parameters.insert(d.name);
     EXPECT_EQ(parameters.count("a-max"), 1u) << s->name() << " lacks a-max";
     EXPECT_EQ(parameters.count("min-frontage"), 1u) << s->name() << " lacks min-frontage";
-    // parish reads only its threshold area (Parish & Muller 2001), sexton no W_max nor omega.
-    if (s->name() == "parish" || s->name() == "sexton") continue;
+    // parish reads only its threshold area (Parish & Muller 2001), sexton no W_max nor omega, template no omega.
+    if (s->name() == "parish" || s->name() == "sexton" || s->name() == "template") continue;
     for (const char* bound : {"a-min", "w-min", "w-max", "omega", "seed"}) {
       EXPECT_EQ(parameters.count(bound), 1u) << s->name() << " lacks " << bound;
     }
     EXPECT_EQ(&style(s->name()), s);
   }
-  EXPECT_EQ(names, (std::set<std::string>{"obb", "skeleton", "offset", "parish", "sexton", "auto"}));
+  EXPECT_EQ(names, (std::set<std::string>{"obb", "skeleton", "offset", "parish", "sexton", "template", "auto"}));
   ASSERT_EQ(generationStyles().size(), styles().size());
   for (std::size_t i = 0; i < styles().size(); ++i) EXPECT_EQ(generationStyles()[i].first, styles()[i]->name());
   try {
@@ -37,7 +37,8 @@ TEST(Styles, EachStyleIsRegisteredOnceWithItsParametersAndTheListsFollowTheRegis
     FAIL() << "an unknown style is a usage error";
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), Error::Kind::Usage);
-    EXPECT_NE(std::string(e.what()).find("obb, skeleton, offset, parish, sexton, auto"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("obb, skeleton, offset, parish, sexton, template, auto"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -64,7 +65,7 @@ TEST(Styles, AutoChoosesPerBlockAndDoesNotSubdivideItself) {
 
 TEST(Styles, ConcreteStylesTileARectangleReproducibly) {
   const Polygon block = test::rect(0, 0, 120, 60);
-  for (const char* name : {"obb", "skeleton", "offset", "parish", "sexton"}) {
+  for (const char* name : {"obb", "skeleton", "offset", "parish", "sexton", "template"}) {
     const Subdivision a = subdivideBlock(block, name, {}, 7), b = subdivideBlock(block, name, {}, 7);
     ASSERT_GT(a.parcels.size(), 1u) << name;
     ASSERT_EQ(a.parcels.size(), b.parcels.size()) << name;

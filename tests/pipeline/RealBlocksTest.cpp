@@ -70,7 +70,7 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
   parallelFor(n, [&](std::size_t k) {
     results[k] = runBlock(inputs, k, plans[k], minFrontage).subdivision;
     reports[k] = test::checkTiling(inputs.entries[k].shape, results[k].parcels);
-    if ((style == "obb" || style == "parish" || style == "sexton") && !results[k].failed) {
+    if ((style == "obb" || style == "parish" || style == "sexton" || style == "template") && !results[k].failed) {
       // The access the subdivision decided on is the measured one.
       measuredWithout[k] = test::measuredWithoutAccess(inputs.entries[k].shape, results[k].parcels, minFrontage);
     }
@@ -89,7 +89,7 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
     } else if (style == "parish") {
       // Exactly the lots without street access are left unassigned.
       EXPECT_EQ(measuredWithout[k], results[k].unassignedParcels) << what;
-    } else if (style == "sexton") {
+    } else if (style == "sexton" || style == "template") {
       EXPECT_EQ(measuredWithout[k], results[k].withoutAccess) << what;
     }
     parcels += static_cast<int>(results[k].parcels.size());
@@ -109,9 +109,21 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
       "%s %s: %zu blocks, %d parcels (%d in patios), %d oversize, %d without street access, "
       "%d fell back to obb, %d failed\n",
       dataset.file, style.c_str(), n, parcels, patios, oversize, withoutAccess, fallbacks, failed);
-  EXPECT_EQ(withoutAccess, 0);
-  // The skeleton route handles at least 95 % of real blocks itself.
-  EXPECT_LE(fallbacks, static_cast<int>(n) / 20);
+  if (style == "template") {
+    // Template parcels all front a street, but regions no template fits are
+    // subdivided by obb inside the block, and a parcel there cut off from the
+    // street is kept when no union with a neighbour is a valid polygon
+    // (docs/algorithms/template.md: at most 0.4 % measured).
+    EXPECT_LE(withoutAccess, parcels / 200);
+  } else {
+    EXPECT_EQ(withoutAccess, 0);
+  }
+  // The skeleton route handles at least 95 % of real blocks itself; template
+  // also leaves to obb the blocks over 1 km2 (malibu_ca's hillside blocks,
+  // with holes and hundreds of corners: no template's, nor a few splits').
+  int huge = 0;
+  for (std::size_t k = 0; k < n; ++k) huge += style == "template" && area(inputs.entries[k].shape) > 1e6;
+  EXPECT_LE(fallbacks, static_cast<int>(n) / 20 + huge);
 
   // No slivers, and the parcels as users read them: written in the input's
   // CRS, read back with GDAL, every one valid with a positive area.
@@ -214,7 +226,8 @@ std::string datasetAndStyle(const ::testing::TestParamInfo<std::tuple<Dataset, c
 
 INSTANTIATE_TEST_SUITE_P(Datasets, RealBlocks,
                          ::testing::Combine(::testing::ValuesIn(kDatasets),
-                                            ::testing::Values("obb", "skeleton", "offset", "parish", "sexton")),
+                                            ::testing::Values("obb", "skeleton", "offset", "parish", "sexton",
+                                                              "template")),
                          datasetAndStyle);
 INSTANTIATE_TEST_SUITE_P(Datasets, RealBlocksReuse,
                          ::testing::Combine(::testing::ValuesIn(kDatasets),

@@ -55,7 +55,7 @@ TEST(WrittenParcels, RandomShapesStayValidThroughAGeographicCrs) {
       values["w-max"] = b.wMax;
       values["omega"] = b.omega;
       const std::uint64_t seed = rng();
-      for (const char* name : {"obb", "skeleton", "offset", "parish", "sexton"}) {
+      for (const char* name : {"obb", "skeleton", "offset", "parish", "sexton", "template"}) {
         SCOPED_TRACE(testing::Message() << "seed " << kSeed << ", latitude " << lat << ", shape " << k << ", style "
                                         << name);
         const Style& s = style(name);

@@ -68,6 +68,9 @@ struct Subdivision {
   int unassignedParcels = 0;
   /// Styles that aim at a number of parcels (sexton): that number; 0 otherwise.
   int targetParcels = 0;
+  /// Styles that choose among variants per block (template: the template
+  /// used, "row", "grid" or "spike"); empty otherwise and on a fallback.
+  std::string variant;
   std::shared_ptr<const ObbSplits> obbSplits;  ///< OBB only, when asked to record them
   /// OBB only: 1 when the block has no holes and a strictly simple ring, 0
   /// when not, -1 when it was not tested (for ObbReuse::blockSimple).

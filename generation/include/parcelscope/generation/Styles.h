@@ -77,7 +77,8 @@ public:
   Subdivision subdivide(const StyleRun& run) const;
 };
 
-/// Every registered style, in the order of --help and the GUI: obb, skeleton, offset, parish, sexton, auto.
+/// Every registered style, in the order of --help and the GUI: obb, skeleton, offset, parish, sexton, template,
+/// auto.
 const std::vector<const Style*>& styles();
 /// The style called `name`; throws Error(Usage) naming the styles otherwise.
 const Style& style(const std::string& name);
@@ -107,6 +108,7 @@ const Style& skeletonStyle();
 const Style& offsetStyle();
 const Style& parishStyle();
 const Style& sextonStyle();
+const Style& templateStyle();
 const Style& autoStyle();
 
 }  // namespace parcelscope::generation

@@ -102,7 +102,9 @@ struct GeneratedParcels {
   /// parcels when empty).
   std::vector<int> assignedOf(const std::vector<int>& parcels) const;
   std::vector<std::string> blockStyles;  ///< style each entry of `blocks` was subdivided with
-  std::vector<std::string> failures;     ///< one line per failed or fallen-back block
+  /// Blocks by the variant their style chose (Subdivision::variant: template's templates).
+  std::map<std::string, std::int64_t> blocksByVariant;
+  std::vector<std::string> failures;  ///< one line per failed or fallen-back block
   std::uint64_t seed = 0;
   Timings timings;  ///< "subdivide" and "measure"
 };
@@ -199,6 +201,9 @@ void measureOutcomeContext(const BlockInputs& inputs, std::size_t entry, BlockOu
 /// The run's result from one outcome per entry (in entry order).
 GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<BlockPlan>& plans,
                                  const std::vector<const BlockOutcome*>& outcomes, std::uint64_t seed);
+
+/// {variant: blocks} of GeneratedParcels::blocksByVariant (run.json's blocks_by_template).
+Json variantCounts(const std::map<std::string, std::int64_t>& blocksByVariant);
 
 /// Reads the input and subdivides every block (in parallel) with the request's
 /// style: prepareBlocks, planBlocks, runBlock on every entry, assembleParcels. Throws Error on bad input or parameters
