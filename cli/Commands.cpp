@@ -30,7 +30,7 @@ const char* kOverview =
     "            per-block statistics and generator parameters\n"
     "  blocks    build the road graph of street centre lines and its blocks\n"
     "  generate  subdivide blocks into procedural parcels (obb, skeleton, offset, parish,\n"
-    "            sexton or auto style)\n"
+    "            sexton, template or auto style)\n"
     "  compare   generate parcels in the blocks of observed ones and compare the two sets:\n"
     "            per-block and city-wide tables, distances, layers and figures\n"
     "  calibrate give each block the style closest to its observed parcels (a session file)\n"
