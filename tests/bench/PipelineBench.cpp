@@ -271,6 +271,22 @@ void CompareTiled500k(benchmark::State& state) {
 }
 BENCHMARK(CompareTiled500k)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
+// Counters of a per-block timing: blocks, parcels, and the median, 90th
+// percentile and mean milliseconds per block.
+void perBlockCounters(benchmark::State& state, const std::vector<double>& ms, std::size_t parcels) {
+  std::vector<double> sorted = ms;
+  std::sort(sorted.begin(), sorted.end());
+  double sum = 0;
+  for (double x : ms) sum += x;
+  state.counters["blocks"] = static_cast<double>(ms.size());
+  state.counters["parcels"] = static_cast<double>(parcels);
+  if (!sorted.empty()) {
+    state.counters["median_ms"] = sorted[sorted.size() / 2];
+    state.counters["p90_ms"] = sorted[sorted.size() * 9 / 10];
+    state.counters["mean_ms"] = sum / static_cast<double>(sorted.size());
+  }
+}
+
 // Straight-skeleton subdivision of every cambridge_ma block with its own
 // derived bounds, one block at a time (single thread). Target: median at most
 // 3 ms per block (Vanegas et al. 2012 report 1-10 ms). Counters give the
@@ -297,18 +313,8 @@ void SkeletonSubdivisionPerBlock(benchmark::State& state) {
       fallbacks += sub.fallback;
     }
   }
-  std::vector<double> sorted = ms;
-  std::sort(sorted.begin(), sorted.end());
-  double sum = 0;
-  for (double x : ms) sum += x;
-  state.counters["blocks"] = static_cast<double>(ms.size());
-  state.counters["parcels"] = static_cast<double>(parcels);
+  perBlockCounters(state, ms, parcels);
   state.counters["fallbacks"] = static_cast<double>(fallbacks);
-  if (!sorted.empty()) {
-    state.counters["median_ms"] = sorted[sorted.size() / 2];
-    state.counters["p90_ms"] = sorted[sorted.size() * 9 / 10];
-    state.counters["mean_ms"] = sum / static_cast<double>(sorted.size());
-  }
 }
 BENCHMARK(SkeletonSubdivisionPerBlock)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
@@ -342,17 +348,7 @@ void StylePerBlock(benchmark::State& state, const char* style) {
       ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }
   }
-  std::vector<double> sorted = ms;
-  std::sort(sorted.begin(), sorted.end());
-  double sum = 0;
-  for (double x : ms) sum += x;
-  state.counters["blocks"] = static_cast<double>(ms.size());
-  state.counters["parcels"] = static_cast<double>(parcels);
-  if (!sorted.empty()) {
-    state.counters["median_ms"] = sorted[sorted.size() / 2];
-    state.counters["p90_ms"] = sorted[sorted.size() * 9 / 10];
-    state.counters["mean_ms"] = sum / static_cast<double>(sorted.size());
-  }
+  perBlockCounters(state, ms, parcels);
 }
 BENCHMARK_CAPTURE(StylePerBlock, obb, "obb")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 BENCHMARK_CAPTURE(StylePerBlock, skeleton, "skeleton")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
