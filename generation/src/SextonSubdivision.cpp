@@ -78,6 +78,10 @@ constexpr double kSquareEnough = 0.25;             // aspect (width / length) li
 constexpr double kMinPieceShare = 0.3;             // of the parcel split, each piece's least area
 constexpr double kPositionSd = 0.15;  // of the side's length: spread of the split position about its middle
 constexpr int kAttempts = 10;         // random splits tried on one parcel
+// When no random split is admissible: the largest parcels scanned, and the
+// positions along each road side tried, middle first.
+constexpr std::size_t kScanParcels = 8;
+constexpr double kScanAt[] = {0.5, 0.4, 0.6, 0.3, 0.7, 0.2, 0.8, 0.1, 0.9};
 // Blocks whose ring has more vertices get no spine (the skeleton's cost grows
 // with them; the paper builds spines from a coarse raster).
 constexpr std::size_t kMaxSpineVertices = 2000;
@@ -287,7 +291,21 @@ public:
         }
         done = true;
       }
-      if (!done) break;  // no parcel takes an admissible split
+      if (!done) {
+        // No random line made it: the positions along the road sides of the
+        // largest parcels, in turn, with the constraints relaxed as far as they go.
+        auto [pick, pieces] = scanSplit(parcels, areas, road, target + 1 - parcels.size());
+        if (pieces.empty()) break;  // no parcel takes an admissible split
+        relaxed = kRelaxLevels - 1;
+        parcels[pick] = std::move(pieces[0]);
+        areas[pick] = area(parcels[pick]);
+        road[pick] = roadSides(parcels[pick]);
+        for (std::size_t k = 1; k < pieces.size(); ++k) {
+          areas.push_back(area(pieces[k]));
+          road.push_back(roadSides(pieces[k]));
+          parcels.push_back(std::move(pieces[k]));
+        }
+      }
       if (parcels.size() > kMaxLots) throw detail::WorkBudgetExceeded("work budget: more than 200000 parcels");
     }
     return parcels;
@@ -303,6 +321,36 @@ private:
     if (road.empty()) return {};
     const Side& s = road[static_cast<std::size_t>(rng.uniform() * static_cast<double>(road.size()))];
     const double f = std::clamp(0.5 + kPositionSd * rng.normal(), 0.05, 0.95);
+    return splitAt(parcel, parcelArea, s, f, maxPieces, relax);
+  }
+
+  // The first admissible split, at the most relaxed level, of the
+  // kScanParcels largest parcels (largest first) at the positions kScanAt
+  // along each of their road sides: the parcel's index and its pieces.
+  std::pair<std::size_t, std::vector<Polygon>> scanSplit(const std::vector<Polygon>& parcels,
+                                                         const std::vector<double>& areas,
+                                                         const std::vector<std::vector<Side>>& road,
+                                                         std::size_t maxPieces) {
+    std::vector<std::size_t> order(parcels.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    const std::size_t n = std::min(order.size(), kScanParcels);
+    std::partial_sort(order.begin(), order.begin() + static_cast<long>(n), order.end(),
+                      [&](std::size_t a, std::size_t b) { return areas[a] > areas[b]; });
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t i = order[k];
+      for (const Side& s : road[i]) {
+        for (double f : kScanAt) {
+          std::vector<Polygon> pieces = splitAt(parcels[i], areas[i], s, f, maxPieces, Relax::Rectangularity);
+          if (!pieces.empty()) return {i, std::move(pieces)};
+        }
+      }
+    }
+    return {0, {}};
+  }
+
+  // The split of `parcel` at right angles to road side `s`, at fraction `f` along it.
+  std::vector<Polygon> splitAt(const Polygon& parcel, double parcelArea, const Side& s, double f, std::size_t maxPieces,
+                               Relax relax) {
     const SplitLine line{{s.a.x + f * (s.b.x - s.a.x), s.a.y + f * (s.b.y - s.a.y)}, {-s.dir.y, s.dir.x}};
     work_ += parcel.outer.size();
     if (work_ > kMaxSplitWork)

@@ -103,7 +103,7 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
   }
   if (withTarget > 0) {
     std::printf("%s %s: %d of %d blocks at their target count\n", dataset.file, style.c_str(), atTarget, withTarget);
-    EXPECT_GE(atTarget, withTarget * 90 / 100) << dataset.file << " " << style;
+    EXPECT_EQ(atTarget, withTarget) << dataset.file << " " << style;
   }
   std::printf(
       "%s %s: %zu blocks, %d parcels (%d in patios), %d oversize, %d without street access, "
