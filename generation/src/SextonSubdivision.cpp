@@ -264,6 +264,17 @@ public:
       road.push_back(roadSides(q));
     }
     int relaxed = 0;  // once a level is needed, the rest of this subdivision keeps it
+    // Parcel `pick` replaced by the pieces of its split.
+    auto apply = [&](std::size_t pick, std::vector<Polygon>& pieces) {
+      parcels[pick] = std::move(pieces[0]);
+      areas[pick] = area(parcels[pick]);
+      road[pick] = roadSides(parcels[pick]);
+      for (std::size_t k = 1; k < pieces.size(); ++k) {
+        areas.push_back(area(pieces[k]));
+        road.push_back(roadSides(pieces[k]));
+        parcels.push_back(std::move(pieces[k]));
+      }
+    };
     while (parcels.size() < target) {
       // The largest parcel first; when it takes no split, random ones; when
       // none does, again with the constraints relaxed one by one (see Relax).
@@ -281,14 +292,7 @@ public:
         }
         if (pieces.empty()) continue;
         relaxed = level;
-        parcels[pick] = std::move(pieces[0]);
-        areas[pick] = area(parcels[pick]);
-        road[pick] = roadSides(parcels[pick]);
-        for (std::size_t k = 1; k < pieces.size(); ++k) {
-          areas.push_back(area(pieces[k]));
-          road.push_back(roadSides(pieces[k]));
-          parcels.push_back(std::move(pieces[k]));
-        }
+        apply(pick, pieces);
         done = true;
       }
       if (!done) {
@@ -297,14 +301,7 @@ public:
         auto [pick, pieces] = scanSplit(parcels, areas, road, target + 1 - parcels.size());
         if (pieces.empty()) break;  // no parcel takes an admissible split
         relaxed = kRelaxLevels - 1;
-        parcels[pick] = std::move(pieces[0]);
-        areas[pick] = area(parcels[pick]);
-        road[pick] = roadSides(parcels[pick]);
-        for (std::size_t k = 1; k < pieces.size(); ++k) {
-          areas.push_back(area(pieces[k]));
-          road.push_back(roadSides(pieces[k]));
-          parcels.push_back(std::move(pieces[k]));
-        }
+        apply(pick, pieces);
       }
       if (parcels.size() > kMaxLots) throw detail::WorkBudgetExceeded("work budget: more than 200000 parcels");
     }
