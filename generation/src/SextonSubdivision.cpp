@@ -298,6 +298,9 @@ public:
       if (!done) {
         // No random line made it: the positions along the road sides of the
         // largest parcels, in turn, with the constraints relaxed as far as they go.
+        // A block's scans are bounded (scansLeft_): a try without any left stops short.
+        if (scansLeft_ == 0) break;
+        --scansLeft_;
         auto [pick, pieces] = scanSplit(parcels, areas, road, target + 1 - parcels.size());
         if (pieces.empty()) break;  // no parcel takes an admissible split
         relaxed = kRelaxLevels - 1;
@@ -309,6 +312,9 @@ public:
   }
 
   bool hasAccess(const Polygon& p) const { return outlineEdges_->sharesAtLeast(p, p_.minFrontage); }
+
+  /// Scans (scanSplit) the block's tries may make in all.
+  void setScanBudget(std::size_t scans) { scansLeft_ = scans; }
 
 private:
   // A random split of `parcel` across one of its road-facing sides, or
@@ -415,6 +421,7 @@ private:
   double frontage_ = 1;
   std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;
   BoxTree<std::size_t> outlineTree_;  // the outer contour's edges, by index
+  std::size_t scansLeft_ = 0;
   std::uint64_t work_ = 0;
 };
 
@@ -462,11 +469,14 @@ Subdivision subdivideSexton(const StyleRun& r) {
         // More spine pieces than parcels wanted: the spine is dropped (3.4.1).
         if (start.empty() || start.size() > wanted) start = {local};
         SextonSubdivider subdivider(local, p);
-        double best = std::numeric_limits<double>::infinity();
+        subdivider.setScanBudget(wanted);  // as many scans as parcels wanted, over all tries
+        // The try closest to the observed parcels among those that reached the
+        // target count (when none did, among all).
+        std::pair<bool, double> best{true, std::numeric_limits<double>::infinity()};
         for (int t = 0; t < std::max(1, p.tries); ++t) {
           std::vector<Polygon> parcels = subdivider.subdivide(
               start, wanted, detail::Rng{detail::splitmix64(r.seed ^ (0x5E7701ULL + static_cast<std::uint64_t>(t)))});
-          const double d = distanceTo(parcels, r.observed, wanted);
+          const std::pair<bool, double> d{parcels.size() != wanted, distanceTo(parcels, r.observed, wanted)};
           if (d < best) {
             best = d;
             out.parcels = std::move(parcels);
