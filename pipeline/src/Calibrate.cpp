@@ -351,9 +351,7 @@ std::string fitText(const FitMeasures& f) {
 
 JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress,
                         const CalibrationRenderer& draw) {
-  std::vector<std::string> inputs = {request.input.path};
-  if (request.streets) inputs.push_back(request.streets->path);
-  io::OutputDirectory out(outDir, inputs);
+  io::OutputDirectory out(outDir, inputPaths(request));
   try {
     const Calibration c = calibrate(request, scaledProgress(progress, 0.0, 0.95));
     reportProgress(progress, 0.95, "writing");

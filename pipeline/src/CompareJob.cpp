@@ -506,13 +506,19 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
 
 }  // namespace
 
+std::vector<std::string> inputPaths(const CompareRequest& request) {
+  std::vector<std::string> paths = {request.input.path};
+  if (request.streets) paths.push_back(request.streets->path);
+  return paths;
+}
+
 JobOutcome runCompare(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress,
                       const FigureRenderer* renderer) {
   const auto started = std::chrono::steady_clock::now();
   const bool figures = value(request, "figures") != 0;
   if (figures && !renderer) throw usageError("compare: this program draws no figures (use --figures 0)");
   if (figures && renderer->check) renderer->check();  // before the long work, not after it
-  io::OutputDirectory out(outDir, {request.input.path});
+  io::OutputDirectory out(outDir, inputPaths(request));
   try {
     return writeCompare(out, request, progress, renderer, started);
   } catch (const Error& e) {

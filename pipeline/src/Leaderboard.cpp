@@ -170,9 +170,7 @@ JobOutcome writeLeaderboard(io::OutputDirectory& out, const Leaderboard& board, 
 
 JobOutcome runLeaderboard(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress,
                           const LeaderboardRenderer& draw) {
-  std::vector<std::string> inputs = {request.input.path};
-  if (request.streets) inputs.push_back(request.streets->path);
-  io::OutputDirectory out(outDir, inputs);
+  io::OutputDirectory out(outDir, inputPaths(request));
   try {
     const auto started = std::chrono::steady_clock::now();
     const Leaderboard board = leaderboard(request, scaledProgress(progress, 0.0, 0.9));
@@ -185,9 +183,7 @@ JobOutcome runLeaderboard(const CompareRequest& request, const std::string& outD
 
 JobOutcome saveLeaderboard(const Leaderboard& board, const CompareRequest& request, const std::string& outDir,
                            const LeaderboardRenderer& draw) {
-  std::vector<std::string> inputs = {request.input.path};
-  if (request.streets) inputs.push_back(request.streets->path);
-  io::OutputDirectory out(outDir, inputs);
+  io::OutputDirectory out(outDir, inputPaths(request));
   double seconds = 0;
   for (const LeaderboardEntry& e : board.entries) seconds += e.seconds;
   try {

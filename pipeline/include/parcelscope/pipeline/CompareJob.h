@@ -47,6 +47,10 @@ struct CompareRequest {
   std::string parcelsFormat = "gpkg";
 };
 
+/// The files `request` reads (its input, and its streets when given): an
+/// output folder must never hold or lie in one of them (io::OutputDirectory).
+std::vector<std::string> inputPaths(const CompareRequest& request);
+
 /// The value of compare parameter `name` in `request`, or its default.
 double compareValue(const CompareRequest& request, const std::string& name);
 
