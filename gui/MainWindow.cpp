@@ -822,10 +822,11 @@ void MainWindow::fitToObserved() {
     QStringList chosen;
     for (const auto& [style, blocks] : made->stylesChosen)
       chosen << QString("%1 %2").arg(QString::fromStdString(style)).arg(blocks);
-    fitSummary_ = QString(
-                      "Fitted each block's style to its observed parcels (%1). Before: %2. After: %3. "
-                      "Cross-validated: %4. Each block's style is now its override.")
-                      .arg(chosen.join(", "), text(made->before), text(made->after), text(made->crossFitted));
+    fitSummary_ =
+        QString(
+            "Fitted each block's style to its observed parcels (%1). Before (the paper's rule): %2. After: %3. "
+            "Cross-validated: %4. Each block's style is now its override.")
+            .arg(chosen.join(", "), text(made->before), text(made->after), text(made->crossFitted));
     showNotice(fitSummary_);
     submit();
   });

@@ -1,17 +1,19 @@
 #include "parcelscope/generation/Styles.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "PostProcess.h"
 #include "parcelscope/analysis/ObservedAnalysis.h"
 #include "parcelscope/core/Error.h"
+#include "parcelscope/generation/AutoRule.h"
 
 namespace parcelscope::generation {
 
 const std::vector<const Style*>& styles() {
   // The registry: one line per style.
   static const std::vector<const Style*> all = {&obbStyle(),    &skeletonStyle(), &offsetStyle(), &parishStyle(),
-                                                &sextonStyle(), &templateStyle(), &autoStyle()};
+                                                &sextonStyle(), &templateStyle(), &accessStyle(), &autoStyle()};
   return all;
 }
 
@@ -59,43 +61,79 @@ Subdivision Style::subdivide(const StyleRun& r) const {
   return out;
 }
 
+bool choosesPerBlock(const Style& s) { return &s.resolve({}) != &s; }
+
 Subdivision subdivideBlock(const Polygon& block, const std::string& name, const ParameterValues& values,
                            std::uint64_t seed, const StreetWidths& streetWidths) {
   const Style& s = style(name);
-  if (&s.resolve({std::nan("")}) != &s) throw usageError("style " + name + " chooses per block; name a concrete one");
+  if (choosesPerBlock(s)) throw usageError("style " + name + " chooses per block; name a concrete one");
   return s.subdivide({block, values, seed, streetWidths});
 }
 
 namespace {
 
-// auto: per block, skeleton where at least 90 % of its observed parcels have
-// street access (the paper's first variety: every parcel on a street, rears
-// abutting), obb otherwise; blocks without observed parcels use skeleton.
-class AutoStyle : public Style {
+// A style that picks a concrete style per block and reads every parameter of
+// the styles it may pick.
+class ChoosingStyle : public Style {
 public:
-  std::string name() const override { return "auto"; }
-  std::string description() const override {
-    return "per block: skeleton where >= 90 % of observed parcels have street access, else obb";
+  explicit ChoosingStyle(std::vector<const Style*> choices) : choices_(std::move(choices)) {
+    for (const Style* s : choices_) appendParameters(parameters_, s->parameters());
   }
-  const std::vector<ParameterDescription>& parameters() const override {
-    static const std::vector<ParameterDescription> p = [] {
-      std::vector<ParameterDescription> all = obbStyle().parameters();
-      appendParameters(all, skeletonStyle().parameters());
-      return all;
-    }();
-    return p;
-  }
-  bool usesStreetWidths() const override { return true; }
-  const Style& resolve(const BlockFacts& facts) const override {
-    return std::isfinite(facts.accessShare) && facts.accessShare < kAutoSkeletonAccessShare ? obbStyle()
-                                                                                            : skeletonStyle();
+  const std::vector<ParameterDescription>& parameters() const override { return parameters_; }
+  bool usesStreetWidths() const override {
+    return std::any_of(choices_.begin(), choices_.end(), [](const Style* s) { return s->usesStreetWidths(); });
   }
   Subdivision run(const StyleRun&) const override {
-    throw usageError("style auto chooses a style per block; it does not subdivide by itself");
+    throw usageError("style " + name() + " chooses a style per block; it does not subdivide by itself");
+  }
+
+private:
+  std::vector<const Style*> choices_;
+  std::vector<ParameterDescription> parameters_;
+};
+
+// access: Vanegas et al.'s rule. Per block, skeleton where at least 90 % of
+// its observed parcels have street access (the paper's first variety: every
+// parcel on a street, rears abutting), obb otherwise; blocks without observed
+// parcels use skeleton.
+class AccessStyle : public ChoosingStyle {
+public:
+  AccessStyle() : ChoosingStyle({&obbStyle(), &skeletonStyle()}) {}
+  std::string name() const override { return "access"; }
+  std::string description() const override {
+    return "per block: skeleton where >= 90 % of observed parcels have street access, else obb (the paper's rule)";
+  }
+  const Style& resolve(const BlockFacts& facts) const override {
+    return std::isfinite(facts.accessShare) && facts.accessShare < kAccessSkeletonShare ? obbStyle() : skeletonStyle();
+  }
+};
+
+// auto: the style the calibrated blocks most like this one got
+// (AutoRule::bundled(), docs/algorithms/auto.md); without observed parcels,
+// the paper's rule.
+class AutoStyle : public ChoosingStyle {
+public:
+  AutoStyle()
+      : ChoosingStyle(
+            {&obbStyle(), &skeletonStyle(), &offsetStyle(), &parishStyle(), &sextonStyle(), &templateStyle()}) {}
+  std::string name() const override { return "auto"; }
+  std::string description() const override {
+    return "per block: the style of the most similar calibrated blocks of the shared datasets (3 nearest, in block "
+           "and observed parcel features)";
+  }
+  const Style& resolve(const BlockFacts& facts) const override {
+    if (!facts.shape || !facts.observed || facts.observed->areas.empty()) return accessStyle().resolve(facts);
+    return style(AutoRule::bundled().predict(
+        autoFeatures(*facts.shape, *facts.observed, facts.accessShare, facts.observedShare)));
   }
 };
 
 }  // namespace
+
+const Style& accessStyle() {
+  static const AccessStyle s;
+  return s;
+}
 
 const Style& autoStyle() {
   static const AutoStyle s;

@@ -7,6 +7,18 @@
 
 namespace parcelscope::pipeline {
 
+std::shared_ptr<generation::ObservedSample> observedSample(const analysis::ObservedAnalysis& analysis,
+                                                           std::size_t block) {
+  auto sample = std::make_shared<generation::ObservedSample>();
+  for (int i : analysis.blocks[block].parcels) {
+    const analysis::ParcelMetrics& m = analysis.metrics[static_cast<std::size_t>(i)];
+    sample->areas.push_back(m.area);
+    sample->widths.push_back(m.width);
+    sample->aspectRatios.push_back(m.aspectRatio);
+  }
+  return sample;
+}
+
 namespace {
 
 class ObservedParcelBlocks : public BlockSource {
@@ -24,12 +36,7 @@ public:
     for (std::size_t b = 0; b < observed.analysis.blocks.size(); ++b) {
       const auto& s = observed.analysis.statistics[b];
       const Block& block = observed.analysis.blocks[b];
-      auto sample = std::make_shared<generation::ObservedSample>();
-      for (int i : block.parcels) {
-        sample->areas.push_back(observed.analysis.metrics[static_cast<std::size_t>(i)].area);
-        sample->widths.push_back(observed.analysis.metrics[static_cast<std::size_t>(i)].width);
-        sample->aspectRatios.push_back(observed.analysis.metrics[static_cast<std::size_t>(i)].aspectRatio);
-      }
+      std::shared_ptr<const generation::ObservedSample> sample = observedSample(observed.analysis, b);
       double blockArea = 0;
       for (const Polygon& part : block.parts) blockArea += area(part);
       for (std::size_t part = 0; part < block.parts.size(); ++part) {

@@ -11,6 +11,7 @@
 #include "parcelscope/core/Keys.h"
 #include "parcelscope/io/OutputDirectory.h"
 #include "parcelscope/io/Writers.h"
+#include "parcelscope/pipeline/BlockSource.h"
 #include "parcelscope/pipeline/CompareSession.h"
 #include "parcelscope/pipeline/StreetsJob.h"
 
@@ -83,71 +84,43 @@ FitMeasures measure(const Leaderboard& board, const std::vector<std::vector<std:
   return f;
 }
 
-// What the fitted rule knows of a block before any style runs: its size and
-// shape, and its observed parcels' street access, mean area and count.
-constexpr std::size_t kFeatures = 6;
-std::array<double, kFeatures> featuresOf(const ObservedData& d, std::size_t b) {
+// What the auto rule knows of observed block b: its largest part's shape and
+// its observed parcels.
+generation::AutoFeatures featuresOf(const ObservedData& d, std::size_t b) {
   const Block& block = d.analysis.blocks[b];
-  const analysis::BlockStatistics& s = d.analysis.statistics[b];
   const Polygon* largest = &block.parts.front();
   double total = 0;
   for (const Polygon& p : block.parts) {
     total += area(p);
     if (area(p) > area(*largest)) largest = &p;
   }
-  const OrientedBox box = minimumAreaBox(largest->outer);
-  const double hull = std::fabs(signedArea(convexHull(largest->outer)));
-  return {std::log10(std::max(total, 1.0)),       box.length > 0 ? box.width / box.length : 1.0,
-          hull > 0 ? area(*largest) / hull : 1.0, s.streetAccessShare,
-          std::log10(std::max(s.meanArea, 1.0)),  std::log10(std::max(1, s.parcelCount))};
+  return generation::autoFeatures(*largest, *observedSample(d.analysis, b), d.analysis.statistics[b].streetAccessShare,
+                                  total > 0 ? area(*largest) / total : 1.0);
 }
 
 // Passes of the city-wide refinement (each visits every block once).
 constexpr int kRefinePasses = 2;
 
-// The style (entry index) of the `k` nearest training blocks in standardised
-// features, by majority (ties: the nearest's).
-constexpr std::size_t kNeighbours = 5;
-std::size_t predict(const std::array<double, kFeatures>& x, const std::vector<std::array<double, kFeatures>>& train,
-                    const std::vector<std::size_t>& labels, const std::array<double, kFeatures>& scale) {
-  std::vector<std::pair<double, std::size_t>> near;
-  for (std::size_t i = 0; i < train.size(); ++i) {
-    double d = 0;
-    for (std::size_t f = 0; f < kFeatures; ++f) d += std::pow((x[f] - train[i][f]) / scale[f], 2);
-    near.emplace_back(d, i);
-  }
-  const std::size_t k = std::min(kNeighbours, near.size());
-  std::partial_sort(near.begin(), near.begin() + static_cast<long>(k), near.end());
-  std::map<std::size_t, int> votes;
-  for (std::size_t i = 0; i < k; ++i) ++votes[labels[near[i].second]];
-  std::size_t best = labels[near.front().second];
-  for (const auto& [label, n] : votes) {
-    if (n > votes[best]) best = label;
-  }
-  return best;
-}
-
-}  // namespace
-
-namespace {
-
 // The calibration of the blocks `blocks` (entries of `choice` elsewhere are
 // left): from the better, over those blocks, of `choice` (the per-block
 // optimum) and the paper's rule, then passes over the blocks changing a
-// block's style wherever that lowers cityObjective() over those blocks. The
-// per-block optimum need not add up to a city-wide one: a block's KS is
-// measured on a few parcels.
+// block's style wherever that lowers calibrationObjective() over those blocks,
+// against the paper's rule's measures there. The per-block optimum need not
+// add up to a city-wide one: a block's KS is measured on a few parcels.
 std::vector<std::size_t> refineChoice(const Leaderboard& board,
                                       const std::vector<std::vector<std::vector<int>>>& parcels,
                                       const std::vector<std::size_t>& blocks,
                                       const std::vector<std::size_t>& candidates,
                                       const std::vector<std::size_t>& paperChoice, std::vector<std::size_t> choice,
                                       const ProgressFn& progress) {
-  if (cityObjective(measure(board, parcels, blocks, paperChoice)) <
-      cityObjective(measure(board, parcels, blocks, choice))) {
+  const FitMeasures paper = measure(board, parcels, blocks, paperChoice);
+  auto objective = [&](const std::vector<std::size_t>& c) {
+    return calibrationObjective(measure(board, parcels, blocks, c), paper);
+  };
+  if (objective(paperChoice) < objective(choice)) {
     for (std::size_t b : blocks) choice[b] = paperChoice[b];
   }
-  double current = cityObjective(measure(board, parcels, blocks, choice));
+  double current = objective(choice);
   for (int pass = 0; pass < kRefinePasses; ++pass) {
     bool changed = false;
     for (std::size_t b : blocks) {
@@ -157,7 +130,7 @@ std::vector<std::size_t> refineChoice(const Leaderboard& board,
       for (std::size_t e : candidates) {
         if (e == kept) continue;
         choice[b] = e;
-        const double o = cityObjective(measure(board, parcels, blocks, choice));
+        const double o = objective(choice);
         if (o < current - 1e-12) {
           current = o;
           chosen = e;
@@ -188,9 +161,31 @@ double cityObjective(const FitMeasures& f) {
   return f.ksArea + f.ksWidth + f.ksAspectRatio + (std::isfinite(f.medianCountError) ? f.medianCountError : 0);
 }
 
+double calibrationObjective(const FitMeasures& f, const FitMeasures& paper) {
+  auto excess = [](double m, double bound) {
+    return std::isfinite(m) && std::isfinite(bound) ? std::max(0.0, m - bound) : 0.0;
+  };
+  return cityObjective(f) + kExcessWeight * (excess(f.ksArea, paper.ksArea) + excess(f.ksWidth, paper.ksWidth) +
+                                             excess(f.ksAspectRatio, paper.ksAspectRatio) +
+                                             excess(f.medianCountError, paper.medianCountError));
+}
+
 FitMeasures fitMeasures(const Leaderboard& board, const std::vector<std::size_t>& blocks,
                         const std::vector<std::size_t>& entryOf) {
   return measure(board, parcelsByBlock(board), blocks, entryOf);
+}
+
+std::size_t entryOfStyle(const Calibration& c, const std::string& style) {
+  for (std::size_t e = 0; e < c.board.entries.size(); ++e) {
+    if (c.board.entries[e].style == style) return e;
+  }
+  throw std::logic_error("calibrate: no leaderboard entry of style " + style);
+}
+
+std::vector<std::size_t> entriesOf(const Calibration& c, const generation::AutoRule& rule) {
+  std::vector<std::size_t> out;
+  for (const BlockCalibration& b : c.blocks) out.push_back(entryOfStyle(c, rule.predict(b.features)));
+  return out;
 }
 
 Calibration calibrate(const CompareRequest& request, const ProgressFn& progress) {
@@ -202,11 +197,8 @@ Calibration calibrate(const CompareRequest& request, const ProgressFn& progress)
   std::size_t paper = board.entries.size();
   std::vector<std::size_t> candidates;
   for (std::size_t e = 0; e < board.entries.size(); ++e) {
-    if (board.entries[e].style == generation::autoStyle().name()) {
-      paper = e;
-    } else {
-      candidates.push_back(e);
-    }
+    if (board.entries[e].style == generation::accessStyle().name()) paper = e;
+    if (!generation::choosesPerBlock(generation::style(board.entries[e].style))) candidates.push_back(e);
   }
   if (paper == board.entries.size() || candidates.empty()) throw std::logic_error("calibrate: the styles are missing");
 
@@ -266,12 +258,9 @@ Calibration calibrate(const CompareRequest& request, const ProgressFn& progress)
   c.entryAfter = best;
 
   // Cross-validation: each half's styles predicted from the other half's calibrated styles.
-  std::vector<std::array<double, kFeatures>> features(n);
-  for (std::size_t b = 0; b < n; ++b) features[b] = featuresOf(*board.observed, b);
+  for (std::size_t b = 0; b < n; ++b) c.blocks[b].features = featuresOf(*board.observed, b);
   std::vector<std::size_t> predicted(n, candidates.front());
   for (int half = 0; half < 2; ++half) {
-    std::vector<std::array<double, kFeatures>> train;
-    std::vector<std::size_t> labels;
     // The other half's styles calibrated on that half alone: nothing of this
     // half's parcels goes into its labels.
     std::vector<std::size_t> trainBlocks;
@@ -280,27 +269,32 @@ Calibration calibrate(const CompareRequest& request, const ProgressFn& progress)
     }
     if (trainBlocks.empty()) continue;
     const std::vector<std::size_t> trained = refine(trainBlocks, perBlock);
+    std::vector<generation::AutoRule::Row> rows;
     for (std::size_t b : trainBlocks) {
-      train.push_back(features[b]);
-      labels.push_back(trained[b]);
       c.blocks[b].styleHalf = board.entries[trained[b]].style;
+      rows.push_back({c.blocks[b].features, c.blocks[b].styleHalf});
     }
-    std::array<double, kFeatures> mean{}, scale{};
-    for (const auto& x : train) {
-      for (std::size_t f = 0; f < kFeatures; ++f) mean[f] += x[f] / static_cast<double>(train.size());
-    }
-    for (const auto& x : train) {
-      for (std::size_t f = 0; f < kFeatures; ++f)
-        scale[f] += std::pow(x[f] - mean[f], 2) / static_cast<double>(train.size());
-    }
-    for (double& s : scale) s = s > 0 ? std::sqrt(s) : 1.0;
+    const generation::AutoRule rule(std::move(rows));
     for (std::size_t b = 0; b < n; ++b) {
-      if (c.blocks[b].half == half) predicted[b] = predict(features[b], train, labels, scale);
+      if (c.blocks[b].half == half) predicted[b] = entryOfStyle(c, rule.predict(c.blocks[b].features));
     }
   }
   for (std::size_t b = 0; b < n; ++b) c.blocks[b].stylePredicted = board.entries[predicted[b]].style;
   c.crossFitted = measure(board, parcels, all, predicted);
   c.crossPaper = c.before;
+  std::size_t autoEntry = paper;
+  for (std::size_t e = 0; e < board.entries.size(); ++e) {
+    if (board.entries[e].style == generation::autoStyle().name()) autoEntry = e;
+  }
+  c.autoRule = measure(board, parcels, all, std::vector<std::size_t>(n, autoEntry));
+  {
+    const GeneratedParcels& g = board.entries[autoEntry].result.generated;
+    std::map<Key, std::string> chosen;
+    for (std::size_t k = 0; k < g.blocks.size(); ++k) chosen.emplace(g.blockKeys[k], g.blockStyles[k]);
+    for (BlockCalibration& bc : c.blocks) {
+      if (const auto it = chosen.find(bc.blockKey); it != chosen.end()) bc.styleAuto = it->second;
+    }
+  }
 
   c.session = request;
   if (c.session.style == "all") c.session.style = generation::autoStyle().name();
@@ -320,10 +314,12 @@ Table calibrationTable(const Calibration& c) {
   t.columns = {{"block_id", T::Integer, ""},   {"block_key", T::String, ""},    {"observed_parcels", T::Integer, ""},
                {"half", T::Integer, ""},       {"style_before", T::String, ""}, {"distance_before", T::Real, ""},
                {"style_after", T::String, ""}, {"distance_after", T::Real, ""}, {"style_predicted", T::String, ""},
-               {"style_half", T::String, ""}};
+               {"style_half", T::String, ""},  {"style_auto", T::String, ""}};
+  for (const char* name : generation::autoFeatureNames()) t.columns.push_back({name, T::Real, ""});
   for (const BlockCalibration& b : c.blocks) {
     t.rows.push_back({b.blockId, keyText(b.blockKey), b.observedParcels, std::int64_t(b.half), b.styleBefore,
-                      b.distanceBefore, b.styleAfter, b.distanceAfter, b.stylePredicted, b.styleHalf});
+                      b.distanceBefore, b.styleAfter, b.distanceAfter, b.stylePredicted, b.styleHalf, b.styleAuto});
+    for (double f : b.features) t.rows.back().push_back(f);
   }
   return t;
 }
@@ -372,17 +368,16 @@ JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir
     run.set("calibration",
             Json::object()
                 .set("distance", "per block: KS area + KS width + KS aspect ratio + |n_generated / n_observed - 1|")
-                .set("before", fitJson(c.before).set("rule", "style auto with the run's k (the paper's rule)"))
+                .set("before", fitJson(c.before).set("rule", "style access with the run's k (the paper's rule)"))
+                .set("auto", fitJson(c.autoRule).set("rule", "style auto (the bundled rule) with the run's k"))
                 .set("after", fitJson(c.after).set("rule", "each block's style of least distance"))
                 .set("styles_chosen", chosen)
                 .set("cross_validation",
                      Json::object()
                          .set("halves", "blocks split by block key parity")
                          .set("fitted_rule",
-                              "the style most of the 5 nearest blocks of the other half got from that half's own "
-                              "calibration, in standardised "
-                              "features: log10 block area, block width / length, convexity, observed street access "
-                              "share, log10 observed mean parcel area, log10 observed parcel count")
+                              "the style most of the 3 nearest blocks of the other half got from that half's own "
+                              "calibration, in the auto rule's standardised features (calibration.csv's f_ columns)")
                          .set("fitted", fitJson(c.crossFitted))
                          .set("paper", fitJson(c.crossPaper))));
     run.set("outputs", outputs.push("run.json"));
@@ -391,7 +386,8 @@ JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir
     reportProgress(progress, 1.0, "writing");
     std::ostringstream s;
     s << "calibrated " << c.blocks.size() << " blocks of " << c.board.observed->layer.path
-      << "\n  before (auto): " << fitText(c.before) << "\n  after: " << fitText(c.after)
+      << "\n  before (access, the paper's rule): " << fitText(c.before) << "\n  auto: " << fitText(c.autoRule)
+      << "\n  after: " << fitText(c.after)
       << "\n  cross-validated (fitted on one half, measured on the other): " << fitText(c.crossFitted)
       << "\n  styles chosen:";
     for (const auto& [style, blocks] : c.stylesChosen) s << " " << style << " " << blocks;

@@ -172,7 +172,7 @@ std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInp
 
     BlockPlan& plan = plans[k];
     const Style& chosen = style(overridden && !override->style.empty() ? override->style : request.style);
-    const Style& concrete = chosen.resolve({e.accessShare});
+    const Style& concrete = chosen.resolve({e.accessShare, &e.shape, e.observed.get(), e.observedShare});
     plan.style = concrete.name();
     plan.values = styleValues(concrete, v);
     plan.values["a-min"] = p.aMin;

@@ -29,7 +29,8 @@ TEST(Styles, EachStyleIsRegisteredOnceWithItsParametersAndTheListsFollowTheRegis
     }
     EXPECT_EQ(&style(s->name()), s);
   }
-  EXPECT_EQ(names, (std::set<std::string>{"obb", "skeleton", "offset", "parish", "sexton", "template", "auto"}));
+  EXPECT_EQ(names,
+            (std::set<std::string>{"obb", "skeleton", "offset", "parish", "sexton", "template", "access", "auto"}));
   ASSERT_EQ(generationStyles().size(), styles().size());
   for (std::size_t i = 0; i < styles().size(); ++i) EXPECT_EQ(generationStyles()[i].first, styles()[i]->name());
   try {
@@ -37,7 +38,8 @@ TEST(Styles, EachStyleIsRegisteredOnceWithItsParametersAndTheListsFollowTheRegis
     FAIL() << "an unknown style is a usage error";
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), Error::Kind::Usage);
-    EXPECT_NE(std::string(e.what()).find("obb, skeleton, offset, parish, sexton, template, auto"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("obb, skeleton, offset, parish, sexton, template, access, auto"),
+              std::string::npos)
         << e.what();
   }
 }
@@ -55,12 +57,27 @@ TEST(Styles, StyleValuesHoldWhatTheStyleReadsAndNothingElse) {
   EXPECT_EQ(skeleton.at("a-max"), values.at("a-max"));
 }
 
-TEST(Styles, AutoChoosesPerBlockAndDoesNotSubdivideItself) {
+TEST(Styles, AccessAndAutoChoosePerBlockAndDoNotSubdivideThemselves) {
+  // access: the paper's rule, on the observed parcels' street access alone.
+  EXPECT_EQ(&accessStyle().resolve({0.5}), &obbStyle());
+  EXPECT_EQ(&accessStyle().resolve({0.95}), &skeletonStyle());
+  EXPECT_EQ(&accessStyle().resolve({std::nan("")}), &skeletonStyle());
+  // auto without observed parcels: the paper's rule.
   EXPECT_EQ(&autoStyle().resolve({0.5}), &obbStyle());
-  EXPECT_EQ(&autoStyle().resolve({0.95}), &skeletonStyle());
   EXPECT_EQ(&autoStyle().resolve({std::nan("")}), &skeletonStyle());
   EXPECT_EQ(&obbStyle().resolve({0.5}), &obbStyle());
-  EXPECT_THROW(subdivideBlock(test::rect(0, 0, 60, 40), "auto", {}, 1), Error);
+  EXPECT_TRUE(choosesPerBlock(autoStyle()));
+  EXPECT_TRUE(choosesPerBlock(accessStyle()));
+  EXPECT_FALSE(choosesPerBlock(sextonStyle()));
+  for (const char* name : {"auto", "access"})
+    EXPECT_THROW(subdivideBlock(test::rect(0, 0, 60, 40), name, {}, 1), Error);
+  // Every parameter of every style auto may pick is one of auto's.
+  std::set<std::string> names;
+  for (const auto& d : autoStyle().parameters()) names.insert(d.name);
+  for (const Style* s : styles()) {
+    if (choosesPerBlock(*s)) continue;
+    for (const auto& d : s->parameters()) EXPECT_EQ(names.count(d.name), 1u) << s->name() << ": " << d.name;
+  }
 }
 
 TEST(Styles, ConcreteStylesTileARectangleReproducibly) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <numeric>
 #include <set>
 
 #include "SampleRequest.h"
@@ -24,13 +25,13 @@ TEST(Calibrate, CalibratedStylesLowerTheCityObjectiveAndTheSessionReproducesThem
   ASSERT_EQ(c.blocks.size(), n);
   std::int64_t chosen = 0;
   for (const auto& [style, blocks] : c.stylesChosen) {
-    EXPECT_NE(style, "auto");
+    EXPECT_FALSE(generation::choosesPerBlock(generation::style(style))) << style;
     chosen += blocks;
   }
   EXPECT_EQ(chosen, static_cast<std::int64_t>(n));
   std::set<std::string> concrete;
   for (const generation::Style* s : generation::styles()) {
-    if (s != &generation::autoStyle()) concrete.insert(s->name());
+    if (!generation::choosesPerBlock(*s)) concrete.insert(s->name());
   }
   std::vector<std::size_t> after(n), all(n);
   for (std::size_t b = 0; b < n; ++b) {
@@ -46,16 +47,16 @@ TEST(Calibrate, CalibratedStylesLowerTheCityObjectiveAndTheSessionReproducesThem
   // Never worse than the paper's rule city-wide, and no single block's style
   // change would lower the objective further (the refinement's fixed point,
   // or its last pass).
-  const double objective = cityObjective(c.after);
-  EXPECT_NEAR(objective, cityObjective(fitMeasures(c.board, all, after)), 1e-12);
+  const double objective = calibrationObjective(c.after, c.before);
+  EXPECT_NEAR(cityObjective(c.after), cityObjective(fitMeasures(c.board, all, after)), 1e-12);
   EXPECT_LE(objective, cityObjective(c.before) + 1e-12);
   int improvable = 0;
   for (std::size_t b = 0; b < n; ++b) {
     for (std::size_t e = 0; e < c.board.entries.size(); ++e) {
-      if (c.board.entries[e].style == "auto") continue;
+      if (generation::choosesPerBlock(generation::style(c.board.entries[e].style))) continue;
       std::vector<std::size_t> changed = after;
       changed[b] = e;
-      improvable += cityObjective(fitMeasures(c.board, all, changed)) < objective - 1e-9;
+      improvable += calibrationObjective(fitMeasures(c.board, all, changed), c.before) < objective - 1e-9;
     }
   }
   EXPECT_EQ(improvable, 0);
@@ -94,6 +95,30 @@ TEST(Calibrate, TheCrossValidatedRuleIsMeasuredOnTheHalfItWasNotFittedOn) {
     for (const BlockCalibration& o : c.blocks) seen = seen || (o.half != b.half && o.styleHalf == b.stylePredicted);
     EXPECT_TRUE(seen) << b.blockId;
   }
+}
+
+TEST(Calibrate, TheAutoRuleReadsTheFeaturesCalibrationWritesAndPicksWhatCompareRuns) {
+  const Calibration c = calibrate(sampleRequest());
+  // A rule trained on this calibration's own labels picks, for each block,
+  // the style of the nearest training blocks; measured through the board it
+  // is what compare gives for those styles.
+  std::vector<generation::AutoRule::Row> rows;
+  for (const BlockCalibration& b : c.blocks) rows.push_back({b.features, b.styleAfter});
+  const generation::AutoRule oneNeighbour(rows, 1);
+  std::vector<std::size_t> all(c.blocks.size());
+  std::iota(all.begin(), all.end(), 0);
+  const std::vector<std::size_t> picked = entriesOf(c, oneNeighbour);
+  for (std::size_t b = 0; b < c.blocks.size(); ++b) {
+    EXPECT_EQ(c.board.entries[picked[b]].style, c.blocks[b].styleAfter) << "block " << c.blocks[b].blockId;
+  }
+  EXPECT_NEAR(cityObjective(fitMeasures(c.board, all, picked)), cityObjective(c.after), 1e-12);
+  // The auto entry is the bundled rule's choice on every block.
+  for (const BlockCalibration& b : c.blocks) {
+    EXPECT_EQ(b.styleAuto, generation::AutoRule::bundled().predict(b.features)) << "block " << b.blockId;
+  }
+  // calibration.csv holds the features under the names the rule's table reads.
+  const Table t = calibrationTable(c);
+  for (const char* name : generation::autoFeatureNames()) EXPECT_NO_THROW(t.column(name)) << name;
 }
 
 }  // namespace

@@ -238,6 +238,7 @@ namespace {
 // observed side, after the observed blocks; nothing throws.
 TEST(CompareStage, ABlockWithoutObservedParcelsIsComparedAsSuch) {
   CompareRequest r = request(kSample);
+  r.style = "access";  // no unassigned land: every generated parcel is compared
   CompareResult result = compare(r);
   const std::size_t observedBlocks = result.observed->analysis.blocks.size();
   ASSERT_EQ(result.blocks.size(), observedBlocks);

@@ -357,7 +357,7 @@ std::vector<std::string> drawCalibration(const pipeline::Calibration& c, const C
     top = std::max(top, c.blocks[b].distanceBefore);
   }
   char title[160];
-  std::snprintf(title, sizeof title, "Before (the paper's rule, auto): city KS area %.3f, width %.3f, aspect %.3f",
+  std::snprintf(title, sizeof title, "Before (the paper's rule, access): city KS area %.3f, width %.3f, aspect %.3f",
                 c.before.ksArea, c.before.ksWidth, c.before.ksAspectRatio);
   panels[0].title = title;
   std::snprintf(title, sizeof title, "Calibrated: city KS area %.3f, width %.3f, aspect %.3f", c.after.ksArea,
@@ -396,7 +396,7 @@ std::vector<std::string> drawCalibration(const pipeline::Calibration& c, const C
       ++counts[static_cast<std::size_t>(std::clamp<long>(bin, 0, static_cast<long>(counts.size()) - 1))];
     }
     const std::vector<HistogramSeries> series = {{"observed", h.a, {0.84, 0.19, 0.15}},
-                                                 {"before (auto)", h.b, {0.55, 0.55, 0.55}},
+                                                 {"before (access)", h.b, {0.55, 0.55, 0.55}},
                                                  {"calibrated", counts, {0.17, 0.40, 0.75}}};
     const std::string file = std::string("figures/hist_calibration_") + name;
     FigureOutput out;

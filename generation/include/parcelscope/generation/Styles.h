@@ -48,7 +48,10 @@ struct StyleRun {
 /// What a style knows of a block before choosing (for styles that choose
 /// another per block, like auto).
 struct BlockFacts {
-  double accessShare = 0;  ///< share of its observed parcels with street access; NaN when unknown
+  double accessShare = 0;                    ///< share of its observed parcels with street access; NaN when unknown
+  const Polygon* shape = nullptr;            ///< the block (part), local metres; null when unknown
+  const ObservedSample* observed = nullptr;  ///< its block's observed parcels; null when none
+  double observedShare = 1.0;                ///< this part's share of its block's area
 };
 
 class Style {
@@ -78,7 +81,7 @@ public:
 };
 
 /// Every registered style, in the order of --help and the GUI: obb, skeleton, offset, parish, sexton, template,
-/// auto.
+/// access, auto.
 const std::vector<const Style*>& styles();
 /// The style called `name`; throws Error(Usage) naming the styles otherwise.
 const Style& style(const std::string& name);
@@ -95,12 +98,15 @@ std::vector<ParameterDescription> generationParameterDescriptions();
 /// make the same parcels.
 ParameterValues styleValues(const Style& s, const ParameterValues& values);
 
+/// Whether `s` chooses another style per block (access, auto) rather than subdividing itself.
+bool choosesPerBlock(const Style& s);
+
 /// Subdivides one block with a concrete style by name (not auto).
 Subdivision subdivideBlock(const Polygon& block, const std::string& style, const ParameterValues& values,
                            std::uint64_t seed, const StreetWidths& streetWidths = {});
 
-/// Share of observed parcels with street access at or above which `auto` picks skeleton.
-constexpr double kAutoSkeletonAccessShare = 0.9;
+/// Share of observed parcels with street access at or above which `access` picks skeleton.
+constexpr double kAccessSkeletonShare = 0.9;
 
 /// The registered styles (defined beside their algorithms).
 const Style& obbStyle();
@@ -109,6 +115,7 @@ const Style& offsetStyle();
 const Style& parishStyle();
 const Style& sextonStyle();
 const Style& templateStyle();
+const Style& accessStyle();
 const Style& autoStyle();
 
 }  // namespace parcelscope::generation

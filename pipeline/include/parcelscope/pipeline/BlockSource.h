@@ -26,6 +26,10 @@ public:
   virtual BlockInputs blocks(const ProgressFn& progress = {}) const = 0;
 };
 
+/// The observed parcels of block `block` of `analysis`, as styles that fit them read them.
+std::shared_ptr<generation::ObservedSample> observedSample(const analysis::ObservedAnalysis& analysis,
+                                                           std::size_t block);
+
 /// Blocks grouped from observed parcels exactly as `stats` groups them, with
 /// bounds derived from their parcels (Vanegas et al. 2012, section 6); the
 /// analysis parameters come from `parameters`. With `observed`, that data (read

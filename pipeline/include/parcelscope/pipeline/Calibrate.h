@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "parcelscope/core/Table.h"
+#include "parcelscope/generation/AutoRule.h"
 #include "parcelscope/pipeline/Leaderboard.h"
 
 namespace parcelscope::pipeline {
@@ -29,16 +30,19 @@ struct BlockCalibration {
   std::int64_t blockId = -1;
   Key blockKey = 0;
   std::int64_t observedParcels = 0;
-  std::string styleBefore;  ///< the paper's rule (the auto style's choice)
+  std::string styleBefore;  ///< the paper's rule (the access style's choice)
   double distanceBefore = NAN;
   /// The calibrated style: from the style of least distance (or the paper's
   /// rule's, when that is better city-wide), changed where that lowers the
-  /// city's cityObjective() (see calibrate()).
+  /// city's calibrationObjective() (see calibrate()).
   std::string styleAfter;
   double distanceAfter = NAN;
   int half = 0;                ///< cross-validation half (0 or 1, from the block key)
   std::string stylePredicted;  ///< the fitted rule's style, fitted on the other half
   std::string styleHalf;       ///< the style its half calibrated alone gave it (the other half's labels)
+  std::string styleAuto;       ///< the auto style's choice (the bundled rule)
+  /// What the auto rule reads of the block (its largest part; see generation::autoFeatures).
+  generation::AutoFeatures features{};
 };
 
 /// The measures over the observed blocks `blocks`, block b's parcels those
@@ -51,6 +55,7 @@ struct Calibration {
   std::vector<BlockCalibration> blocks;  ///< per observed block
   CompareRequest session;                ///< the request with each block's style as an override
   FitMeasures before, after;             ///< every block: the paper's rule, the calibrated styles
+  FitMeasures autoRule;                  ///< every block: the auto style (the bundled rule)
   /// Cross-validation: on each half, the rule fitted on the other half and the
   /// paper's rule; the two halves' measures, parcels pooled.
   FitMeasures crossFitted, crossPaper;
@@ -72,12 +77,29 @@ double calibrationDistance(const analysis::Comparison& c);
 /// calibration lowers city-wide.
 double cityObjective(const FitMeasures& f);
 
+/// Weight of a measure's excess over the paper's rule in calibrationObjective().
+constexpr double kExcessWeight = 10;
+
+/// What the calibration lowers: cityObjective(f), plus kExcessWeight times
+/// each measure's excess over the paper's rule's `paper` on the same blocks,
+/// so that a calibration that can be better than the paper's rule on every
+/// measure is preferred to one better on the sum only.
+double calibrationObjective(const FitMeasures& f, const FitMeasures& paper);
+
 /// Runs every concrete style on `request`'s blocks (request.style is ignored)
 /// and calibrates: each block first takes its style of least distance; when
 /// the paper's rule scores better city-wide, the blocks start from its choice
 /// instead; then, twice over the blocks, a block's style is changed wherever
-/// that lowers cityObjective(). Throws as compare().
+/// that lowers calibrationObjective(). Throws as compare().
 Calibration calibrate(const CompareRequest& request, const ProgressFn& progress = {});
+
+/// The leaderboard entry of style `style`; throws std::logic_error when absent.
+std::size_t entryOfStyle(const Calibration& c, const std::string& style);
+
+/// Per observed block, the leaderboard entry of the style `rule` picks from
+/// its features: how a rule trained elsewhere (another city) does here, with
+/// fitMeasures().
+std::vector<std::size_t> entriesOf(const Calibration& c, const generation::AutoRule& rule);
 
 /// calibration.csv: one row per observed block.
 Table calibrationTable(const Calibration& c);

@@ -1,0 +1,109 @@
+// The auto style's rule: block features, the training table and the vote.
+#include "parcelscope/generation/AutoRule.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "TestUtil.h"
+#include "parcelscope/core/Error.h"
+#include "parcelscope/generation/Styles.h"
+
+namespace parcelscope::generation {
+namespace {
+
+const std::string kHeader =
+    "city,f_log_area,f_box_ratio,f_convexity,f_access,f_log_mean_area,f_log_parcels,f_log_aspect,style\n";
+
+TEST(AutoRule, FeaturesDescribeTheBlockAndItsObservedParcels) {
+  ObservedSample s;
+  s.areas = {100, 300, 200, 400};
+  s.aspectRatios = {1, 2, 4, 8};
+  const AutoFeatures f = autoFeatures(test::rect(0, 0, 100, 50), s, 0.75, 0.5);
+  EXPECT_NEAR(f[0], std::log10(5000.0), 1e-12);  // area
+  EXPECT_NEAR(f[1], 0.5, 1e-12);                 // box width / length
+  EXPECT_NEAR(f[2], 1.0, 1e-12);                 // convex
+  EXPECT_EQ(f[3], 0.75);
+  EXPECT_NEAR(f[4], std::log10(250.0), 1e-12);  // mean observed area
+  EXPECT_NEAR(f[5], std::log10(2.0), 1e-12);    // half of the 4 parcels in this part
+  EXPECT_NEAR(f[6], std::log10(4.0), 1e-12);    // the upper median of 1, 2, 4, 8
+  // An L: convexity below 1.
+  Polygon l;
+  l.outer = {{0, 0}, {40, 0}, {40, 10}, {10, 10}, {10, 40}, {0, 40}};
+  EXPECT_NEAR(autoFeatures(l, s, 1.0)[2], 700.0 / 1150.0, 1e-9);
+}
+
+TEST(AutoRule, PredictsTheStyleMostNearestRowsHaveTiesToTheNearest) {
+  auto row = [](double x, const char* style) {
+    AutoRule::Row r;
+    r.features.fill(0);
+    r.features[0] = x;
+    r.style = style;
+    return r;
+  };
+  const AutoRule rule({row(0, "obb"), row(1, "sexton"), row(2, "sexton"), row(10, "parish"), row(11, "parish"),
+                       row(12, "parish"), row(13, "skeleton")},
+                      3);
+  AutoFeatures x{};
+  x[0] = 0.2;
+  EXPECT_EQ(rule.predict(x), "sexton");  // obb, sexton, sexton
+  x[0] = 12.4;
+  EXPECT_EQ(rule.predict(x), "parish");  // parish 12, skeleton 13, parish 11
+  const AutoRule pairs({row(0, "obb"), row(1, "sexton"), row(5, "skeleton"), row(6, "template")}, 2);
+  x[0] = 0.4;
+  EXPECT_EQ(pairs.predict(x), "obb");  // one vote each: the nearer
+  x[0] = 0.6;
+  EXPECT_EQ(pairs.predict(x), "sexton");
+}
+
+TEST(AutoRule, ReadsATableLeavesCitiesOutAndNamesTheLineOfABadRow) {
+  const std::string table = kHeader + "a,3,0.5,0.9,1,2.5,1,0.3,obb\nb,4,0.5,0.9,1,2.5,1,0.3,sexton\n";
+  EXPECT_EQ(AutoRule::fromCsv(table, "t.csv").rows().size(), 2u);
+  const AutoRule onlyB = AutoRule::fromCsv(table, "t.csv", {"a"});
+  ASSERT_EQ(onlyB.rows().size(), 1u);
+  EXPECT_EQ(onlyB.rows()[0].style, "sexton");
+  auto message = [](const std::string& text) {
+    try {
+      AutoRule::fromCsv(text, "t.csv");
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), Error::Kind::Input);
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message(kHeader + "a,3,x,0.9,1,2.5,1,0.3,obb\n"), "t.csv:2: f_box_ratio is 'x', not a number");
+  EXPECT_EQ(message(kHeader + "a,3,0.5,0.9,1,2.5,1,0.3,auto\n"),
+            "t.csv:2: style auto chooses per block; name a concrete one");
+  EXPECT_NE(message(kHeader + "a,3,0.5,0.9,1,2.5,1,0.3,voronoi\n").find("t.csv:2: no subdivision style 'voronoi'"),
+            std::string::npos);
+  EXPECT_EQ(message(kHeader + "a,3,0.5\n"), "t.csv:2: 3 fields, the header has 9");
+  EXPECT_EQ(message("city,style\n"), "t.csv: the auto rule table has no column 'f_log_area'");
+  EXPECT_EQ(message(kHeader), "t.csv: the auto rule table has no training blocks");
+  EXPECT_EQ(message(table), "no error");
+}
+
+TEST(AutoRule, TheBundledRuleIsTrainedOnTheSixSharedDatasetsWithConcreteStyles) {
+  const AutoRule& rule = AutoRule::bundled();
+  EXPECT_GT(rule.rows().size(), 1000u);
+  std::set<std::string> styles;
+  for (const AutoRule::Row& r : rule.rows()) styles.insert(r.style);
+  EXPECT_GE(styles.size(), 3u);
+  for (const std::string& s : styles) EXPECT_FALSE(choosesPerBlock(style(s))) << s;
+  // Leaving a city out leaves its rows out.
+  const std::size_t withoutCambridge =
+      AutoRule::fromCsv(AutoRule::bundledTable(), "auto_rule.csv", {"cambridge_ma"}).rows().size();
+  EXPECT_GT(withoutCambridge, 0u);
+  EXPECT_LT(withoutCambridge, rule.rows().size());
+  // The auto style asks this rule when the block has observed parcels.
+  ObservedSample s;
+  s.areas = {400, 420, 380, 410, 390, 405};
+  s.aspectRatios = {2.5, 2.6, 2.4, 2.5, 2.7, 2.3};
+  const Polygon block = test::rect(0, 0, 120, 40);
+  const AutoFeatures f = autoFeatures(block, s, 1.0);
+  BlockFacts facts{1.0, &block, &s, 1.0};
+  EXPECT_EQ(autoStyle().resolve(facts).name(), rule.predict(f));
+}
+
+}  // namespace
+}  // namespace parcelscope::generation
