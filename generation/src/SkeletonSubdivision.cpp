@@ -1246,15 +1246,31 @@ private:
     return true;
   }
 
+  // Whether the turn whose cross and dot products are `cross` and `dot`
+  // exceeds 10 degrees: |atan2(cross, dot)| > 10 degrees, decided without
+  // atan2 unless the ratio is within 1e-9 of the limit's tangent (atan2 is
+  // then asked, so the answer is always atan2's).
+  static bool sharpTurn(double cross, double dot) {
+    constexpr double kLimit = 10.0 * kPi / 180.0;
+    constexpr double kTangent = 0.17632698070846498;  // tan(kLimit)
+    // More than 90 degrees.
+    if (dot < 0) return true;
+    if (dot > 0) {
+      const double across = std::fabs(cross);
+      if (across > kTangent * (1 + 1e-9) * dot) return true;
+      if (across < kTangent * (1 - 1e-9) * dot) return false;
+    }
+    return std::fabs(std::atan2(cross, dot)) > kLimit;
+  }
+
   static bool triangular(const Polygon& p) {
     if (!p.holes.empty()) return false;
     int corners = 0;
     const Ring& r = p.outer;
     for (std::size_t i = 0, n = r.size(); i < n; ++i) {
       const Point &a = r[(i + n - 1) % n], &b = r[i], &c = r[(i + 1) % n];
-      const double t = std::atan2((b.x - a.x) * (c.y - b.y) - (b.y - a.y) * (c.x - b.x),
-                                  (b.x - a.x) * (c.x - b.x) + (b.y - a.y) * (c.y - b.y));
-      if (std::fabs(t) > 10.0 * kPi / 180.0) ++corners;
+      corners += sharpTurn((b.x - a.x) * (c.y - b.y) - (b.y - a.y) * (c.x - b.x),
+                           (b.x - a.x) * (c.x - b.x) + (b.y - a.y) * (c.y - b.y));
     }
     return corners <= 3;
   }
