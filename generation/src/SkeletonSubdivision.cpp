@@ -1396,11 +1396,13 @@ private:
 
 // Back to the block's coordinates, where rounding can close what were
 // separate points locally: cleaned there; a parcel pinched into a corridor of
-// no width becomes its parts (street access counted again).
-void finish(const Polygon& block, const Point& o, Subdivision& out, double minFrontage) {
+// no width becomes its parts (street access counted again). Returns, per
+// parcel, whether it was proved valid here (checkTiling need not test it again).
+std::vector<char> finish(const Polygon& block, const Point& o, Subdivision& out, double minFrontage) {
   const Box b = bounds(block);
   const std::size_t streetParcels = out.parcels.size() - static_cast<std::size_t>(out.patioParcels);
   std::vector<Polygon> parcels;
+  std::vector<char> valid;
   std::size_t street = 0;
   bool split = false;
   for (std::size_t i = 0; i < out.parcels.size(); ++i) {
@@ -1410,13 +1412,14 @@ void finish(const Polygon& block, const Point& o, Subdivision& out, double minFr
     // catches anything of substance lost.
     if (!normalise(parcel)) continue;
     // A ring clearly simple (floating-point test with a margin) is valid as it is.
-    std::vector<Polygon> parts =
-        parcel.holes.empty() && isClearlySimple(parcel.outer) ? std::vector<Polygon>{parcel} : geos::validParts(parcel);
+    const bool simple = parcel.holes.empty() && isClearlySimple(parcel.outer);
+    std::vector<Polygon> parts = simple ? std::vector<Polygon>{parcel} : geos::validParts(parcel);
     double partsArea = 0;
     for (const Polygon& q : parts) partsArea += area(q);
     if (std::fabs(partsArea - area(parcel)) > 1e-9 * area(parcel)) throw Fallback("a parcel is not valid once rounded");
     split = split || parts.size() != 1;
     if (i < streetParcels) street += parts.size();
+    valid.insert(valid.end(), parts.size(), simple);
     for (Polygon& q : parts) parcels.push_back(std::move(q));
   }
   out.parcels = std::move(parcels);
@@ -1429,6 +1432,7 @@ void finish(const Polygon& block, const Point& o, Subdivision& out, double minFr
       out.withoutAccess += analysis::sharedBoundaryLength(out.parcels[i], outline, tolerance) < minFrontage;
     }
   }
+  return valid;
 }
 
 }  // namespace
@@ -1555,8 +1559,8 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
     }
     // Back to the block's coordinates, where rounding can close what were
     // separate points locally: clean and check there.
-    finish(block, o, out, p.bounds.minFrontage);
-    detail::checkTiling(block, out);
+    const std::vector<char> valid = finish(block, o, out, p.bounds.minFrontage);
+    detail::checkTiling(block, out, valid);
   } catch (const std::exception& e) {
     detail::rethrowUnlessBlockFailure();
     reason = e.what();
