@@ -24,8 +24,10 @@ struct StyleFailure : std::runtime_error {
 };
 
 /// Throws StyleFailure unless every parcel is a valid polygon (GEOS) and the
-/// parcels' areas sum to the block's within 1e-9 of it.
-void checkTiling(const Polygon& block, const Subdivision& out);
+/// parcels' areas sum to the block's within 1e-9 of it. Parcels whose flag in
+/// `knownValid` is set (the style proved them valid as they are) are not
+/// tested again; the flags may be fewer than the parcels, or none.
+void checkTiling(const Polygon& block, const Subdivision& out, const std::vector<char>& knownValid = {});
 
 /// Parcels narrower than this (twice the area over the perimeter) are slivers:
 /// numerical crumbs of a cut passing next to a vertex (a triangle of 1e-13 m²

@@ -1246,15 +1246,31 @@ private:
     return true;
   }
 
+  // Whether the turn whose cross and dot products are `cross` and `dot`
+  // exceeds 10 degrees: |atan2(cross, dot)| > 10 degrees, decided without
+  // atan2 unless the ratio is within 1e-9 of the limit's tangent (atan2 is
+  // then asked, so the answer is always atan2's).
+  static bool sharpTurn(double cross, double dot) {
+    constexpr double kLimit = 10.0 * kPi / 180.0;
+    constexpr double kTangent = 0.17632698070846498;  // tan(kLimit)
+    // More than 90 degrees.
+    if (dot < 0) return true;
+    if (dot > 0) {
+      const double across = std::fabs(cross);
+      if (across > kTangent * (1 + 1e-9) * dot) return true;
+      if (across < kTangent * (1 - 1e-9) * dot) return false;
+    }
+    return std::fabs(std::atan2(cross, dot)) > kLimit;
+  }
+
   static bool triangular(const Polygon& p) {
     if (!p.holes.empty()) return false;
     int corners = 0;
     const Ring& r = p.outer;
     for (std::size_t i = 0, n = r.size(); i < n; ++i) {
       const Point &a = r[(i + n - 1) % n], &b = r[i], &c = r[(i + 1) % n];
-      const double t = std::atan2((b.x - a.x) * (c.y - b.y) - (b.y - a.y) * (c.x - b.x),
-                                  (b.x - a.x) * (c.x - b.x) + (b.y - a.y) * (c.y - b.y));
-      if (std::fabs(t) > 10.0 * kPi / 180.0) ++corners;
+      corners += sharpTurn((b.x - a.x) * (c.y - b.y) - (b.y - a.y) * (c.x - b.x),
+                           (b.x - a.x) * (c.x - b.x) + (b.y - a.y) * (c.y - b.y));
     }
     return corners <= 3;
   }
@@ -1380,11 +1396,13 @@ private:
 
 // Back to the block's coordinates, where rounding can close what were
 // separate points locally: cleaned there; a parcel pinched into a corridor of
-// no width becomes its parts (street access counted again).
-void finish(const Polygon& block, const Point& o, Subdivision& out, double minFrontage) {
+// no width becomes its parts (street access counted again). Returns, per
+// parcel, whether it was proved valid here (checkTiling need not test it again).
+std::vector<char> finish(const Polygon& block, const Point& o, Subdivision& out, double minFrontage) {
   const Box b = bounds(block);
   const std::size_t streetParcels = out.parcels.size() - static_cast<std::size_t>(out.patioParcels);
   std::vector<Polygon> parcels;
+  std::vector<char> valid;
   std::size_t street = 0;
   bool split = false;
   for (std::size_t i = 0; i < out.parcels.size(); ++i) {
@@ -1394,13 +1412,14 @@ void finish(const Polygon& block, const Point& o, Subdivision& out, double minFr
     // catches anything of substance lost.
     if (!normalise(parcel)) continue;
     // A ring clearly simple (floating-point test with a margin) is valid as it is.
-    std::vector<Polygon> parts =
-        parcel.holes.empty() && isClearlySimple(parcel.outer) ? std::vector<Polygon>{parcel} : geos::validParts(parcel);
+    const bool simple = parcel.holes.empty() && isClearlySimple(parcel.outer);
+    std::vector<Polygon> parts = simple ? std::vector<Polygon>{parcel} : geos::validParts(parcel);
     double partsArea = 0;
     for (const Polygon& q : parts) partsArea += area(q);
     if (std::fabs(partsArea - area(parcel)) > 1e-9 * area(parcel)) throw Fallback("a parcel is not valid once rounded");
     split = split || parts.size() != 1;
     if (i < streetParcels) street += parts.size();
+    valid.insert(valid.end(), parts.size(), simple);
     for (Polygon& q : parts) parcels.push_back(std::move(q));
   }
   out.parcels = std::move(parcels);
@@ -1413,6 +1432,7 @@ void finish(const Polygon& block, const Point& o, Subdivision& out, double minFr
       out.withoutAccess += analysis::sharedBoundaryLength(out.parcels[i], outline, tolerance) < minFrontage;
     }
   }
+  return valid;
 }
 
 }  // namespace
@@ -1539,8 +1559,8 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
     }
     // Back to the block's coordinates, where rounding can close what were
     // separate points locally: clean and check there.
-    finish(block, o, out, p.bounds.minFrontage);
-    detail::checkTiling(block, out);
+    const std::vector<char> valid = finish(block, o, out, p.bounds.minFrontage);
+    detail::checkTiling(block, out, valid);
   } catch (const std::exception& e) {
     detail::rethrowUnlessBlockFailure();
     reason = e.what();

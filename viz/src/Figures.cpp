@@ -995,37 +995,43 @@ void MapLayer::setShapes(const std::vector<const Polygon*>& shapes, const std::v
                      " values and " + std::to_string(groups.size()) + " groups");
   }
   Impl& m = *impl_;
-  m.rebuilt = 0;
   std::array<std::vector<std::size_t>, kLayerParts> members;
-  std::vector<std::size_t> stale;  // parts to build again
   for (std::size_t k = 0; k < shapes.size(); ++k) {
     // Without groups, runs of consecutive shapes.
     const std::size_t part = groups.empty() ? k * kLayerParts / shapes.size()
                                             : static_cast<std::size_t>(static_cast<unsigned>(groups[k])) % kLayerParts;
     members[part].push_back(k);
   }
+  std::array<std::size_t, kLayerParts> before{};  // each part's count of members until now
+  std::vector<std::size_t> order(kLayerParts);
   for (std::size_t i = 0; i < kLayerParts; ++i) {
+    before[i] = m.parts[i].members.size();
+    m.parts[i].members = std::move(members[i]);
+    order[i] = i;
+  }
+  // The parts share nothing: each is compared with what it drew (by a hash
+  // of its shapes), then recoloured or triangulated again, side by side, the
+  // largest first, so that no thread is left with a large part at the end.
+  largestFirst(m.parts, order);
+  std::array<char, kLayerParts> stale{};
+  parallelFor(order.size(), [&](std::size_t j) {
+    const std::size_t i = order[j];
     LayerPart& p = m.parts[i];
-    std::uint64_t hash = members[i].size();
-    for (std::size_t k : members[i]) hash = hash * 0x100000001b3ull ^ shapeHash(*shapes[k]);
+    std::uint64_t hash = p.members.size();
+    for (std::size_t k : p.members) hash = hash * 0x100000001b3ull ^ shapeHash(*shapes[k]);
     std::vector<double> partValues;
-    partValues.reserve(members[i].size());
-    for (std::size_t k : members[i]) partValues.push_back(values[k]);
-    if (hash == p.hash && members[i].size() == p.members.size()) {
-      p.members = std::move(members[i]);
+    partValues.reserve(p.members.size());
+    for (std::size_t k : p.members) partValues.push_back(values[k]);
+    if (hash == p.hash && p.members.size() == before[i]) {
       p.recolour(std::move(partValues));
-      continue;
+      return;
     }
-    p.members = std::move(members[i]);
     p.hash = hash;
     p.values = std::move(partValues);
-    stale.push_back(i);
-  }
-  // The parts share nothing: they are triangulated side by side, the largest
-  // first, so that no thread is left with a large part at the end.
-  largestFirst(m.parts, stale);
-  parallelFor(stale.size(), [&](std::size_t i) { m.parts[stale[i]].rebuild(shapes, m.metresPerPixel, m.tolerance); });
-  m.rebuilt = stale.size();
+    p.rebuild(shapes, m.metresPerPixel, m.tolerance);
+    stale[i] = 1;
+  });
+  m.rebuilt = static_cast<std::size_t>(std::count(stale.begin(), stale.end(), 1));
   m.drawn = shapes;
 }
 

@@ -93,7 +93,9 @@ double distance2(const Point& p, Point a, Point b) {
 void simplifyRun(const Ring& ring, std::size_t first, std::size_t count, double tolerance2, std::vector<char>& keep,
                  std::vector<std::pair<std::size_t, std::size_t>>& stack) {
   const std::size_t n = ring.size();
-  const auto at = [&](std::size_t k) { return (first + k) % n; };
+  // first + k stays below 2n (a run ends at most one turn after it starts):
+  // no division needed to wrap it.
+  const auto at = [&](std::size_t k) { return first + k < n ? first + k : first + k - n; };
   stack.clear();
   stack.emplace_back(0, count - 1);
   while (!stack.empty()) {
@@ -187,7 +189,7 @@ void simplifyShared(const std::vector<const Polygon*>& shapes, double tolerance,
   seen.reset(vertices);
   const auto look = [&](const Ring& ring) {
     const std::size_t n = ring.size();
-    for (std::size_t i = 0; i < n; ++i) seen.see(ring[i], ring[(i + n - 1) % n], ring[(i + 1) % n]);
+    for (std::size_t i = 0; i < n; ++i) seen.see(ring[i], ring[i == 0 ? n - 1 : i - 1], ring[i + 1 == n ? 0 : i + 1]);
   };
   for (const Polygon* shape : shapes) {
     look(shape->outer);
