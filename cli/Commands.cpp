@@ -14,6 +14,7 @@
 #include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/pipeline/Inspect.h"
 #include "parcelscope/pipeline/StatsJob.h"
+#include "parcelscope/pipeline/StreetEditor.h"
 #include "parcelscope/pipeline/StreetsJob.h"
 #include "parcelscope/viz/CompareFigures.h"
 
@@ -30,10 +31,11 @@ const char* kOverview =
     "            per-block statistics and generator parameters\n"
     "  blocks    build the road graph of street centre lines and its blocks\n"
     "  generate  subdivide blocks into procedural parcels (obb, skeleton, offset, parish,\n"
-    "            sexton, template or auto style)\n"
+    "            sexton, template, access or auto style)\n"
     "  compare   generate parcels in the blocks of observed ones and compare the two sets:\n"
     "            per-block and city-wide tables, distances, layers and figures\n"
     "  calibrate give each block the style closest to its observed parcels (a session file)\n"
+    "  edit      edit a street network (JSON list of edits); parcels follow, keeping their keys\n"
     "  inspect   print one observed parcel's attributes, metrics and block statistics\n"
     "  metrics   print the table of parcel metrics (Markdown, as in docs/user/metrics.md)\n"
     "  version   print the version\n"
@@ -123,6 +125,14 @@ std::vector<T> joined(std::vector<T> a, const std::vector<T>& b) {
   return a;
 }
 
+// The flags of a STREETS input (blocks, edit).
+std::vector<FlagSpec> streetInputFlags() {
+  return joined<FlagSpec>({{"layer", "layer of STREETS to read (default: the first)"},
+                           {"where", "OGR SQL attribute filter on the street lines"},
+                           {"crs", "CRS of STREETS (e.g. EPSG:2286), replacing a missing or wrong one"}},
+                          streetFlags(""));
+}
+
 FlagSpec styleFlag() {
   std::string help = "subdivision style (default obb):";
   for (const auto& [name, text] : generation::generationStyles()) help += "\n      " + name + ": " + text;
@@ -182,8 +192,9 @@ int dispatch(const std::vector<std::string>& args) {
   if (args[0] == "compare") return compareCommand(rest);
   if (args[0] == "inspect") return inspectCommand(rest);
   if (args[0] == "calibrate") return calibrateCommand(rest);
+  if (args[0] == "edit") return editCommand(rest);
   throw usageError("unknown command '" + args[0] +
-                   "' (commands: stats, blocks, generate, compare, calibrate, inspect, metrics, version)");
+                   "' (commands: stats, blocks, generate, compare, calibrate, edit, inspect, metrics, version)");
 }
 
 int metricsCommand(const std::vector<std::string>& args) {
@@ -226,10 +237,7 @@ int statsCommand(const std::vector<std::string>& args) {
 }
 
 int blocksCommand(const std::vector<std::string>& args) {
-  std::vector<FlagSpec> flags = {{"layer", "layer of STREETS to read (default: the first)"},
-                                 {"where", "OGR SQL attribute filter on the street lines"},
-                                 {"crs", "CRS of STREETS (e.g. EPSG:2286), replacing a missing or wrong one"}};
-  flags = joined(flags, streetFlags(""));
+  std::vector<FlagSpec> flags = streetInputFlags();
   flags.push_back({"parcels",
                    "observed parcels: unknown widths are measured from the gap between their blocks,\n"
                    "      and blocks.gpkg counts each block's parcels"});
@@ -265,6 +273,42 @@ int blocksCommand(const std::vector<std::string>& args) {
   }
   return reportOutcome(pipeline::runBlocks(streets, a.parameters(), parcels ? &*parcels : nullptr, *a.value("out"),
                                            terminalProgress(a.has("quiet"))),
+                       a);
+}
+
+int editCommand(const std::vector<std::string>& args) {
+  std::vector<FlagSpec> flags = streetInputFlags();
+  flags.push_back(styleFlag());
+  flags.push_back({"edits", "JSON list of edits to apply in order (docs/user/cli.md#parcelscope-edit)"});
+  flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
+  flags.push_back({"quiet", "no progress or summary on stderr", false});
+  const std::vector<ParameterDescription> params =
+      joined(generation::generationParameterDescriptions(), pipeline::streetParameters());
+  if (wantsHelp(args)) {
+    std::fputs(usageText("parcelscope edit STREETS [--style S] [--seed N] --edits EDITS.json --out DIR", flags, params)
+                   .c_str(),
+               stdout);
+    std::fputs(
+        "\nBuilds the street network of STREETS and subdivides its blocks (as 'generate --streets'),\n"
+        "then applies the edits of EDITS.json in order: move_node, move_edge, set_width, set_curve,\n"
+        "transform_nodes, set_block. Only the blocks an edit changes are subdivided again; their\n"
+        "parcels are matched to those before, and a matched parcel keeps its key. Writes\n"
+        "DIR/parcels.gpkg (with parcel_key and label), DIR/blocks.gpkg, DIR/streets.gpkg,\n"
+        "DIR/street_surface.gpkg, DIR/persistence.csv (per edit: blocks affected, parcels before\n"
+        "and after, keys kept) and DIR/run.json.\n",
+        stdout);
+    return 0;
+  }
+  const Args a(args, flags, params);
+  if (a.positional().size() != 1) throw usageError("expected exactly one STREETS file");
+  if (!a.value("out")) throw usageError("--out DIR is required");
+  if (!a.value("edits")) throw usageError("--edits EDITS.json is required");
+  pipeline::GenerateRequest request;
+  request.streets = streetOptions(a, a.positional()[0], "");
+  request.style = a.value("style").value_or("obb");
+  request.parameters = a.parameters();
+  request.explicitParameters = givenParameters(a, params);
+  return reportOutcome(pipeline::runEdit(request, *a.value("edits"), *a.value("out"), terminalProgress(a.has("quiet"))),
                        a);
 }
 

@@ -14,5 +14,6 @@ int generateCommand(const std::vector<std::string>& args);
 int compareCommand(const std::vector<std::string>& args);
 int inspectCommand(const std::vector<std::string>& args);
 int calibrateCommand(const std::vector<std::string>& args);
+int editCommand(const std::vector<std::string>& args);
 
 }  // namespace parcelscope::cli

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <tuple>
 
@@ -169,25 +170,46 @@ ParcelMatches matchParcels(const Polygon& blockBefore, const std::vector<Polygon
   out.distance.assign(parcelsAfter.size(), -1.0);
   const Ring contourBefore = matchingContour(blockBefore.outer), contourAfter = matchingContour(blockAfter.outer);
   const auto pairs = correspondContours(contourBefore, contourAfter);
-  if (pairs.empty()) return out;
+  // A parcel's position in its block, and the distance between two: the
+  // paper's over the corresponded vertices; without a correspondence, the
+  // parcel's centre relative to the block's area centroid in units of the
+  // square root of the block's area, and their Euclidean distance.
+  std::function<std::vector<double>(const Polygon&, bool)> position;
+  std::function<double(const std::vector<double>&, const std::vector<double>&)> distance = positionDistance;
   Ring verticesBefore, verticesAfter;
-  for (const auto& [i, j] : pairs) {
-    verticesBefore.push_back(contourBefore[i]);
-    verticesAfter.push_back(contourAfter[j]);
+  if (!pairs.empty()) {
+    for (const auto& [i, j] : pairs) {
+      verticesBefore.push_back(contourBefore[i]);
+      verticesAfter.push_back(contourAfter[j]);
+    }
+    position = [&](const Polygon& p, bool after) {
+      return relativePosition(parcelCentre(p), after ? verticesAfter : verticesBefore);
+    };
+  } else {
+    if (!(area(blockBefore) > 0) || !(area(blockAfter) > 0)) return out;  // degenerate: nothing to place parcels in
+    const Point centreBefore = centroid(blockBefore), centreAfter = centroid(blockAfter);
+    const double unitBefore = std::sqrt(area(blockBefore)), unitAfter = std::sqrt(area(blockAfter));
+    position = [=](const Polygon& p, bool after) {
+      const Point c = parcelCentre(p), o = after ? centreAfter : centreBefore;
+      const double u = after ? unitAfter : unitBefore;
+      return std::vector<double>{(c.x - o.x) / u, (c.y - o.y) / u};
+    };
+    distance = [](const std::vector<double>& a, const std::vector<double>& b) {
+      return std::hypot(a[0] - b[0], a[1] - b[1]);
+    };
   }
   std::vector<std::vector<double>> positionsBefore;
   positionsBefore.reserve(parcelsBefore.size());
-  for (const Polygon& p : parcelsBefore) positionsBefore.push_back(relativePosition(parcelCentre(p), verticesBefore));
+  for (const Polygon& p : parcelsBefore) positionsBefore.push_back(position(p, false));
 
   // Every pair (distance, after, before), taken by increasing distance, ties
   // to the lower indices; a pair is kept when neither parcel is matched yet.
   std::vector<std::tuple<double, std::size_t, std::size_t>> candidates;
   candidates.reserve(parcelsAfter.size() * parcelsBefore.size());
   for (std::size_t i = 0; i < parcelsAfter.size(); ++i) {
-    const std::vector<double> position = relativePosition(parcelCentre(parcelsAfter[i]), verticesAfter);
-    for (std::size_t j = 0; j < parcelsBefore.size(); ++j) {
-      candidates.emplace_back(positionDistance(position, positionsBefore[j]), i, j);
-    }
+    const std::vector<double> at = position(parcelsAfter[i], true);
+    for (std::size_t j = 0; j < parcelsBefore.size(); ++j)
+      candidates.emplace_back(distance(at, positionsBefore[j]), i, j);
   }
   std::sort(candidates.begin(), candidates.end());
   std::vector<bool> taken(parcelsBefore.size(), false);

@@ -97,6 +97,23 @@ private:
 
 }  // namespace
 
+BlockInputs streetNetworkInputs(std::shared_ptr<const StreetNetwork> network) {
+  BlockInputs in;
+  for (std::size_t b = 0; b < network->blocks.blocks.size(); ++b) {
+    const analysis::StreetBlock& block = network->blocks.blocks[b];
+    in.entries.push_back({static_cast<std::int64_t>(b), block.shape, NAN, NAN, NAN, NAN, NAN, block.key, 0, {}, 1.0});
+    in.widths.push_back(analysis::facedWidths(network->graph, block));
+  }
+  auto layer = std::make_shared<io::ParcelLayer>();
+  layer->path = network->layer.path;
+  layer->layerName = network->layer.layerName;
+  layer->frame = network->layer.frame;
+  layer->crs = network->layer.crs;
+  in.source = std::move(layer);
+  in.streets = std::move(network);
+  return in;
+}
+
 std::unique_ptr<BlockSource> observedParcelBlocks(const io::ReadOptions& input, const ParameterValues& parameters,
                                                   const ObservedData* observed) {
   return std::make_unique<ObservedParcelBlocks>(input, parameters, observed);
@@ -125,21 +142,8 @@ public:
       const ObservedData observed = loadObservedInStreetBlocks(parcels_, &streets_, parameters_, progress);
       return ObservedParcelBlocks(parcels_, parameters_, &observed).blocks({});
     }
-    auto network = std::make_shared<StreetNetwork>(buildStreetNetwork(streets_, parameters_, nullptr, progress));
-    BlockInputs in;
-    for (std::size_t b = 0; b < network->blocks.blocks.size(); ++b) {
-      const analysis::StreetBlock& block = network->blocks.blocks[b];
-      in.entries.push_back({static_cast<std::int64_t>(b), block.shape, NAN, NAN, NAN, NAN, NAN, block.key, 0});
-      in.widths.push_back(analysis::facedWidths(network->graph, block));
-    }
-    auto layer = std::make_shared<io::ParcelLayer>();
-    layer->path = network->layer.path;
-    layer->layerName = network->layer.layerName;
-    layer->frame = network->layer.frame;
-    layer->crs = network->layer.crs;
-    in.source = std::move(layer);
-    in.streets = std::move(network);
-    return in;
+    return streetNetworkInputs(
+        std::make_shared<StreetNetwork>(buildStreetNetwork(streets_, parameters_, nullptr, progress)));
   }
 
 private:

@@ -328,26 +328,15 @@ Json streetRecord(const StreetNetwork& network) {
       .set("seconds", seconds);
 }
 
-namespace {
-JobOutcome writeBlocks(io::OutputDirectory& out, const io::StreetReadOptions& streets,
-                       const ParameterValues& parameters, const io::ReadOptions* parcels, const ProgressFn& progress) {
-  ObservedData observed;
-  if (parcels) observed = loadObserved(*parcels, parameters, scaledProgress(progress, 0.0, 0.4));
-  const auto shared = std::make_shared<const StreetNetwork>(buildStreetNetwork(
-      streets, parameters, parcels ? &observed : nullptr, scaledProgress(progress, parcels ? 0.4 : 0.0, 0.9)));
-  const StreetNetwork& network = *shared;
-  reportProgress(progress, 0.9, "writing");
+std::vector<std::pair<std::string, io::LayerWrite>> writeStreetLayers(io::OutputDirectory& out,
+                                                                      const StreetNetwork& network,
+                                                                      const ObservedData* observed) {
   const io::LocalFrame& frame = network.layer.frame;
   const io::CrsInfo& crs = network.layer.crs;
   std::vector<std::vector<Polygon>> outlines;
   for (const analysis::StreetBlock& b : network.blocks.blocks) outlines.push_back({b.shape});
-  const ObservedData* withParcels = nullptr;
-  if (parcels) {
-    assignToStreetBlocks(observed, shared, analysis::analysisOptionsFrom(parameters).bounds());
-    withParcels = &observed;
-  }
   const io::LayerWrite blocksWritten = io::writePolygonLayer(out.stage("blocks.gpkg"), "blocks", outlines,
-                                                             streetBlockTable(network, withParcels), frame, crs);
+                                                             streetBlockTable(network, observed), frame, crs);
   std::vector<Point> nodes;
   for (const analysis::RoadNode& n : network.graph.nodes) nodes.push_back(n.at);
   std::vector<std::vector<Point>> edges;
@@ -361,13 +350,31 @@ JobOutcome writeBlocks(io::OutputDirectory& out, const io::StreetReadOptions& st
   for (std::size_t i = 0; i < surface.size(); ++i) surfaceTable.rows.push_back({static_cast<std::int64_t>(i)});
   const io::LayerWrite surfaceWritten =
       io::writePolygonLayer(out.stage("street_surface.gpkg"), "surface", surface, surfaceTable, frame, crs);
+  return {{"blocks.gpkg", blocksWritten}, {"street_surface.gpkg", surfaceWritten}};
+}
 
+namespace {
+
+JobOutcome writeBlocks(io::OutputDirectory& out, const io::StreetReadOptions& streets,
+                       const ParameterValues& parameters, const io::ReadOptions* parcels, const ProgressFn& progress) {
+  ObservedData observed;
+  if (parcels) observed = loadObserved(*parcels, parameters, scaledProgress(progress, 0.0, 0.4));
+  const auto shared = std::make_shared<const StreetNetwork>(buildStreetNetwork(
+      streets, parameters, parcels ? &observed : nullptr, scaledProgress(progress, parcels ? 0.4 : 0.0, 0.9)));
+  const StreetNetwork& network = *shared;
+  reportProgress(progress, 0.9, "writing");
+  const ObservedData* withParcels = nullptr;
+  if (parcels) {
+    assignToStreetBlocks(observed, shared, analysis::analysisOptionsFrom(parameters).bounds());
+    withParcels = &observed;
+  }
+  const auto written = writeStreetLayers(out, network, withParcels);
   Json run = runRecord("blocks", parameters);
   run.set("streets", streetRecord(network));
   if (parcels) {
     addObservedRecord(run, observed);
   }
-  run.set("written", writtenLayersJson({{"blocks.gpkg", blocksWritten}, {"street_surface.gpkg", surfaceWritten}}));
+  run.set("written", writtenLayersJson(written));
   run.set("outputs",
           Json::array().push("blocks.gpkg").push("streets.gpkg").push("street_surface.gpkg").push("run.json"));
   io::writeJson(out.stage("run.json"), run);

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "OgrTestUtil.h"
@@ -247,6 +248,64 @@ TEST(BlocksCommand, BadStreetInputsAreOneLineErrors) {
     // One line; a usage error adds where to find the usage.
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), c.code == 2 ? 2 : 1) << r.output;
   }
+}
+
+// `parcelscope edit`: edits in the input's CRS (lon/lat here) by the keys
+// streets.gpkg gives; the parcels written are valid, keyed and labelled, and
+// persistence.csv counts what each edit kept. A bad edit writes nothing.
+TEST(EditCommand, EditsByKeyInTheInputsCrsAndWritesValidParcelsAndPersistence) {
+  TempDir dir;
+  const std::string streets = dir.write("streets.geojson", geojson(network(), false));
+  ASSERT_EQ(run("blocks '" + streets + "'" + kFlags + " --out '" + dir.file("net") + "'").code, 0);
+  auto ds = test::openVectorFile(dir.file("net") + "/streets.gpkg");
+  ASSERT_TRUE(ds);
+  std::string node, edge;
+  double lon = 0, lat = 0;
+  for (auto& f : *ds->GetLayerByName("nodes")) {
+    if (f->GetFieldAsInteger("degree") == 4 && node.empty()) {
+      node = f->GetFieldAsString("node_key");
+      const OGRPoint* p = f->GetGeometryRef()->toPoint();
+      lon = p->getX();
+      lat = p->getY();
+    }
+  }
+  for (auto& f : *ds->GetLayerByName("edges")) {
+    if (std::string(f->GetFieldAsString("kind")) == "street" && edge.empty()) edge = f->GetFieldAsString("edge_key");
+  }
+  ASSERT_FALSE(node.empty());
+  ASSERT_FALSE(edge.empty());
+  std::ostringstream edits;
+  edits.precision(12);
+  edits << R"([{"op": "move_node", "node": ")" << node << R"(", "to": [)" << lon + 2 / 82200.0 << ", " << lat
+        << R"(]}, {"op": "set_width", "edge": ")" << edge << R"(", "width": 14}])";
+  const std::string editsFile = dir.write("edits.json", edits.str());
+  const CliRun r = run("edit '" + streets + "'" + kFlags + " --style skeleton --edits '" + editsFile + "' --out '" +
+                       dir.file("edited") + "'");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const OGRSpatialReference crs = test::layerCrs(streets);
+  const test::ReadLayer blocks =
+      test::expectValidPolygonLayer(dir.file("edited") + "/blocks.gpkg", 20, {"blocks", {"block_key"}, &crs});
+  const std::string csv = slurp(dir.file("edited") + "/persistence.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3) << csv;
+  EXPECT_NE(csv.find("move_node"), std::string::npos);
+  EXPECT_NE(csv.find("set_width"), std::string::npos);
+  auto parcels = test::openVectorFile(dir.file("edited") + "/parcels.gpkg");
+  ASSERT_TRUE(parcels);
+  const std::int64_t n = parcels->GetLayer(0)->GetFeatureCount();
+  ASSERT_GT(n, 20);
+  const test::ReadLayer written = test::expectValidPolygonLayer(dir.file("edited") + "/parcels.gpkg", n,
+                                                                {"parcels", {"parcel_key", "label"}, &crs});
+  std::set<std::string> keys;
+  for (const auto& f : written.features) keys.insert(f->GetFieldAsString("parcel_key"));
+  EXPECT_EQ(static_cast<std::int64_t>(keys.size()), n);  // unique
+
+  // An edit naming a node the network does not have: one line naming the file and the edit, nothing written.
+  const std::string bad = dir.write("bad.json", R"([{"op": "move_node", "node": "0123456789abcdef", "to": [0, 0]}])");
+  const CliRun b = run("edit '" + streets + "'" + kFlags + " --edits '" + bad + "' --out '" + dir.file("bad") + "'");
+  EXPECT_NE(b.code, 0);
+  EXPECT_NE(b.output.find("bad.json: edit 0 (move_node): the network has no node 0123456789abcdef"), std::string::npos)
+      << b.output;
+  EXPECT_FALSE(fs::exists(dir.file("bad")));
 }
 
 }  // namespace

@@ -266,11 +266,37 @@ TEST(ParcelMatching, TiesGoToTheLowerIndices) {
   EXPECT_EQ(m.before, (std::vector<int>{0, 1, -1}));
 }
 
-TEST(ParcelMatching, UncorrespondedContoursMatchNothing) {
+TEST(ParcelMatching, ADegenerateBlockMatchesNothing) {
   const std::vector<Polygon> lots{rect(0, 0, 10, 10), rect(10, 0, 20, 10)};
   const ParcelMatches m = matchParcels(rect(0, 0, 20, 10), lots, poly({{0, 0}, {10, 0}, {20, 0}}), lots);
   EXPECT_EQ(m.before, (std::vector<int>{-1, -1}));
   EXPECT_EQ(m.distance, (std::vector<double>{-1, -1}));
+}
+
+// Contours that cannot be put in correspondence (a square, and a triangle
+// with two corners by one of the square's: fewer than 3 mutual nearest
+// vertices) match parcels by their place relative to the block's centroid,
+// in units of the square root of its area.
+TEST(ParcelMatching, UncorrespondedContoursMatchByPlaceAroundTheCentroid) {
+  const Polygon before = rect(-50, -50, 50, 50);
+  Polygon after;
+  for (double degrees : {25.0, 65.0, 225.0}) {
+    const double a = degrees * M_PI / 180;
+    after.outer.push_back({80 * std::cos(a), 80 * std::sin(a)});
+  }
+  ASSERT_TRUE(correspondContours(matchingContour(before.outer), matchingContour(after.outer)).empty());
+  const Point ob = centroid(before), oa = centroid(after);
+  const double ub = std::sqrt(area(before)), ua = std::sqrt(area(after));
+  std::vector<Polygon> lotsBefore, lotsAfter;
+  for (int i = 0; i < 6; ++i) {
+    const double x = 0.1 * (i % 3) - 0.1, y = 0.12 * (i / 3) - 0.06;
+    lotsBefore.push_back(rect(ob.x + x * ub - 1, ob.y + y * ub - 1, ob.x + x * ub + 1, ob.y + y * ub + 1));
+    lotsAfter.push_back(rect(oa.x + x * ua - 1, oa.y + y * ua - 1, oa.x + x * ua + 1, oa.y + y * ua + 1));
+  }
+  std::reverse(lotsAfter.begin(), lotsAfter.end());
+  const ParcelMatches m = matchParcels(before, lotsBefore, after, lotsAfter);
+  EXPECT_EQ(m.before, (std::vector<int>{5, 4, 3, 2, 1, 0}));
+  for (double d : m.distance) EXPECT_NEAR(d, 0, 1e-9);
 }
 
 /// `block` with one corner of its matching contour moved by `distance` in a

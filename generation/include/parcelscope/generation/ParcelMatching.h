@@ -79,7 +79,8 @@ struct ParcelMatches {
   /// Index of the matched parcel before the edit, or -1: no parcel before is
   /// used twice, so parcels after beyond the count before stay unmatched.
   std::vector<int> before;
-  /// positionDistance to the matched parcel; -1 when unmatched.
+  /// positionDistance to the matched parcel (or the fallback's distance, see
+  /// matchParcels); -1 when unmatched.
   std::vector<double> distance;
 };
 
@@ -91,8 +92,11 @@ struct ParcelMatches {
 /// must stay unique, so here the pairs are taken one to one, greedily by
 /// increasing distance (ties to the lower index after, then before): a pair
 /// of strictly mutually nearest parcels is always matched, as in the paper.
-/// Every parcel after is unmatched when the contours cannot be corresponded.
-/// Deterministic.
+/// When the contours cannot be corresponded (a street's width or a node's
+/// move changed the block's outline beyond a vertex added or removed), a
+/// parcel's position is its centre relative to the block's area centroid, in
+/// units of the square root of the block's area, and the distance Euclidean
+/// (`distance` is then in those units). Deterministic.
 ParcelMatches matchParcels(const Polygon& blockBefore, const std::vector<Polygon>& parcelsBefore,
                            const Polygon& blockAfter, const std::vector<Polygon>& parcelsAfter);
 

@@ -43,6 +43,11 @@ std::unique_ptr<BlockSource> observedParcelBlocks(const io::ReadOptions& input, 
 /// gives the key otherwise).
 std::unique_ptr<BlockSource> blockLayer(const io::ReadOptions& input);
 
+/// The blocks of a street network without observed parcels: one entry per
+/// street block (its index as id, its key, the run's values for its bounds)
+/// with the widths of the streets it faces.
+BlockInputs streetNetworkInputs(std::shared_ptr<const StreetNetwork> network);
+
 /// The source a generate request names: the street network with `streets`
 /// (its blocks, observed parcels of `input` assigned to them with fromParcels),
 /// else observedParcelBlocks with fromParcels, else blockLayer.

@@ -13,7 +13,9 @@
 #include "parcelscope/core/Parameter.h"
 #include "parcelscope/core/Table.h"
 #include "parcelscope/core/Timings.h"
+#include "parcelscope/io/OutputDirectory.h"
 #include "parcelscope/io/StreetReader.h"
+#include "parcelscope/io/Writers.h"
 #include "parcelscope/pipeline/StatsJob.h"
 
 namespace parcelscope::pipeline {
@@ -71,6 +73,14 @@ Table streetEdgeTable(const StreetNetwork& network);
 /// The run record's "streets" section: the layer read, the graph's counts and
 /// the blocks'.
 Json streetRecord(const StreetNetwork& network);
+
+/// Writes `network` into `out`'s staging folder: blocks.gpkg (layer `blocks`,
+/// streetBlockTable with `observed`), streets.gpkg (layers `nodes` and `edges`)
+/// and street_surface.gpkg (layer `surface`), in the network's frame and CRS.
+/// Returns the polygon layers written, for the run record.
+std::vector<std::pair<std::string, io::LayerWrite>> writeStreetLayers(io::OutputDirectory& out,
+                                                                      const StreetNetwork& network,
+                                                                      const ObservedData* observed = nullptr);
 
 /// `parcelscope blocks`: builds the network (widths measured from `parcels`
 /// when given) and writes, all at once when complete, DIR/blocks.gpkg (layer

@@ -1,0 +1,626 @@
+#include "parcelscope/pipeline/StreetEditor.h"
+
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <set>
+#include <sstream>
+#include <utility>
+
+#include "parcelscope/core/Error.h"
+#include "parcelscope/core/GeosOps.h"
+#include "parcelscope/core/Parallel.h"
+#include "parcelscope/generation/ParcelMatching.h"
+#include "parcelscope/generation/Styles.h"
+#include "parcelscope/io/OutputDirectory.h"
+#include "parcelscope/io/Writers.h"
+#include "parcelscope/pipeline/BlockSource.h"
+
+namespace parcelscope::pipeline {
+
+const char* editOpName(StreetEdit::Op op) {
+  switch (op) {
+    case StreetEdit::Op::MoveNode:
+      return "move_node";
+    case StreetEdit::Op::MoveEdge:
+      return "move_edge";
+    case StreetEdit::Op::SetWidth:
+      return "set_width";
+    case StreetEdit::Op::SetCurve:
+      return "set_curve";
+    case StreetEdit::Op::TransformNodes:
+      return "transform_nodes";
+    case StreetEdit::Op::SetBlock:
+      return "set_block";
+  }
+  return "?";
+}
+
+// One state of the document: what an undo goes back to, whole.
+struct StreetEditor::State {
+  std::shared_ptr<const StreetNetwork> network;
+  BlockInputs inputs;
+  std::vector<BlockPlan> plans;
+  std::vector<std::shared_ptr<const BlockOutcome>> outcomes;  // per entry; shared with the states before
+  std::vector<std::vector<Key>> entryKeys;                    // per entry, its parcels' keys
+  BlockOverrides overrides;
+  std::map<Key, std::string> labels;  // by parcel key
+  GeneratedParcels parcels;
+  std::vector<Key> parcelKeys;  // of parcels.parcels
+};
+
+namespace {
+
+bool sameRing(const Ring& a, const Ring& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i].x != b[i].x || a[i].y != b[i].y) return false;
+  }
+  return true;
+}
+
+bool sameShape(const Polygon& a, const Polygon& b) {
+  if (!sameRing(a.outer, b.outer) || a.holes.size() != b.holes.size()) return false;
+  for (std::size_t h = 0; h < a.holes.size(); ++h) {
+    if (!sameRing(a.holes[h], b.holes[h])) return false;
+  }
+  return true;
+}
+
+bool sameWidths(const StreetWidths& a, const StreetWidths& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t r = 0; r < a.size(); ++r) {
+    if (a[r].size() != b[r].size()) return false;
+    for (std::size_t i = 0; i < a[r].size(); ++i) {
+      const double x = a[r][i], y = b[r][i];
+      if (!(x == y || (std::isnan(x) && std::isnan(y)))) return false;
+    }
+  }
+  return true;
+}
+
+// Key of a parcel that inherits none: its block part's key, the edit that made
+// it (0: the first build) and its index in the block.
+Key freshKey(Key blockKey, int part, std::uint64_t serial, std::size_t index) {
+  return mixKeys(mixKeys(partKey(blockKey, part), serial), static_cast<Key>(index));
+}
+
+std::size_t indexOf(const std::vector<analysis::RoadNode>& nodes, Key key) {
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    if (nodes[i].key == key) return i;
+  }
+  throw usageError("the network has no node " + keyText(key));
+}
+
+std::size_t indexOf(const std::vector<analysis::RoadEdge>& edges, Key key) {
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    if (edges[i].key == key) return i;
+  }
+  throw usageError("the network has no edge " + keyText(key));
+}
+
+// Moves the nodes of `graph` by `move` (a node's new position from its old),
+// the ends of the edges at them with them; the inner vertices and control
+// points of edges whose ends both move, moved the same way.
+void moveNodes(analysis::RoadGraph& graph, const std::set<std::size_t>& nodes,
+               const std::function<Point(const Point&)>& move) {
+  for (std::size_t n : nodes) graph.nodes[n].at = move(graph.nodes[n].at);
+  for (std::size_t e = 0; e < graph.edges.size(); ++e) {
+    analysis::RoadEdge& edge = graph.edges[e];
+    const bool from = nodes.count(static_cast<std::size_t>(edge.from)) > 0;
+    const bool to = nodes.count(static_cast<std::size_t>(edge.to)) > 0;
+    if (!from && !to) continue;
+    if (from && to) {
+      for (Point& p : edge.line) p = move(p);
+      if (edge.controls) {
+        for (Point& c : *edge.controls) c = move(c);
+      }
+    }
+    if (edge.controls) {
+      analysis::setCurve(graph, e, edge.controls);  // flattened again between its nodes
+      continue;
+    }
+    edge.line.front() = graph.nodes[static_cast<std::size_t>(edge.from)].at;
+    edge.line.back() = graph.nodes[static_cast<std::size_t>(edge.to)].at;
+  }
+}
+
+}  // namespace
+
+std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<const StreetNetwork> network,
+                                                               BlockOverrides overrides,
+                                                               std::map<Key, std::string> labels, const State* previous,
+                                                               EditReport* report) const {
+  auto s = std::make_shared<State>();
+  s->network = network;
+  s->inputs = streetNetworkInputs(network);
+  // An override stays with its block's key; a block gone takes its override with it.
+  std::set<Key> keys;
+  for (const BlockInputs::Entry& e : s->inputs.entries) keys.insert(e.blockKey);
+  for (auto it = overrides.begin(); it != overrides.end();) {
+    it = keys.count(it->first) ? std::next(it) : overrides.erase(it);
+  }
+  GenerateRequest r = request_;
+  r.overrides = overrides;
+  r.overridesById.clear();
+  s->plans = planBlocks(r, s->inputs);
+  s->overrides = std::move(overrides);
+
+  // Each entry's counterpart before: the same block part (key and part).
+  std::map<std::pair<Key, int>, std::size_t> before;
+  if (previous) {
+    for (std::size_t k = 0; k < previous->inputs.entries.size(); ++k) {
+      const BlockInputs::Entry& e = previous->inputs.entries[k];
+      before.emplace(std::make_pair(e.blockKey, e.part), k);
+    }
+  }
+  const std::size_t n = s->inputs.entries.size();
+  s->outcomes.resize(n);
+  s->entryKeys.resize(n);
+  std::vector<std::size_t> todo;
+  std::vector<long> counterpart(n, -1);
+  for (std::size_t k = 0; k < n; ++k) {
+    const BlockInputs::Entry& e = s->inputs.entries[k];
+    const auto it = before.find({e.blockKey, e.part});
+    if (it != before.end()) {
+      const std::size_t p = it->second;
+      counterpart[k] = static_cast<long>(p);
+      if (sameShape(e.shape, previous->inputs.entries[p].shape) &&
+          sameWidths(s->inputs.widths[k], previous->inputs.widths[p]) && s->plans[k] == previous->plans[p]) {
+        s->outcomes[k] = previous->outcomes[p];
+        s->entryKeys[k] = previous->entryKeys[p];
+        continue;
+      }
+    }
+    todo.push_back(k);
+  }
+  // A block whose key is new (its faces or the streets it faces changed)
+  // inherits from the block gone from the network that it overlaps most.
+  std::vector<std::size_t> gone;
+  if (previous) {
+    for (std::size_t p = 0; p < previous->inputs.entries.size(); ++p) {
+      if (keys.count(previous->inputs.entries[p].blockKey) == 0) gone.push_back(p);
+    }
+  }
+  for (std::size_t k : todo) {
+    if (counterpart[k] >= 0 || gone.empty()) continue;
+    const Polygon& shape = s->inputs.entries[k].shape;
+    const Box box = bounds(shape);
+    double most = 0;
+    for (std::size_t p : gone) {
+      const Polygon& old = previous->inputs.entries[p].shape;
+      const Box b = bounds(old);
+      if (b.minX > box.maxX || box.minX > b.maxX || b.minY > box.maxY || box.minY > b.maxY) continue;
+      const double shared = geos::intersectionArea(shape, old);
+      if (shared > most) {
+        most = shared;
+        counterpart[k] = static_cast<long>(p);
+      }
+    }
+  }
+
+  const double minFrontage = generation::obbParametersFrom(request_.parameters).minFrontage;
+  auto lap = std::chrono::steady_clock::now();
+  auto seconds = [&lap] {
+    const auto now = std::chrono::steady_clock::now();
+    return std::chrono::duration<double>(now - std::exchange(lap, now)).count();
+  };
+  parallelFor(todo.size(), [&](std::size_t t) {
+    const std::size_t k = todo[t];
+    s->outcomes[k] = std::make_shared<const BlockOutcome>(runBlock(s->inputs, k, s->plans[k], minFrontage));
+  });
+
+  const double subdivideSeconds = seconds();
+  // Keys: a regenerated block's parcels inherit those of the parcels they
+  // match in its counterpart; a key goes to one parcel only (a block split in
+  // two passes each key to one of them).
+  std::set<Key> kept;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (s->outcomes[k] && std::find(todo.begin(), todo.end(), k) == todo.end()) {
+      kept.insert(s->entryKeys[k].begin(), s->entryKeys[k].end());
+    }
+  }
+  std::int64_t parcelsAfter = 0, matched = 0;
+  std::set<std::size_t> involved;  // entries before whose parcels were replaced
+  for (std::size_t k : todo) {
+    const BlockInputs::Entry& e = s->inputs.entries[k];
+    const std::vector<Polygon>& now = s->outcomes[k]->subdivision.parcels;
+    std::vector<Key>& out = s->entryKeys[k];
+    out.resize(now.size());
+    for (std::size_t i = 0; i < now.size(); ++i) out[i] = freshKey(e.blockKey, e.part, serial_, i);
+    parcelsAfter += static_cast<std::int64_t>(now.size());
+    if (counterpart[k] < 0) continue;
+    const std::size_t p = static_cast<std::size_t>(counterpart[k]);
+    involved.insert(p);
+    const std::vector<Polygon>& then = previous->outcomes[p]->subdivision.parcels;
+    const generation::ParcelMatches m = generation::matchParcels(previous->inputs.entries[p].shape, then, e.shape, now);
+    for (std::size_t i = 0; i < now.size(); ++i) {
+      if (m.before[i] < 0) continue;
+      const Key inherited = previous->entryKeys[p][static_cast<std::size_t>(m.before[i])];
+      if (!kept.insert(inherited).second) continue;
+      out[i] = inherited;
+      ++matched;
+    }
+  }
+  for (std::size_t p : gone) involved.insert(p);
+  if (report) {
+    report->secondsSubdivide = subdivideSeconds;
+    report->secondsMatch = seconds();
+    for (std::size_t p : involved) {
+      report->parcelsBefore += static_cast<std::int64_t>(previous->outcomes[p]->subdivision.parcels.size());
+    }
+    report->parcelsAfter = parcelsAfter;
+    report->matched = matched;
+    for (std::size_t k : todo) report->blocksAffected.push_back(s->inputs.entries[k].blockKey);
+    for (std::size_t p : gone) report->blocksRemoved.push_back(previous->inputs.entries[p].blockKey);
+    for (auto* list : {&report->blocksAffected, &report->blocksRemoved}) {
+      std::sort(list->begin(), list->end());
+      list->erase(std::unique(list->begin(), list->end()), list->end());
+    }
+  }
+
+  std::vector<const BlockOutcome*> pointers;
+  for (const auto& o : s->outcomes) pointers.push_back(o.get());
+  s->parcels =
+      assembleParcels(s->inputs, s->plans, pointers, static_cast<std::uint64_t>(request_.parameters.at("seed")));
+  s->parcelKeys.assign(s->parcels.parcels.size(), 0);
+  for (std::size_t k = 0; k < s->parcels.blocks.size(); ++k) {
+    const std::vector<int>& indices = s->parcels.blocks[k].parcels;
+    for (std::size_t i = 0; i < indices.size() && i < s->entryKeys[k].size(); ++i) {
+      s->parcelKeys[static_cast<std::size_t>(indices[i])] = s->entryKeys[k][i];
+    }
+  }
+  // Labels follow their parcels' keys; a parcel gone takes its label with it.
+  const std::set<Key> present(s->parcelKeys.begin(), s->parcelKeys.end());
+  for (auto it = labels.begin(); it != labels.end();) it = present.count(it->first) ? std::next(it) : labels.erase(it);
+  s->labels = std::move(labels);
+  return s;
+}
+
+StreetEditor::StreetEditor(const GenerateRequest& request, const ProgressFn& progress) : request_(request) {
+  if (!request_.streets) throw usageError("editing needs a street network (--streets)");
+  if (request_.fromParcels) throw usageError("editing works on a street network without observed parcels");
+  for (const ParameterDescription& d : streetParameters()) request_.parameters.emplace(d.name, d.defaultValue);
+  request_.parameters.emplace("seed", 1.0);
+  auto network = std::make_shared<const StreetNetwork>(
+      buildStreetNetwork(*request_.streets, request_.parameters, nullptr, scaledProgress(progress, 0, 0.5)));
+  current_ = build(network, request_.overrides, {}, nullptr, nullptr);
+  reportProgress(progress, 1.0, "subdividing");
+}
+
+StreetEditor::~StreetEditor() = default;
+
+EditReport StreetEditor::apply(const StreetEdit& edit) {
+  const auto started = std::chrono::steady_clock::now();
+  EditReport report;
+  report.op = editOpName(edit.op);
+  const State& now = *current_;
+  BlockOverrides overrides = now.overrides;
+  std::shared_ptr<const StreetNetwork> network = now.network;
+  if (edit.op == StreetEdit::Op::SetBlock) {
+    if (std::none_of(now.inputs.entries.begin(), now.inputs.entries.end(),
+                     [&](const BlockInputs::Entry& e) { return e.blockKey == edit.block; })) {
+      throw usageError("the network has no block " + keyText(edit.block));
+    }
+    if (edit.style.empty() && edit.parameters.empty()) {
+      overrides.erase(edit.block);
+    } else {
+      overrides[edit.block] = {edit.style, edit.parameters};
+    }
+  } else {
+    auto edited = std::make_shared<StreetNetwork>(*network);
+    analysis::RoadGraph& g = edited->graph;
+    switch (edit.op) {
+      case StreetEdit::Op::MoveNode: {
+        const Point to = edit.to;
+        moveNodes(g, {indexOf(g.nodes, edit.node)}, [&](const Point&) { return to; });
+        break;
+      }
+      case StreetEdit::Op::MoveEdge: {
+        const std::size_t e = indexOf(g.edges, edit.edge);
+        const Point by = edit.by;
+        auto move = [&](const Point& p) { return Point{p.x + by.x, p.y + by.y}; };
+        moveNodes(g, {static_cast<std::size_t>(g.edges[e].from), static_cast<std::size_t>(g.edges[e].to)}, move);
+        break;
+      }
+      case StreetEdit::Op::SetWidth: {
+        const std::size_t e = indexOf(g.edges, edit.edge);
+        if (!std::isfinite(edit.width) || edit.width <= 0) {
+          throw usageError("edge " + keyText(edit.edge) + ": a width must be a positive number of metres");
+        }
+        if (g.edges[e].boundary)
+          throw usageError("edge " + keyText(edit.edge) + " is the study area's edge, not a street");
+        g.edges[e].width = edit.width;
+        break;
+      }
+      case StreetEdit::Op::SetCurve:
+        analysis::setCurve(g, indexOf(g.edges, edit.edge), edit.controls);
+        break;
+      case StreetEdit::Op::TransformNodes: {
+        if (!(edit.scale > 0) || !std::isfinite(edit.scale) || !std::isfinite(edit.rotate)) {
+          throw usageError("transform_nodes: the scale must be positive and the rotation finite");
+        }
+        std::set<std::size_t> nodes;
+        for (Key k : edit.nodes) nodes.insert(indexOf(g.nodes, k));
+        const double a = edit.rotate * M_PI / 180.0, c = std::cos(a) * edit.scale, s = std::sin(a) * edit.scale;
+        const Point o = edit.centre, by = edit.by;
+        moveNodes(g, nodes, [&](const Point& p) {
+          const double x = p.x - o.x, y = p.y - o.y;
+          return Point{o.x + c * x - s * y + by.x, o.y + s * x + c * y + by.y};
+        });
+        break;
+      }
+      case StreetEdit::Op::SetBlock:
+        break;
+    }
+    analysis::StreetBlockOptions options;
+    options.maxArea = request_.parameters.at("max-block-area");
+    const auto blocksStarted = std::chrono::steady_clock::now();
+    edited->blocks = analysis::streetBlocks(g, options);
+    report.secondsBlocks = std::chrono::duration<double>(std::chrono::steady_clock::now() - blocksStarted).count();
+    network = std::move(edited);
+  }
+  ++serial_;
+  std::shared_ptr<const State> next = build(network, std::move(overrides), now.labels, &now, &report);
+  undo_.push_back(current_);
+  redo_.clear();
+  current_ = std::move(next);
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return report;
+}
+
+namespace {
+
+// Moves the current state onto `onto` and takes the last of `from` as current.
+template <typename Stack, typename State>
+bool step(Stack& from, Stack& onto, State& current) {
+  if (from.empty()) return false;
+  onto.push_back(std::move(current));
+  current = std::move(from.back());
+  from.pop_back();
+  return true;
+}
+
+}  // namespace
+
+bool StreetEditor::undo() { return step(undo_, redo_, current_); }
+bool StreetEditor::redo() { return step(redo_, undo_, current_); }
+
+std::size_t StreetEditor::undoSize() const { return undo_.size(); }
+std::size_t StreetEditor::redoSize() const { return redo_.size(); }
+
+void StreetEditor::setLabel(Key parcel, const std::string& label) {
+  const State& now = *current_;
+  if (std::find(now.parcelKeys.begin(), now.parcelKeys.end(), parcel) == now.parcelKeys.end()) {
+    throw usageError("no parcel " + keyText(parcel));
+  }
+  auto next = std::make_shared<State>(now);
+  if (label.empty()) {
+    next->labels.erase(parcel);
+  } else {
+    next->labels[parcel] = label;
+  }
+  undo_.push_back(current_);
+  redo_.clear();
+  current_ = std::move(next);
+}
+
+GeneratedParcels StreetEditor::freshParcels() const {
+  return build(current_->network, current_->overrides, {}, nullptr, nullptr)->parcels;
+}
+
+const StreetNetwork& StreetEditor::network() const { return *current_->network; }
+const GeneratedParcels& StreetEditor::parcels() const { return current_->parcels; }
+const std::vector<Key>& StreetEditor::parcelKeys() const { return current_->parcelKeys; }
+const std::map<Key, std::string>& StreetEditor::labels() const { return current_->labels; }
+const BlockOverrides& StreetEditor::overrides() const { return current_->overrides; }
+Point StreetEditor::toLocal(const Point& source) const {
+  return current_->network->layer.frame.toLocal(source.x, source.y);
+}
+
+namespace {
+
+// One edit of an edits file; `where` names it in errors.
+StreetEdit readEdit(const Json& j, const std::string& where, const std::function<Point(const Point&)>& toLocal) {
+  auto bad = [&](const std::string& what) { return inputError(where + ": " + what); };
+  if (!j.isObject()) throw bad("an edit is an object {\"op\": ...}");
+  auto member = [&](const char* name) -> const Json& {
+    const Json* v = j.find(name);
+    if (!v || v->isNull()) throw bad(std::string("member ") + name + " is missing");
+    return *v;
+  };
+  auto number = [&](const char* name) {
+    const Json& v = member(name);
+    if (!v.isNumber()) throw bad(std::string("member ") + name + " is not a number");
+    return v.number();
+  };
+  auto key = [&](const Json& v, const std::string& name) {
+    const std::optional<Key> k = v.isString() ? parseKey(v.string()) : std::nullopt;
+    if (!k) throw bad("member " + name + " is not a key (16 hexadecimal digits)");
+    return *k;
+  };
+  auto point = [&](const Json& v, const std::string& name, bool local) {
+    const std::vector<Json> xy = v.elements();
+    if (!v.isArray() || xy.size() != 2 || !xy[0].isNumber() || !xy[1].isNumber()) {
+      throw bad("member " + name + " is not a point [x, y]");
+    }
+    const Point p{xy[0].number(), xy[1].number()};
+    return local ? toLocal(p) : p;
+  };
+  // A displacement in the input's CRS: the difference of two converted points.
+  auto vector = [&](const Json& v, const std::string& name) {
+    const Point d = point(v, name, false);
+    const Point a = toLocal({0, 0}), b = toLocal(d);
+    return Point{b.x - a.x, b.y - a.y};
+  };
+  const Json& op = member("op");
+  if (!op.isString()) throw bad("member op is not a string");
+  StreetEdit e;
+  const std::string& name = op.string();
+  if (name == "move_node") {
+    e.op = StreetEdit::Op::MoveNode;
+    e.node = key(member("node"), "node");
+    e.to = point(member("to"), "to", true);
+  } else if (name == "move_edge") {
+    e.op = StreetEdit::Op::MoveEdge;
+    e.edge = key(member("edge"), "edge");
+    e.by = vector(member("by"), "by");
+  } else if (name == "set_width") {
+    e.op = StreetEdit::Op::SetWidth;
+    e.edge = key(member("edge"), "edge");
+    e.width = number("width");
+  } else if (name == "set_curve") {
+    e.op = StreetEdit::Op::SetCurve;
+    e.edge = key(member("edge"), "edge");
+    if (const Json* c = j.find("controls"); c && !c->isNull()) {
+      const std::vector<Json> pair = c->elements();
+      if (pair.size() != 2) throw bad("member controls is not two points");
+      e.controls = std::array<Point, 2>{point(pair[0], "controls", true), point(pair[1], "controls", true)};
+    }
+  } else if (name == "transform_nodes") {
+    e.op = StreetEdit::Op::TransformNodes;
+    const Json& nodes = member("nodes");
+    if (!nodes.isArray()) throw bad("member nodes is not a list of keys");
+    for (const Json& n : nodes.elements()) e.nodes.push_back(key(n, "nodes"));
+    e.centre = j.find("centre") ? point(member("centre"), "centre", true) : toLocal({0, 0});
+    if (j.find("by")) e.by = vector(member("by"), "by");
+    if (j.find("rotate")) e.rotate = number("rotate");
+    if (j.find("scale")) e.scale = number("scale");
+  } else if (name == "set_block") {
+    e.op = StreetEdit::Op::SetBlock;
+    e.block = key(member("block"), "block");
+    if (const Json* st = j.find("style"); st && !st->isNull()) {
+      if (!st->isString()) throw bad("member style is not a string");
+      e.style = st->string();
+    }
+    if (const Json* ps = j.find("parameters"); ps && !ps->isNull()) {
+      if (!ps->isObject()) throw bad("member parameters is not an object");
+      for (const auto& [k, v] : ps->members()) {
+        if (!v.isNumber()) throw bad("parameter " + k + " is not a number");
+        e.parameters[k] = v.number();
+      }
+    }
+  } else {
+    throw bad("op '" + name +
+              "' is not an edit (move_node, move_edge, set_width, set_curve, transform_nodes, set_block)");
+  }
+  return e;
+}
+
+}  // namespace
+
+std::vector<StreetEdit> readEdits(const std::string& path, const std::function<Point(const Point&)>& toLocal) {
+  const Json root = io::readJson(path);
+  if (!root.isArray()) throw inputError(path + ": an edits file holds a list of edits");
+  std::vector<StreetEdit> edits;
+  const std::vector<Json> list = root.elements();
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    edits.push_back(readEdit(list[i], path + ": edit " + std::to_string(i), toLocal));
+  }
+  return edits;
+}
+
+Table persistenceTable(const std::vector<EditReport>& reports) {
+  Table t;
+  using T = Column::Type;
+  t.columns = {{"edit", T::Integer, ""},
+               {"op", T::String, ""},
+               {"blocks_affected", T::Integer, ""},
+               {"blocks_removed", T::Integer, ""},
+               {"parcels_before", T::Integer, ""},
+               {"parcels_after", T::Integer, ""},
+               {"keys_kept", T::Integer, ""},
+               {"keys_kept_share", T::Real, ""},
+               {"seconds", T::Real, "s"},
+               {"seconds_blocks", T::Real, "s"},
+               {"seconds_subdivide", T::Real, "s"},
+               {"seconds_match", T::Real, "s"},
+               {"affected_block_keys", T::String, ""}};
+  for (std::size_t i = 0; i < reports.size(); ++i) {
+    const EditReport& r = reports[i];
+    std::string keys;
+    for (Key k : r.blocksAffected) keys += (keys.empty() ? "" : ";") + keyText(k);
+    t.rows.push_back(
+        {static_cast<std::int64_t>(i), r.op, static_cast<std::int64_t>(r.blocksAffected.size()),
+         static_cast<std::int64_t>(r.blocksRemoved.size()), r.parcelsBefore, r.parcelsAfter, r.matched,
+         r.parcelsBefore > 0 ? static_cast<double>(r.matched) / static_cast<double>(r.parcelsBefore) : std::nan(""),
+         r.seconds, r.secondsBlocks, r.secondsSubdivide, r.secondsMatch, keys});
+  }
+  return t;
+}
+
+Table editedParcelTable(const StreetEditor& editor, std::vector<std::vector<Polygon>>* geometries) {
+  Table t = generatedParcelTable(editor.parcels(), geometries);
+  const std::size_t keyColumn = t.column("parcel_key");
+  t.columns.push_back({"label", Column::Type::String, ""});
+  for (std::size_t i = 0; i < t.rows.size(); ++i) {
+    const Key k = editor.parcelKeys()[i];
+    t.rows[i][keyColumn] = keyText(k);
+    const auto it = editor.labels().find(k);
+    t.rows[i].push_back(it == editor.labels().end() ? std::string() : it->second);
+  }
+  return t;
+}
+
+JobOutcome runEdit(const GenerateRequest& request, const std::string& editsPath, const std::string& outDir,
+                   const ProgressFn& progress) {
+  std::vector<std::string> inputs{editsPath};
+  if (request.streets) inputs.push_back(request.streets->path);
+  io::OutputDirectory out(outDir, inputs);
+  try {
+    StreetEditor editor(request, scaledProgress(progress, 0.0, 0.3));
+    const std::vector<StreetEdit> edits = readEdits(editsPath, [&](const Point& p) { return editor.toLocal(p); });
+    std::vector<EditReport> reports;
+    for (std::size_t i = 0; i < edits.size(); ++i) {
+      reportProgress(progress, 0.3 + 0.6 * static_cast<double>(i) / static_cast<double>(edits.size()), "editing");
+      try {
+        reports.push_back(editor.apply(edits[i]));
+      } catch (const Error& e) {
+        throw Error(e.kind(),
+                    editsPath + ": edit " + std::to_string(i) + " (" + editOpName(edits[i].op) + "): " + e.what());
+      }
+    }
+    reportProgress(progress, 0.9, "writing");
+    std::vector<std::vector<Polygon>> geometries;
+    const Table parcels = editedParcelTable(editor, &geometries);
+    const GeneratedParcels& g = editor.parcels();
+    auto written = writeStreetLayers(out, editor.network());
+    written.emplace_back("parcels.gpkg", io::writePolygonLayer(out.stage("parcels.gpkg"), "parcels", geometries,
+                                                               parcels, g.source->frame, g.source->crs));
+    io::writeCsv(out.stage("persistence.csv"), persistenceTable(reports));
+    Json run = runRecord("edit", request.parameters)
+                   .set("style", request.style)
+                   .set("edits",
+                        Json::object().set("path", editsPath).set("applied", static_cast<std::int64_t>(reports.size())))
+                   .set("counts", Json::object()
+                                      .set("blocks", static_cast<std::int64_t>(g.blocks.size()))
+                                      .set("parcels", static_cast<std::int64_t>(g.parcels.size()))
+                                      .set("labels", static_cast<std::int64_t>(editor.labels().size())));
+    run.set("streets", streetRecord(editor.network()));
+    run.set("written", writtenLayersJson(written));
+    run.set("outputs", Json::array()
+                           .push("parcels.gpkg")
+                           .push("blocks.gpkg")
+                           .push("streets.gpkg")
+                           .push("street_surface.gpkg")
+                           .push("persistence.csv")
+                           .push("run.json"));
+    io::writeJson(out.stage("run.json"), run);
+    out.commit();
+    reportProgress(progress, 1.0, "writing");
+    std::int64_t before = 0, kept = 0;
+    for (const EditReport& r : reports) {
+      before += r.parcelsBefore;
+      kept += r.matched;
+    }
+    std::ostringstream s;
+    s << reports.size() << " edits applied to " << editsPath << "'s network: " << g.blocks.size() << " blocks, "
+      << g.parcels.size() << " parcels; " << kept << " of " << before
+      << " parcels of the blocks the edits subdivided again kept their keys";
+    return {run, s.str()};
+  } catch (const Error& e) {
+    throw out.explain(e);
+  }
+}
+
+}  // namespace parcelscope::pipeline

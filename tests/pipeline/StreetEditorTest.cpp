@@ -1,0 +1,261 @@
+// Editing the street network: only the blocks an edit changes are
+// subdivided again, the others keep their parcels bit for bit; matched
+// parcels keep their keys and labels; undo gives back the state before, bit
+// for bit; the incremental state is the one a fresh build of the edited
+// network gives.
+#include "parcelscope/pipeline/StreetEditor.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+
+#include "TestUtil.h"
+#include "parcelscope/core/Error.h"
+
+namespace parcelscope::pipeline {
+namespace {
+
+GenerateRequest sampleStreets(const std::string& style = "skeleton") {
+  GenerateRequest r;
+  r.streets = io::StreetReadOptions{};
+  r.streets->path = std::string(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_streets.geojson";
+  r.streets->widthField = "width";
+  r.style = style;
+  r.parameters["seed"] = 3;
+  return r;
+}
+
+// Every block's parcels and keys, by block key.
+struct Snapshot {
+  std::map<Key, std::vector<Polygon>> parcels;
+  std::map<Key, std::vector<Key>> keys;
+};
+
+Snapshot snapshot(const StreetEditor& e) {
+  Snapshot s;
+  const GeneratedParcels& g = e.parcels();
+  for (std::size_t b = 0; b < g.blocks.size(); ++b) {
+    for (int i : g.blocks[b].parcels) {
+      s.parcels[g.blockKeys[b]].push_back(g.parcels[static_cast<std::size_t>(i)]);
+      s.keys[g.blockKeys[b]].push_back(e.parcelKeys()[static_cast<std::size_t>(i)]);
+    }
+  }
+  return s;
+}
+
+bool sameParcels(const std::vector<Polygon>& a, const std::vector<Polygon>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!test::sameBits(a[i], b[i])) return false;
+  }
+  return true;
+}
+
+bool sameState(const Snapshot& a, const Snapshot& b) {
+  if (a.parcels.size() != b.parcels.size() || a.keys != b.keys) return false;
+  for (const auto& [key, parcels] : a.parcels) {
+    const auto it = b.parcels.find(key);
+    if (it == b.parcels.end() || !sameParcels(parcels, it->second)) return false;
+  }
+  return true;
+}
+
+// The node of highest degree (an intersection inside the network).
+Key busiestNode(const StreetEditor& e) {
+  const auto& nodes = e.network().graph.nodes;
+  std::size_t best = 0;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    if (nodes[i].degree > nodes[best].degree) best = i;
+  }
+  return nodes[best].key;
+}
+
+StreetEdit moveNodeBy(const StreetEditor& e, Key node, double dx, double dy) {
+  StreetEdit edit;
+  edit.op = StreetEdit::Op::MoveNode;
+  edit.node = node;
+  for (const auto& n : e.network().graph.nodes) {
+    if (n.key == node) edit.to = {n.at.x + dx, n.at.y + dy};
+  }
+  return edit;
+}
+
+TEST(StreetEditor, AMoveRegeneratesOnlyTheBlocksAroundTheNodeAndUndoRestoresEverything) {
+  StreetEditor editor(sampleStreets());
+  const Snapshot before = snapshot(editor);
+  ASSERT_EQ(before.parcels.size(), 10u);
+  const Key node = busiestNode(editor);
+  const EditReport r = editor.apply(moveNodeBy(editor, node, 2, 1));
+  ASSERT_FALSE(r.blocksAffected.empty());
+  EXPECT_LT(r.blocksAffected.size(), before.parcels.size());
+  EXPECT_TRUE(r.blocksRemoved.empty());
+  const Snapshot after = snapshot(editor);
+  // Block keys survive a geometric edit.
+  ASSERT_EQ(after.parcels.size(), before.parcels.size());
+  for (const auto& [key, parcels] : before.parcels) {
+    ASSERT_TRUE(after.parcels.count(key)) << keyText(key);
+    const bool affected = std::binary_search(r.blocksAffected.begin(), r.blocksAffected.end(), key);
+    if (!affected) {
+      EXPECT_TRUE(sameParcels(parcels, after.parcels.at(key))) << keyText(key) << " changed without being affected";
+      EXPECT_EQ(before.keys.at(key), after.keys.at(key));
+    }
+  }
+  // After a 2.2 m move most parcels of the affected blocks keep their key.
+  EXPECT_GT(r.parcelsBefore, 0);
+  EXPECT_GE(static_cast<double>(r.matched), 0.8 * static_cast<double>(std::min(r.parcelsBefore, r.parcelsAfter)))
+      << r.matched << " of " << r.parcelsBefore;
+  // Undo: the state before, bit for bit; redo: the state after.
+  ASSERT_TRUE(editor.undo());
+  EXPECT_TRUE(sameState(snapshot(editor), before));
+  ASSERT_TRUE(editor.redo());
+  EXPECT_TRUE(sameState(snapshot(editor), after));
+  EXPECT_FALSE(editor.redo());
+}
+
+TEST(StreetEditor, RandomEditsGiveWhatAFreshBuildOfTheEditedNetworkGives) {
+  StreetEditor editor(sampleStreets());
+  auto rng = test::seededRandom(11, "street edits");
+  std::uniform_real_distribution<double> shift(-3, 3);
+  std::vector<Key> nodes, edges;
+  for (const auto& n : editor.network().graph.nodes) {
+    if (n.degree >= 3) nodes.push_back(n.key);
+  }
+  for (const auto& e : editor.network().graph.edges) {
+    if (!e.boundary) edges.push_back(e.key);
+  }
+  ASSERT_FALSE(nodes.empty());
+  for (int step = 0; step < 8; ++step) {
+    StreetEdit edit;
+    switch (step % 4) {
+      case 0:
+        edit = moveNodeBy(editor, nodes[rng() % nodes.size()], shift(rng), shift(rng));
+        break;
+      case 1:
+        edit.op = StreetEdit::Op::SetWidth;
+        edit.edge = edges[rng() % edges.size()];
+        edit.width = 8 + std::fabs(shift(rng)) * 3;
+        break;
+      case 2:
+        edit.op = StreetEdit::Op::MoveEdge;
+        edit.edge = edges[rng() % edges.size()];
+        edit.by = {shift(rng), shift(rng)};
+        break;
+      case 3:
+        edit.op = StreetEdit::Op::SetBlock;
+        edit.block = editor.parcels().blockKeys[rng() % editor.parcels().blockKeys.size()];
+        edit.style = step % 2 ? "obb" : "offset";
+        break;
+    }
+    editor.apply(edit);
+    const GeneratedParcels fresh = editor.freshParcels();
+    const GeneratedParcels& now = editor.parcels();
+    ASSERT_EQ(fresh.parcels.size(), now.parcels.size()) << "step " << step;
+    for (std::size_t i = 0; i < now.parcels.size(); ++i) {
+      ASSERT_TRUE(test::sameBits(fresh.parcels[i], now.parcels[i])) << "step " << step << " parcel " << i;
+    }
+    // Keys stay unique.
+    std::set<Key> keys(editor.parcelKeys().begin(), editor.parcelKeys().end());
+    EXPECT_EQ(keys.size(), now.parcels.size()) << "step " << step;
+  }
+}
+
+TEST(StreetEditor, AWidthChangeTouchesTheBlocksFacingTheStreetAndLabelsFollowTheirParcels) {
+  StreetEditor editor(sampleStreets());
+  const auto& edges = editor.network().graph.edges;
+  const auto street = std::find_if(edges.begin(), edges.end(), [](const auto& e) { return !e.boundary; });
+  ASSERT_NE(street, edges.end());
+  const Key edge = street->key;
+  // Label every parcel, then widen the street by 1 m.
+  const std::vector<Key> keys = editor.parcelKeys();
+  for (Key k : keys) editor.setLabel(k, "lot " + keyText(k));
+  StreetEdit widen;
+  widen.op = StreetEdit::Op::SetWidth;
+  widen.edge = edge;
+  widen.width = street->width + 1;
+  const EditReport r = editor.apply(widen);
+  ASSERT_FALSE(r.blocksAffected.empty());
+  // The blocks on either side, and those at its ends where its round end
+  // reaches: every affected block lies within the street's width of it.
+  Box line{1e300, 1e300, -1e300, -1e300};
+  for (const Point& p : street->line) {
+    line = {std::min(line.minX, p.x), std::min(line.minY, p.y), std::max(line.maxX, p.x), std::max(line.maxY, p.y)};
+  }
+  const GeneratedParcels& g = editor.parcels();
+  for (Key k : r.blocksAffected) {
+    for (std::size_t b = 0; b < g.blocks.size(); ++b) {
+      if (g.blockKeys[b] != k) continue;
+      const Box x = bounds(g.blocks[b].parts[0]);
+      const double gap = std::max({x.minX - line.maxX, line.minX - x.maxX, x.minY - line.maxY, line.minY - x.maxY});
+      EXPECT_LE(gap, widen.width) << keyText(k);
+    }
+  }
+  EXPECT_LT(r.blocksAffected.size(), g.blocks.size());
+  EXPECT_EQ(static_cast<std::int64_t>(editor.labels().size()),
+            static_cast<std::int64_t>(keys.size()) - r.parcelsBefore + r.matched);
+  for (const auto& [key, label] : editor.labels()) EXPECT_EQ(label, "lot " + keyText(key));
+  // A label on a key no parcel has is refused.
+  EXPECT_THROW(editor.setLabel(0x1234, "x"), Error);
+}
+
+TEST(StreetEditor, ABadEditNamesWhatIsWrongAndChangesNothing) {
+  StreetEditor editor(sampleStreets());
+  const Snapshot before = snapshot(editor);
+  StreetEdit e;
+  e.op = StreetEdit::Op::MoveNode;
+  e.node = 0x0123456789abcdefull;
+  try {
+    editor.apply(e);
+    FAIL() << "an unknown node is refused";
+  } catch (const Error& error) {
+    EXPECT_EQ(error.kind(), Error::Kind::Usage);
+    EXPECT_NE(std::string(error.what()).find("0123456789abcdef"), std::string::npos) << error.what();
+  }
+  e.op = StreetEdit::Op::SetWidth;
+  e.edge = editor.network().graph.edges.front().key;
+  e.width = -2;
+  EXPECT_THROW(editor.apply(e), Error);
+  EXPECT_TRUE(sameState(snapshot(editor), before));
+  EXPECT_EQ(editor.undoSize(), 0u);
+}
+
+TEST(StreetEditor, AnEditsFileIsReadWithItsErrorsNamed) {
+  test::TempDir dir;
+  auto write = [&](const std::string& text) {
+    const std::string path = dir.file("edits.json");
+    std::ofstream(path) << text;
+    return path;
+  };
+  const auto identity = [](const Point& p) { return p; };
+  const std::vector<StreetEdit> edits =
+      readEdits(write(R"([{"op": "move_node", "node": "00000000000000ff", "to": [1, 2]},
+                {"op": "set_width", "edge": "00000000000000aa", "width": 12},
+                {"op": "set_block", "block": "00000000000000bb", "style": "obb", "parameters": {"a-max": 900}},
+                {"op": "transform_nodes", "nodes": ["0000000000000001"], "scale": 2, "rotate": 90}])"),
+                identity);
+  ASSERT_EQ(edits.size(), 4u);
+  EXPECT_EQ(edits[0].node, 0xffu);
+  EXPECT_EQ(edits[0].to.y, 2);
+  EXPECT_EQ(edits[1].width, 12);
+  EXPECT_EQ(edits[2].parameters.at("a-max"), 900);
+  EXPECT_EQ(edits[3].scale, 2);
+  auto message = [&](const std::string& text) {
+    try {
+      readEdits(write(text), identity);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(R"([{"op": "fly"}])").find("edit 0: op 'fly' is not an edit"), std::string::npos);
+  EXPECT_NE(message(R"([{"op": "move_node", "node": "xyz", "to": [1, 2]}])").find("edit 0: member node is not a key"),
+            std::string::npos);
+  EXPECT_NE(message(R"([{"op": "set_width", "edge": "00000000000000aa"}])").find("edit 0: member width is missing"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"op": "set_width"})").find("holds a list of edits"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace parcelscope::pipeline
