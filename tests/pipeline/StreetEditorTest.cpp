@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -198,6 +199,104 @@ TEST(StreetEditor, AWidthChangeTouchesTheBlocksFacingTheStreetAndLabelsFollowThe
   for (const auto& [key, label] : editor.labels()) EXPECT_EQ(label, "lot " + keyText(key));
   // A label on a key no parcel has is refused.
   EXPECT_THROW(editor.setLabel(0x1234, "x"), Error);
+}
+
+// Vanegas et al. 2012, Figure 7's six edits on the sample's network, each
+// undone: (a) a dead end moved across the next street, enclosing a block;
+// (b) a street moved; (c) two streets curved; (d) a street widened; (e) a
+// block's style changed; (f) the whole network scaled. Each states the share
+// of the affected blocks' parcels that keep their key; each undo gives the
+// state before, bit for bit.
+TEST(StreetEditor, Figure7sSixEditsKeepMostKeysAndEachUndoRestoresTheStateBefore) {
+  StreetEditor editor(sampleStreets());
+  const auto& g = editor.network().graph;
+  const auto deadEnd = std::find_if(g.nodes.begin(), g.nodes.end(), [](const auto& n) { return n.degree == 1; });
+  ASSERT_NE(deadEnd, g.nodes.end()) << "the sample has a cul-de-sac";
+  std::vector<Key> streets, all;
+  for (const auto& e : g.edges) {
+    if (!e.boundary && e.line.size() == 2 && e.from != e.to) streets.push_back(e.key);
+  }
+  for (const auto& n : g.nodes) all.push_back(n.key);
+  ASSERT_GE(streets.size(), 2u);
+  const Snapshot start = snapshot(editor);
+  const std::size_t blocksBefore = start.parcels.size();
+
+  std::vector<std::pair<std::string, StreetEdit>> edits;
+  {
+    // (a) The cul-de-sac's end carried on along its street to 5 m past the
+    // first street it meets.
+    const auto& n = *deadEnd;
+    const int index = static_cast<int>(&n - &g.nodes[0]);
+    const auto& e =
+        *std::find_if(g.edges.begin(), g.edges.end(), [&](const auto& x) { return x.from == index || x.to == index; });
+    const Point other = e.from == index ? e.line[1] : e.line[e.line.size() - 2];
+    const double l = std::hypot(n.at.x - other.x, n.at.y - other.y);
+    const Point u{(n.at.x - other.x) / l, (n.at.y - other.y) / l};
+    double nearest = 1e300;  // along u from the dead end to the first street crossed
+    for (const auto& x : g.edges) {
+      if (&x == &e) continue;
+      for (std::size_t i = 0; i + 1 < x.line.size(); ++i) {
+        const Point p = x.line[i], q = x.line[i + 1];
+        const double den = u.x * (q.y - p.y) - u.y * (q.x - p.x);
+        if (std::fabs(den) < 1e-12) continue;
+        const double t = ((p.x - n.at.x) * (q.y - p.y) - (p.y - n.at.y) * (q.x - p.x)) / den;
+        const double s = ((p.x - n.at.x) * u.y - (p.y - n.at.y) * u.x) / den;
+        if (t > 0 && s >= 0 && s <= 1) nearest = std::min(nearest, t);
+      }
+    }
+    ASSERT_LT(nearest, 1e3) << "the cul-de-sac points at a street";
+    StreetEdit a;
+    a.op = StreetEdit::Op::MoveNode;
+    a.node = n.key;
+    a.to = {n.at.x + (nearest + 5) * u.x, n.at.y + (nearest + 5) * u.y};
+    edits.emplace_back("enclose", a);
+  }
+  StreetEdit b;
+  b.op = StreetEdit::Op::MoveEdge;
+  b.edge = streets[0];
+  b.by = {2, 1};
+  edits.emplace_back("move edge", b);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const auto& e = *std::find_if(g.edges.begin(), g.edges.end(), [&](const auto& x) { return x.key == streets[k]; });
+    const Point p = e.line.front(), q = e.line.back();
+    const Point n{-(q.y - p.y) * 0.1, (q.x - p.x) * 0.1};  // a tenth of the length sideways
+    StreetEdit c;
+    c.op = StreetEdit::Op::SetCurve;
+    c.edge = e.key;
+    c.controls = std::array<Point, 2>{Point{p.x + (q.x - p.x) / 3 + n.x, p.y + (q.y - p.y) / 3 + n.y},
+                                      Point{p.x + 2 * (q.x - p.x) / 3 + n.x, p.y + 2 * (q.y - p.y) / 3 + n.y}};
+    edits.emplace_back("curve", c);
+  }
+  StreetEdit d;
+  d.op = StreetEdit::Op::SetWidth;
+  d.edge = streets[1];
+  d.width = 18;
+  edits.emplace_back("width", d);
+  StreetEdit e;
+  e.op = StreetEdit::Op::SetBlock;
+  e.block = start.parcels.begin()->first;
+  e.style = "obb";
+  edits.emplace_back("style", e);
+  StreetEdit f;
+  f.op = StreetEdit::Op::TransformNodes;
+  f.nodes = all;
+  f.scale = 1.1;
+  edits.emplace_back("scale", f);
+
+  for (const auto& [name, edit] : edits) {
+    const Snapshot before = snapshot(editor);
+    const EditReport r = editor.apply(edit);
+    const double share = r.parcelsBefore > 0 ? static_cast<double>(r.matched) / r.parcelsBefore : 1.0;
+    std::printf("  Figure 7 %-10s blocks affected %zu, removed %zu, parcels %lld -> %lld, keys kept %lld (%.0f %%)\n",
+                name.c_str(), r.blocksAffected.size(), r.blocksRemoved.size(), static_cast<long long>(r.parcelsBefore),
+                static_cast<long long>(r.parcelsAfter), static_cast<long long>(r.matched), 100 * share);
+    ASSERT_FALSE(r.blocksAffected.empty()) << name;
+    if (name == "enclose") EXPECT_GT(snapshot(editor).parcels.size(), blocksBefore) << "a block was enclosed";
+    if (name != "style" && name != "enclose") EXPECT_GE(share, 0.8) << name;
+    ASSERT_TRUE(editor.undo());
+    EXPECT_TRUE(sameState(snapshot(editor), before)) << name;
+    ASSERT_TRUE(editor.redo());
+  }
 }
 
 TEST(StreetEditor, ABadEditNamesWhatIsWrongAndChangesNothing) {
