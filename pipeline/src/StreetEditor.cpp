@@ -32,6 +32,8 @@ const char* editOpName(StreetEdit::Op op) {
       return "transform_nodes";
     case StreetEdit::Op::SetBlock:
       return "set_block";
+    case StreetEdit::Op::SetLabel:
+      return "set_label";
   }
   return "?";
 }
@@ -214,11 +216,11 @@ std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<c
   // Keys: a regenerated block's parcels inherit those of the parcels they
   // match in its counterpart; a key goes to one parcel only (a block split in
   // two passes each key to one of them).
+  std::vector<bool> regenerated(n, false);
+  for (std::size_t k : todo) regenerated[k] = true;
   std::set<Key> kept;
   for (std::size_t k = 0; k < n; ++k) {
-    if (s->outcomes[k] && std::find(todo.begin(), todo.end(), k) == todo.end()) {
-      kept.insert(s->entryKeys[k].begin(), s->entryKeys[k].end());
-    }
+    if (!regenerated[k]) kept.insert(s->entryKeys[k].begin(), s->entryKeys[k].end());
   }
   std::int64_t parcelsAfter = 0, matched = 0;
   std::set<std::size_t> involved;  // entries before whose parcels were replaced
@@ -294,6 +296,11 @@ EditReport StreetEditor::apply(const StreetEdit& edit) {
   const auto started = std::chrono::steady_clock::now();
   EditReport report;
   report.op = editOpName(edit.op);
+  if (edit.op == StreetEdit::Op::SetLabel) {
+    setLabel(edit.parcel, edit.label);
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    return report;
+  }
   const State& now = *current_;
   BlockOverrides overrides = now.overrides;
   std::shared_ptr<const StreetNetwork> network = now.network;
@@ -351,6 +358,7 @@ EditReport StreetEditor::apply(const StreetEdit& edit) {
         break;
       }
       case StreetEdit::Op::SetBlock:
+      case StreetEdit::Op::SetLabel:
         break;
     }
     analysis::StreetBlockOptions options;
@@ -500,9 +508,15 @@ StreetEdit readEdit(const Json& j, const std::string& where, const std::function
         e.parameters[k] = v.number();
       }
     }
+  } else if (name == "set_label") {
+    e.op = StreetEdit::Op::SetLabel;
+    e.parcel = key(member("parcel"), "parcel");
+    const Json& label = member("label");
+    if (!label.isString()) throw bad("member label is not a string");
+    e.label = label.string();
   } else {
     throw bad("op '" + name +
-              "' is not an edit (move_node, move_edge, set_width, set_curve, transform_nodes, set_block)");
+              "' is not an edit (move_node, move_edge, set_width, set_curve, transform_nodes, set_block, set_label)");
   }
   return e;
 }

@@ -274,9 +274,22 @@ TEST(EditCommand, EditsByKeyInTheInputsCrsAndWritesValidParcelsAndPersistence) {
   }
   ASSERT_FALSE(node.empty());
   ASSERT_FALSE(edge.empty());
+  // The network as built (no edit) gives the parcels' keys; one gets a label.
+  const std::string none = dir.write("none.json", "[]");
+  ASSERT_EQ(run("edit '" + streets + "'" + kFlags + " --style skeleton --edits '" + none + "' --out '" +
+                dir.file("built") + "'")
+                .code,
+            0);
+  std::string labelled;
+  {
+    auto built = test::openVectorFile(dir.file("built") + "/parcels.gpkg");
+    ASSERT_TRUE(built);
+    labelled = built->GetLayer(0)->GetNextFeature()->GetFieldAsString("parcel_key");
+  }
   std::ostringstream edits;
   edits.precision(12);
-  edits << R"([{"op": "move_node", "node": ")" << node << R"(", "to": [)" << lon + 2 / 82200.0 << ", " << lat
+  edits << R"([{"op": "set_label", "parcel": ")" << labelled << R"(", "label": "blue house"},)"
+        << R"({"op": "move_node", "node": ")" << node << R"(", "to": [)" << lon + 2 / 82200.0 << ", " << lat
         << R"(]}, {"op": "set_width", "edge": ")" << edge << R"(", "width": 14}])";
   const std::string editsFile = dir.write("edits.json", edits.str());
   const CliRun r = run("edit '" + streets + "'" + kFlags + " --style skeleton --edits '" + editsFile + "' --out '" +
@@ -286,7 +299,7 @@ TEST(EditCommand, EditsByKeyInTheInputsCrsAndWritesValidParcelsAndPersistence) {
   const test::ReadLayer blocks =
       test::expectValidPolygonLayer(dir.file("edited") + "/blocks.gpkg", 20, {"blocks", {"block_key"}, &crs});
   const std::string csv = slurp(dir.file("edited") + "/persistence.csv");
-  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3) << csv;
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4) << csv;
   EXPECT_NE(csv.find("move_node"), std::string::npos);
   EXPECT_NE(csv.find("set_width"), std::string::npos);
   auto parcels = test::openVectorFile(dir.file("edited") + "/parcels.gpkg");
@@ -296,8 +309,16 @@ TEST(EditCommand, EditsByKeyInTheInputsCrsAndWritesValidParcelsAndPersistence) {
   const test::ReadLayer written = test::expectValidPolygonLayer(dir.file("edited") + "/parcels.gpkg", n,
                                                                 {"parcels", {"parcel_key", "label"}, &crs});
   std::set<std::string> keys;
-  for (const auto& f : written.features) keys.insert(f->GetFieldAsString("parcel_key"));
+  int labels = 0;
+  for (const auto& f : written.features) {
+    keys.insert(f->GetFieldAsString("parcel_key"));
+    if (std::string(f->GetFieldAsString("label")) == "blue house") {
+      ++labels;
+      EXPECT_EQ(f->GetFieldAsString("parcel_key"), labelled) << "the label stays with its parcel's key";
+    }
+  }
   EXPECT_EQ(static_cast<std::int64_t>(keys.size()), n);  // unique
+  EXPECT_EQ(labels, 1);
 
   // An edit naming a node the network does not have: one line naming the file and the edit, nothing written.
   const std::string bad = dir.write("bad.json", R"([{"op": "move_node", "node": "0123456789abcdef", "to": [0, 0]}])");

@@ -33,15 +33,17 @@ struct StreetEdit {
     TransformNodes,  ///< nodes `nodes` scaled by `scale` and rotated by `rotate` (deg) about `centre`, then moved by
                      ///< `by`
     SetBlock,        ///< block `block`'s style (empty: the run's) and parameters (replacing its former override)
+    SetLabel,        ///< parcel `parcel`'s label to `label` (empty: none); it follows the parcel across edits
   };
   Op op = Op::MoveNode;
-  Key node = 0, edge = 0, block = 0;
+  Key node = 0, edge = 0, block = 0, parcel = 0;
   Point to, by, centre;
   double width = NAN, rotate = 0, scale = 1;
   std::optional<std::array<Point, 2>> controls;
   std::vector<Key> nodes;
   std::string style;
   ParameterValues parameters;
+  std::string label;
 };
 
 /// The name of an edit's op as the edits file spells it ("move_node", ...).
