@@ -1,8 +1,10 @@
 #include "parcelscope/pipeline/StreetEditor.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <numeric>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -34,6 +36,12 @@ const char* editOpName(StreetEdit::Op op) {
       return "set_block";
     case StreetEdit::Op::SetLabel:
       return "set_label";
+    case StreetEdit::Op::InsertNode:
+      return "insert_node";
+    case StreetEdit::Op::AddStreet:
+      return "add_street";
+    case StreetEdit::Op::DeleteStreet:
+      return "delete_street";
   }
   return "?";
 }
@@ -125,6 +133,66 @@ void moveNodes(analysis::RoadGraph& graph, const std::set<std::size_t>& nodes,
     edge.line.front() = graph.nodes[static_cast<std::size_t>(edge.from)].at;
     edge.line.back() = graph.nodes[static_cast<std::size_t>(edge.to)].at;
   }
+}
+
+// `graph` with the edges `removed` left out and the lines `added`, noded again
+// (analysis::buildRoadGraph). A node where a node was keeps its key; an edge
+// with the same vertices as an edge before keeps its key and its curve's
+// control points (another curved edge keeps its flattened line).
+analysis::RoadGraph renoded(const analysis::RoadGraph& graph, const std::set<std::size_t>& removed,
+                            const std::vector<analysis::StreetLine>& added, double snap) {
+  std::vector<analysis::StreetLine> lines;
+  for (std::size_t e = 0; e < graph.edges.size(); ++e) {
+    if (removed.count(e)) continue;
+    const analysis::RoadEdge& x = graph.edges[e];
+    lines.push_back({x.line, x.width, x.name, x.noNode, x.key, x.boundary});
+  }
+  lines.insert(lines.end(), added.begin(), added.end());
+  analysis::RoadGraphOptions options;
+  options.snap = snap;
+  analysis::RoadGraph out = analysis::buildRoadGraph(lines, options);
+  std::map<std::pair<double, double>, Key> nodeAt;
+  for (const analysis::RoadNode& n : graph.nodes) nodeAt.emplace(std::make_pair(n.at.x, n.at.y), n.key);
+  for (analysis::RoadNode& n : out.nodes) {
+    if (const auto it = nodeAt.find({n.at.x, n.at.y}); it != nodeAt.end()) n.key = it->second;
+  }
+  auto sameLine = [](const std::vector<Point>& a, const std::vector<Point>& b) {
+    if (a.size() != b.size()) return false;
+    const bool forward = std::equal(a.begin(), a.end(), b.begin(),
+                                    [](const Point& p, const Point& q) { return p.x == q.x && p.y == q.y; });
+    return forward || std::equal(a.begin(), a.end(), b.rbegin(),
+                                 [](const Point& p, const Point& q) { return p.x == q.x && p.y == q.y; });
+  };
+  for (analysis::RoadEdge& e : out.edges) {
+    for (std::size_t k = 0; k < graph.edges.size(); ++k) {
+      const analysis::RoadEdge& old = graph.edges[k];
+      if (removed.count(k) || !sameLine(e.line, old.line)) continue;
+      e.key = old.key;
+      if (old.controls && e.line.front().x == old.line.front().x && e.line.front().y == old.line.front().y) {
+        e.controls = old.controls;
+      }
+      break;
+    }
+  }
+  // Sorted by key again, as buildRoadGraph leaves them.
+  std::vector<std::size_t> order(out.nodes.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return out.nodes[a].key < out.nodes[b].key; });
+  std::vector<int> rank(order.size());
+  std::vector<analysis::RoadNode> nodes;
+  for (std::size_t r = 0; r < order.size(); ++r) {
+    rank[order[r]] = static_cast<int>(r);
+    nodes.push_back(out.nodes[order[r]]);
+  }
+  out.nodes = std::move(nodes);
+  for (analysis::RoadEdge& e : out.edges) {
+    e.from = rank[static_cast<std::size_t>(e.from)];
+    e.to = rank[static_cast<std::size_t>(e.to)];
+  }
+  std::sort(out.edges.begin(), out.edges.end(),
+            [](const analysis::RoadEdge& a, const analysis::RoadEdge& b) { return a.key < b.key; });
+  return out;
 }
 
 }  // namespace
@@ -357,6 +425,52 @@ EditReport StreetEditor::apply(const StreetEdit& edit) {
         });
         break;
       }
+      case StreetEdit::Op::InsertNode: {
+        const std::size_t e = indexOf(g.edges, edit.edge);
+        const analysis::RoadEdge& x = g.edges[e];
+        // The point of the edge nearest `to`, and the edge cut there in two.
+        std::size_t segment = 0;
+        Point at = x.line.front();
+        double nearest = HUGE_VAL;
+        for (std::size_t i = 0; i + 1 < x.line.size(); ++i) {
+          const Point a = x.line[i], b = x.line[i + 1];
+          const double dx = b.x - a.x, dy = b.y - a.y, l2 = dx * dx + dy * dy;
+          const double t = l2 > 0 ? std::clamp(((edit.to.x - a.x) * dx + (edit.to.y - a.y) * dy) / l2, 0.0, 1.0) : 0;
+          const Point p{a.x + t * dx, a.y + t * dy};
+          const double d = std::hypot(p.x - edit.to.x, p.y - edit.to.y);
+          if (d < nearest) {
+            nearest = d;
+            at = p;
+            segment = i;
+          }
+        }
+        std::vector<Point> first(x.line.begin(), x.line.begin() + static_cast<long>(segment) + 1), second{at};
+        first.push_back(at);
+        second.insert(second.end(), x.line.begin() + static_cast<long>(segment) + 1, x.line.end());
+        g = renoded(g, {e},
+                    {{first, x.width, x.name, x.noNode, mixKeys(x.key, 1), false},
+                     {second, x.width, x.name, x.noNode, mixKeys(x.key, 2), false}},
+                    request_.parameters.at("street-snap"));
+        break;
+      }
+      case StreetEdit::Op::AddStreet: {
+        auto end = [&](Key node, const Point& p) { return node ? g.nodes[indexOf(g.nodes, node)].at : p; };
+        if (!std::isfinite(edit.width) || edit.width <= 0) {
+          throw usageError("add_street: a width must be a positive number of metres");
+        }
+        const Point a = end(edit.node, edit.from), b = end(edit.node2, edit.to);
+        if (a.x == b.x && a.y == b.y) throw usageError("add_street: the street's ends are one point");
+        g = renoded(g, {}, {{{a, b}, edit.width, edit.name, false, hashBytes("added street"), false}},
+                    request_.parameters.at("street-snap"));
+        break;
+      }
+      case StreetEdit::Op::DeleteStreet: {
+        const std::size_t e = indexOf(g.edges, edit.edge);
+        if (g.edges[e].boundary)
+          throw usageError("edge " + keyText(edit.edge) + " is the study area's edge, not a street");
+        g = renoded(g, {e}, {}, request_.parameters.at("street-snap"));
+        break;
+      }
       case StreetEdit::Op::SetBlock:
       case StreetEdit::Op::SetLabel:
         break;
@@ -508,6 +622,28 @@ StreetEdit readEdit(const Json& j, const std::string& where, const std::function
         e.parameters[k] = v.number();
       }
     }
+  } else if (name == "insert_node") {
+    e.op = StreetEdit::Op::InsertNode;
+    e.edge = key(member("edge"), "edge");
+    e.to = point(member("at"), "at", true);
+  } else if (name == "add_street") {
+    e.op = StreetEdit::Op::AddStreet;
+    // Each end a node's key or a point.
+    auto endOf = [&](const char* name, Key& node, Point& at) {
+      const Json& v = member(name);
+      if (v.isString()) {
+        node = key(v, name);
+      } else {
+        at = point(v, name, true);
+      }
+    };
+    endOf("from", e.node, e.from);
+    endOf("to", e.node2, e.to);
+    e.width = number("width");
+    if (const Json* n = j.find("name"); n && n->isString()) e.name = n->string();
+  } else if (name == "delete_street") {
+    e.op = StreetEdit::Op::DeleteStreet;
+    e.edge = key(member("edge"), "edge");
   } else if (name == "set_label") {
     e.op = StreetEdit::Op::SetLabel;
     e.parcel = key(member("parcel"), "parcel");
@@ -516,7 +652,8 @@ StreetEdit readEdit(const Json& j, const std::string& where, const std::function
     e.label = label.string();
   } else {
     throw bad("op '" + name +
-              "' is not an edit (move_node, move_edge, set_width, set_curve, transform_nodes, set_block, set_label)");
+              "' is not an edit (move_node, move_edge, set_width, set_curve, transform_nodes, insert_node, add_street, "
+              "delete_street, set_block, set_label)");
   }
   return e;
 }

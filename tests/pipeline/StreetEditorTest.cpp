@@ -299,6 +299,78 @@ TEST(StreetEditor, Figure7sSixEditsKeepMostKeysAndEachUndoRestoresTheStateBefore
   }
 }
 
+// Edits of the topology: a street added across the largest block splits it in
+// two (the new blocks inherit its parcels' keys by overlap), deleting it joins
+// them again; a node inserted on a street splits the street in two. Each
+// undo gives the state before, and the state is a fresh build's.
+TEST(StreetEditor, AStreetAddedSplitsABlockDeletedJoinsItAndANodeInsertedSplitsAStreet) {
+  StreetEditor editor(sampleStreets());
+  const GeneratedParcels& g0 = editor.parcels();
+  std::size_t largest = 0;
+  for (std::size_t b = 0; b < g0.blocks.size(); ++b) {
+    if (area(g0.blocks[b].parts[0]) > area(g0.blocks[largest].parts[0])) largest = b;
+  }
+  const Key split = g0.blockKeys[largest];
+  const Box box = bounds(g0.blocks[largest].parts[0]);
+  const double blockArea = area(g0.blocks[largest].parts[0]);
+  const std::size_t blocks = g0.blocks.size(), nodes = editor.network().graph.nodes.size(),
+                    edges = editor.network().graph.edges.size();
+  const Snapshot start = snapshot(editor);
+
+  StreetEdit add;
+  add.op = StreetEdit::Op::AddStreet;
+  const double y = 0.5 * (box.minY + box.maxY);
+  add.from = {box.minX - 30, y};
+  add.to = {box.maxX + 30, y};
+  add.width = 10;
+  add.name = "New Street";
+  const EditReport r = editor.apply(add);
+  // The block split, and the blocks beside it whose side streets got a node
+  // (their faced edges are new) are gone.
+  EXPECT_TRUE(std::binary_search(r.blocksRemoved.begin(), r.blocksRemoved.end(), split));
+  EXPECT_GE(editor.parcels().blocks.size(), blocks + 1);
+  EXPECT_GT(r.matched, 0);
+  std::printf("  add_street: blocks %zu -> %zu, parcels %lld -> %lld, keys kept %lld\n", blocks,
+              editor.parcels().blocks.size(), static_cast<long long>(r.parcelsBefore),
+              static_cast<long long>(r.parcelsAfter), static_cast<long long>(r.matched));
+  const GeneratedParcels fresh = editor.freshParcels();
+  ASSERT_EQ(fresh.parcels.size(), editor.parcels().parcels.size());
+  for (std::size_t i = 0; i < fresh.parcels.size(); ++i)
+    ASSERT_TRUE(test::sameBits(fresh.parcels[i], editor.parcels().parcels[i]));
+  const Snapshot added = snapshot(editor);
+
+  // Delete it: as many blocks as at the start, the split block whole again.
+  StreetEdit remove;
+  remove.op = StreetEdit::Op::DeleteStreet;
+  for (const auto& e : editor.network().graph.edges) {
+    const double x0 = std::min(e.line.front().x, e.line.back().x), x1 = std::max(e.line.front().x, e.line.back().x);
+    if (e.name == "New Street" && x0 < box.maxX && x1 > box.minX) remove.edge = e.key;
+  }
+  ASSERT_NE(remove.edge, 0u);
+  editor.apply(remove);
+  // The stubs beyond the side streets stay (only the edge across the block was deleted).
+  double largestArea = 0;
+  for (const Block& b : editor.parcels().blocks) largestArea = std::max(largestArea, area(b.parts[0]));
+  EXPECT_NEAR(largestArea, blockArea, 1e-6 * blockArea);
+  ASSERT_TRUE(editor.undo());
+  EXPECT_TRUE(sameState(snapshot(editor), added));
+  ASSERT_TRUE(editor.undo());
+  EXPECT_TRUE(sameState(snapshot(editor), start));
+
+  // A node inserted halfway along a street: one node and one edge more, as many blocks.
+  const auto& street = *std::find_if(editor.network().graph.edges.begin(), editor.network().graph.edges.end(),
+                                     [](const auto& e) { return !e.boundary && e.line.size() == 2; });
+  StreetEdit insert;
+  insert.op = StreetEdit::Op::InsertNode;
+  insert.edge = street.key;
+  insert.to = {0.5 * (street.line[0].x + street.line[1].x) + 3, 0.5 * (street.line[0].y + street.line[1].y) + 3};
+  const EditReport ri = editor.apply(insert);
+  EXPECT_EQ(editor.network().graph.nodes.size(), nodes + 1);
+  EXPECT_EQ(editor.network().graph.edges.size(), edges + 1);
+  EXPECT_EQ(editor.parcels().blocks.size(), blocks);
+  EXPECT_GE(static_cast<double>(ri.matched), 0.8 * static_cast<double>(ri.parcelsBefore));
+}
+
 TEST(StreetEditor, ABadEditNamesWhatIsWrongAndChangesNothing) {
   StreetEditor editor(sampleStreets());
   const Snapshot before = snapshot(editor);

@@ -4,7 +4,9 @@
 // a block's style or parameters; the blocks are the graph's faces again, and
 // only the blocks whose contour, faced streets or plan changed are subdivided
 // again. Nodes, edges and blocks keep their keys across geometric edits (a
-// moved node is the same node). A regenerated block's parcels are matched to
+// moved node is the same node); an edit of the topology (a street added,
+// deleted, a node inserted) nodes the streets again, and what it did not
+// change keeps its key. A regenerated block's parcels are matched to
 // its parcels before the edit (generation::matchParcels): a matched parcel
 // keeps its key and its label. Every edit can be undone and redone, bit for
 // bit. No Qt: the application and `parcelscope edit` drive the same class.
@@ -34,16 +36,20 @@ struct StreetEdit {
                      ///< `by`
     SetBlock,        ///< block `block`'s style (empty: the run's) and parameters (replacing its former override)
     SetLabel,        ///< parcel `parcel`'s label to `label` (empty: none); it follows the parcel across edits
+    InsertNode,      ///< a node on edge `edge` at the point of it nearest `to` (a T-junction to be)
+    AddStreet,       ///< a straight street from `from` (or node `node`) to `to` (or node `node2`), `width`, `name`
+    DeleteStreet,    ///< edge `edge` removed
   };
   Op op = Op::MoveNode;
-  Key node = 0, edge = 0, block = 0, parcel = 0;
-  Point to, by, centre;
+  Key node = 0, node2 = 0, edge = 0, block = 0, parcel = 0;
+  Point from, to, by, centre;
   double width = NAN, rotate = 0, scale = 1;
   std::optional<std::array<Point, 2>> controls;
   std::vector<Key> nodes;
   std::string style;
   ParameterValues parameters;
   std::string label;
+  std::string name;  ///< a new street's name
 };
 
 /// The name of an edit's op as the edits file spells it ("move_node", ...).
