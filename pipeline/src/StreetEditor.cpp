@@ -42,6 +42,8 @@ const char* editOpName(StreetEdit::Op op) {
       return "add_street";
     case StreetEdit::Op::DeleteStreet:
       return "delete_street";
+    case StreetEdit::Op::SetLock:
+      return "set_lock";
   }
   return "?";
 }
@@ -54,7 +56,7 @@ struct StreetEditor::State {
   std::vector<std::shared_ptr<const BlockOutcome>> outcomes;  // per entry; shared with the states before
   std::vector<std::vector<Key>> entryKeys;                    // per entry, its parcels' keys
   BlockOverrides overrides;
-  std::map<Key, std::string> labels;  // by parcel key
+  Attributes attributes;  // labels and locks, by parcel key
   GeneratedParcels parcels;
   std::vector<Key> parcelKeys;  // of parcels.parcels
 };
@@ -197,10 +199,33 @@ analysis::RoadGraph renoded(const analysis::RoadGraph& graph, const std::set<std
 
 }  // namespace
 
+namespace {
+
+// Block entry `entry` subdivided by `plan` around the parcels `anchored` (kept
+// as they are, first): the rest of the block, in pieces, each subdivided with
+// the plan's style and values and a seed of its own; measured in the block.
+BlockOutcome runAround(const BlockInputs& inputs, std::size_t entry, const BlockPlan& plan,
+                       std::vector<Polygon> anchored, double minFrontage) {
+  BlockOutcome o;
+  std::vector<const Polygon*> cut;
+  for (const Polygon& a : anchored) cut.push_back(&a);
+  std::vector<Polygon> rest = geos::difference(inputs.entries[entry].shape, cut, 1e-6);
+  o.subdivision.parcels = std::move(anchored);
+  for (std::size_t i = 0; i < rest.size(); ++i) {
+    Subdivision piece = generation::subdivideBlock(rest[i], plan.style, plan.values, mixKeys(plan.seed, i + 1));
+    for (Polygon& p : piece.parcels) o.subdivision.parcels.push_back(std::move(p));
+  }
+  o.metrics = analysis::measureShapes(o.subdivision.parcels);
+  o.contextMeasured = false;
+  measureOutcomeContext(inputs, entry, o, minFrontage);
+  return o;
+}
+
+}  // namespace
+
 std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<const StreetNetwork> network,
-                                                               BlockOverrides overrides,
-                                                               std::map<Key, std::string> labels, const State* previous,
-                                                               EditReport* report) const {
+                                                               BlockOverrides overrides, Attributes attributes,
+                                                               const State* previous, EditReport* report) const {
   auto s = std::make_shared<State>();
   s->network = network;
   s->inputs = streetNetworkInputs(network);
@@ -275,9 +300,26 @@ std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<c
     const auto now = std::chrono::steady_clock::now();
     return std::chrono::duration<double>(now - std::exchange(lap, now)).count();
   };
+  // Locked parcels of a block's counterpart that still lie inside the block
+  // stay as they are; the rest of the block is subdivided around them.
+  std::vector<std::vector<Key>> anchoredKeys(n);
   parallelFor(todo.size(), [&](std::size_t t) {
     const std::size_t k = todo[t];
-    s->outcomes[k] = std::make_shared<const BlockOutcome>(runBlock(s->inputs, k, s->plans[k], minFrontage));
+    std::vector<Polygon> anchored;
+    if (counterpart[k] >= 0 && !attributes.locked.empty()) {
+      const std::size_t p = static_cast<std::size_t>(counterpart[k]);
+      const std::vector<Polygon>& then = previous->outcomes[p]->subdivision.parcels;
+      for (std::size_t i = 0; i < then.size(); ++i) {
+        const Key key = previous->entryKeys[p][i];
+        if (!attributes.locked.count(key)) continue;
+        if (geos::intersectionArea(then[i], s->inputs.entries[k].shape) < (1 - 1e-9) * area(then[i])) continue;
+        anchored.push_back(then[i]);
+        anchoredKeys[k].push_back(key);
+      }
+    }
+    s->outcomes[k] = std::make_shared<const BlockOutcome>(
+        anchored.empty() ? runBlock(s->inputs, k, s->plans[k], minFrontage)
+                         : runAround(s->inputs, k, s->plans[k], std::move(anchored), minFrontage));
   });
 
   const double subdivideSeconds = seconds();
@@ -289,6 +331,7 @@ std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<c
   std::set<Key> kept;
   for (std::size_t k = 0; k < n; ++k) {
     if (!regenerated[k]) kept.insert(s->entryKeys[k].begin(), s->entryKeys[k].end());
+    kept.insert(anchoredKeys[k].begin(), anchoredKeys[k].end());
   }
   std::int64_t parcelsAfter = 0, matched = 0;
   std::set<std::size_t> involved;  // entries before whose parcels were replaced
@@ -298,13 +341,16 @@ std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<c
     std::vector<Key>& out = s->entryKeys[k];
     out.resize(now.size());
     for (std::size_t i = 0; i < now.size(); ++i) out[i] = freshKey(e.blockKey, e.part, serial_, i);
+    // The anchored parcels come first, with their keys.
+    std::copy(anchoredKeys[k].begin(), anchoredKeys[k].end(), out.begin());
+    matched += static_cast<std::int64_t>(anchoredKeys[k].size());
     parcelsAfter += static_cast<std::int64_t>(now.size());
     if (counterpart[k] < 0) continue;
     const std::size_t p = static_cast<std::size_t>(counterpart[k]);
     involved.insert(p);
     const std::vector<Polygon>& then = previous->outcomes[p]->subdivision.parcels;
     const generation::ParcelMatches m = generation::matchParcels(previous->inputs.entries[p].shape, then, e.shape, now);
-    for (std::size_t i = 0; i < now.size(); ++i) {
+    for (std::size_t i = anchoredKeys[k].size(); i < now.size(); ++i) {
       if (m.before[i] < 0) continue;
       const Key inherited = previous->entryKeys[p][static_cast<std::size_t>(m.before[i])];
       if (!kept.insert(inherited).second) continue;
@@ -340,10 +386,13 @@ std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<c
       s->parcelKeys[static_cast<std::size_t>(indices[i])] = s->entryKeys[k][i];
     }
   }
-  // Labels follow their parcels' keys; a parcel gone takes its label with it.
+  // Labels and locks follow their parcels' keys; a parcel gone takes them with it.
   const std::set<Key> present(s->parcelKeys.begin(), s->parcelKeys.end());
+  auto& labels = attributes.labels;
   for (auto it = labels.begin(); it != labels.end();) it = present.count(it->first) ? std::next(it) : labels.erase(it);
-  s->labels = std::move(labels);
+  auto& locked = attributes.locked;
+  for (auto it = locked.begin(); it != locked.end();) it = present.count(*it) ? std::next(it) : locked.erase(it);
+  s->attributes = std::move(attributes);
   return s;
 }
 
@@ -364,8 +413,12 @@ EditReport StreetEditor::apply(const StreetEdit& edit) {
   const auto started = std::chrono::steady_clock::now();
   EditReport report;
   report.op = editOpName(edit.op);
-  if (edit.op == StreetEdit::Op::SetLabel) {
-    setLabel(edit.parcel, edit.label);
+  if (edit.op == StreetEdit::Op::SetLabel || edit.op == StreetEdit::Op::SetLock) {
+    if (edit.op == StreetEdit::Op::SetLabel) {
+      setLabel(edit.parcel, edit.label);
+    } else {
+      setLock(edit.parcel, edit.locked);
+    }
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     return report;
   }
@@ -473,6 +526,7 @@ EditReport StreetEditor::apply(const StreetEdit& edit) {
       }
       case StreetEdit::Op::SetBlock:
       case StreetEdit::Op::SetLabel:
+      case StreetEdit::Op::SetLock:
         break;
     }
     analysis::StreetBlockOptions options;
@@ -483,7 +537,7 @@ EditReport StreetEditor::apply(const StreetEdit& edit) {
     network = std::move(edited);
   }
   ++serial_;
-  std::shared_ptr<const State> next = build(network, std::move(overrides), now.labels, &now, &report);
+  std::shared_ptr<const State> next = build(network, std::move(overrides), now.attributes, &now, &report);
   undo_.push_back(current_);
   redo_.clear();
   current_ = std::move(next);
@@ -511,20 +565,36 @@ bool StreetEditor::redo() { return step(redo_, undo_, current_); }
 std::size_t StreetEditor::undoSize() const { return undo_.size(); }
 std::size_t StreetEditor::redoSize() const { return redo_.size(); }
 
-void StreetEditor::setLabel(Key parcel, const std::string& label) {
+void StreetEditor::changeAttributes(Key parcel, const std::function<void(Attributes&)>& change) {
   const State& now = *current_;
   if (std::find(now.parcelKeys.begin(), now.parcelKeys.end(), parcel) == now.parcelKeys.end()) {
     throw usageError("no parcel " + keyText(parcel));
   }
   auto next = std::make_shared<State>(now);
-  if (label.empty()) {
-    next->labels.erase(parcel);
-  } else {
-    next->labels[parcel] = label;
-  }
+  change(next->attributes);
   undo_.push_back(current_);
   redo_.clear();
   current_ = std::move(next);
+}
+
+void StreetEditor::setLabel(Key parcel, const std::string& label) {
+  changeAttributes(parcel, [&](Attributes& a) {
+    if (label.empty()) {
+      a.labels.erase(parcel);
+    } else {
+      a.labels[parcel] = label;
+    }
+  });
+}
+
+void StreetEditor::setLock(Key parcel, bool locked) {
+  changeAttributes(parcel, [&](Attributes& a) {
+    if (locked) {
+      a.locked.insert(parcel);
+    } else {
+      a.locked.erase(parcel);
+    }
+  });
 }
 
 GeneratedParcels StreetEditor::freshParcels() const {
@@ -534,7 +604,8 @@ GeneratedParcels StreetEditor::freshParcels() const {
 const StreetNetwork& StreetEditor::network() const { return *current_->network; }
 const GeneratedParcels& StreetEditor::parcels() const { return current_->parcels; }
 const std::vector<Key>& StreetEditor::parcelKeys() const { return current_->parcelKeys; }
-const std::map<Key, std::string>& StreetEditor::labels() const { return current_->labels; }
+const std::map<Key, std::string>& StreetEditor::labels() const { return current_->attributes.labels; }
+const std::set<Key>& StreetEditor::locked() const { return current_->attributes.locked; }
 const BlockOverrides& StreetEditor::overrides() const { return current_->overrides; }
 Point StreetEditor::toLocal(const Point& source) const {
   return current_->network->layer.frame.toLocal(source.x, source.y);
@@ -644,6 +715,16 @@ StreetEdit readEdit(const Json& j, const std::string& where, const std::function
   } else if (name == "delete_street") {
     e.op = StreetEdit::Op::DeleteStreet;
     e.edge = key(member("edge"), "edge");
+  } else if (name == "set_lock") {
+    e.op = StreetEdit::Op::SetLock;
+    e.parcel = key(member("parcel"), "parcel");
+    if (const Json* v = j.find("locked"); v && !v->isNull()) {
+      try {
+        e.locked = v->boolean();
+      } catch (const std::logic_error&) {
+        throw bad("member locked is not true or false");
+      }
+    }
   } else if (name == "set_label") {
     e.op = StreetEdit::Op::SetLabel;
     e.parcel = key(member("parcel"), "parcel");
@@ -653,7 +734,7 @@ StreetEdit readEdit(const Json& j, const std::string& where, const std::function
   } else {
     throw bad("op '" + name +
               "' is not an edit (move_node, move_edge, set_width, set_curve, transform_nodes, insert_node, add_street, "
-              "delete_street, set_block, set_label)");
+              "delete_street, set_block, set_label, set_lock)");
   }
   return e;
 }
@@ -704,11 +785,13 @@ Table editedParcelTable(const StreetEditor& editor, std::vector<std::vector<Poly
   Table t = generatedParcelTable(editor.parcels(), geometries);
   const std::size_t keyColumn = t.column("parcel_key");
   t.columns.push_back({"label", Column::Type::String, ""});
+  t.columns.push_back({"locked", Column::Type::Integer, ""});
   for (std::size_t i = 0; i < t.rows.size(); ++i) {
     const Key k = editor.parcelKeys()[i];
     t.rows[i][keyColumn] = keyText(k);
     const auto it = editor.labels().find(k);
     t.rows[i].push_back(it == editor.labels().end() ? std::string() : it->second);
+    t.rows[i].push_back(static_cast<std::int64_t>(editor.locked().count(k)));
   }
   return t;
 }

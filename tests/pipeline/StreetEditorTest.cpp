@@ -15,6 +15,7 @@
 
 #include "TestUtil.h"
 #include "parcelscope/core/Error.h"
+#include "parcelscope/core/GeosOps.h"
 
 namespace parcelscope::pipeline {
 namespace {
@@ -369,6 +370,72 @@ TEST(StreetEditor, AStreetAddedSplitsABlockDeletedJoinsItAndANodeInsertedSplitsA
   EXPECT_EQ(editor.network().graph.edges.size(), edges + 1);
   EXPECT_EQ(editor.parcels().blocks.size(), blocks);
   EXPECT_GE(static_cast<double>(ri.matched), 0.8 * static_cast<double>(ri.parcelsBefore));
+}
+
+// Lipp et al. 2011's anchored assignment: a locked parcel keeps its geometry
+// and key when its block is subdivided again around it, and the block is
+// still tiled by valid parcels.
+TEST(StreetEditor, ALockedParcelKeepsItsGeometryWhileItsBlockIsSubdividedAroundIt) {
+  StreetEditor editor(sampleStreets());
+  const Key node = busiestNode(editor);
+  const StreetEdit move = moveNodeBy(editor, node, 2, 1);
+  const EditReport dry = editor.apply(move);
+  ASSERT_TRUE(editor.undo());
+  ASSERT_FALSE(dry.blocksAffected.empty());
+  const Key block = dry.blocksAffected.front();
+  // The block's parcel farthest from the node: still inside after the move.
+  const GeneratedParcels& g = editor.parcels();
+  Point at;
+  for (const auto& n : editor.network().graph.nodes) {
+    if (n.key == node) at = n.at;
+  }
+  int chosen = -1;
+  double farthest = -1;
+  for (std::size_t b = 0; b < g.blocks.size(); ++b) {
+    if (g.blockKeys[b] != block) continue;
+    for (int i : g.blocks[b].parcels) {
+      const Point c = centroid(g.parcels[static_cast<std::size_t>(i)]);
+      if (std::hypot(c.x - at.x, c.y - at.y) > farthest) {
+        farthest = std::hypot(c.x - at.x, c.y - at.y);
+        chosen = i;
+      }
+    }
+  }
+  ASSERT_GE(chosen, 0);
+  const Key locked = editor.parcelKeys()[static_cast<std::size_t>(chosen)];
+  const Polygon shape = g.parcels[static_cast<std::size_t>(chosen)];
+  editor.setLock(locked, true);
+  editor.apply(move);
+  const GeneratedParcels& after = editor.parcels();
+  const auto it = std::find(editor.parcelKeys().begin(), editor.parcelKeys().end(), locked);
+  ASSERT_NE(it, editor.parcelKeys().end()) << "the locked parcel kept its key";
+  EXPECT_TRUE(test::sameBits(after.parcels[static_cast<std::size_t>(it - editor.parcelKeys().begin())], shape));
+  EXPECT_EQ(editor.locked().count(locked), 1u);
+  for (std::size_t b = 0; b < after.blocks.size(); ++b) {
+    if (after.blockKeys[b] != block) continue;
+    double sum = 0;
+    for (int i : after.blocks[b].parcels) {
+      const Polygon& p = after.parcels[static_cast<std::size_t>(i)];
+      EXPECT_TRUE(geos::isValid(p)) << "parcel " << i;
+      sum += area(p);
+    }
+    const double whole = area(after.blocks[b].parts[0]);
+    EXPECT_NEAR(sum, whole, 1e-6 * whole) << "the block is tiled";
+    EXPECT_NEAR(geos::unionArea(
+                    [&] {
+                      std::vector<const Polygon*> all;
+                      for (int i : after.blocks[b].parcels) all.push_back(&after.parcels[static_cast<std::size_t>(i)]);
+                      return all;
+                    }(),
+                    0),
+                whole, 1e-6 * whole)
+        << "without overlaps";
+  }
+  std::set<Key> keys(editor.parcelKeys().begin(), editor.parcelKeys().end());
+  EXPECT_EQ(keys.size(), after.parcels.size());
+  // Unlocked, the next subdivision of the block no longer keeps it.
+  editor.setLock(locked, false);
+  EXPECT_TRUE(editor.locked().empty());
 }
 
 TEST(StreetEditor, ABadEditNamesWhatIsWrongAndChangesNothing) {

@@ -11,9 +11,11 @@
 // keeps its key and its label. Every edit can be undone and redone, bit for
 // bit. No Qt: the application and `parcelscope edit` drive the same class.
 #include <array>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -39,6 +41,7 @@ struct StreetEdit {
     InsertNode,      ///< a node on edge `edge` at the point of it nearest `to` (a T-junction to be)
     AddStreet,       ///< a straight street from `from` (or node `node`) to `to` (or node `node2`), `width`, `name`
     DeleteStreet,    ///< edge `edge` removed
+    SetLock,         ///< parcel `parcel` locked (`locked`) or unlocked: see StreetEditor::setLock
   };
   Op op = Op::MoveNode;
   Key node = 0, node2 = 0, edge = 0, block = 0, parcel = 0;
@@ -50,6 +53,7 @@ struct StreetEdit {
   ParameterValues parameters;
   std::string label;
   std::string name;  ///< a new street's name
+  bool locked = true;
 };
 
 /// The name of an edit's op as the edits file spells it ("move_node", ...).
@@ -91,6 +95,11 @@ public:
 
   /// Sets (empty: clears) the label of parcel `parcel`; Error(Usage) when no parcel has that key.
   void setLabel(Key parcel, const std::string& label);
+  /// Locks (or unlocks) parcel `parcel` (Lipp et al. 2011's anchored
+  /// assignment): when its block is subdivided again, a locked parcel that
+  /// still lies inside the block keeps its geometry and key, and the rest of
+  /// the block is subdivided around it. Error(Usage) when no parcel has that key.
+  void setLock(Key parcel, bool locked);
 
   /// The current network and parcels. parcelKeys()[i] is the key of
   /// parcels().parcels[i]; labels() by parcel key.
@@ -98,9 +107,10 @@ public:
   const GeneratedParcels& parcels() const;
   const std::vector<Key>& parcelKeys() const;
   const std::map<Key, std::string>& labels() const;
+  const std::set<Key>& locked() const;
   const BlockOverrides& overrides() const;
   /// The parcels a fresh build of the current network and overrides gives,
-  /// nothing reused: what parcels() must equal.
+  /// nothing reused: what parcels() must equal when no parcel is locked.
   GeneratedParcels freshParcels() const;
   /// A point of the input's CRS in the editor's local metres.
   Point toLocal(const Point& source) const;
@@ -109,9 +119,14 @@ private:
   struct State;
   // The state of `network` with `overrides` and `labels`, reusing what
   // `previous` holds for unchanged entries (see StreetEditor.cpp).
+  struct Attributes {
+    std::map<Key, std::string> labels;
+    std::set<Key> locked;
+  };
   std::shared_ptr<const State> build(std::shared_ptr<const StreetNetwork> network, BlockOverrides overrides,
-                                     std::map<Key, std::string> labels, const State* previous,
-                                     EditReport* report) const;
+                                     Attributes attributes, const State* previous, EditReport* report) const;
+  // A copy of the current state with `change` applied to its attributes, made current.
+  void changeAttributes(Key parcel, const std::function<void(Attributes&)>& change);
   std::shared_ptr<const State> current_;
   std::vector<std::shared_ptr<const State>> undo_, redo_;
   GenerateRequest request_;
