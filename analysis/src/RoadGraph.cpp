@@ -557,7 +557,33 @@ std::vector<Polygon> streetSurface(const RoadGraph& graph, int quadrantSegments)
   return geos::bufferedUnion(lines, halves, quadrantSegments);
 }
 
-StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& options, const ProgressFn& progress) {
+namespace {
+
+Key bitsKey(const std::vector<Point>& points, Key basis) {
+  return hashBytes(std::string_view(reinterpret_cast<const char*>(points.data()), points.size() * sizeof(Point)),
+                   basis);
+}
+
+Key doubleKey(double x, Key basis) {
+  return hashBytes(std::string_view(reinterpret_cast<const char*>(&x), sizeof x), basis);
+}
+
+bool sameVertexBits(const Polygon& a, const Polygon& b) {
+  auto same = [](const Ring& x, const Ring& y) {
+    return x.size() == y.size() && std::equal(x.begin(), x.end(), y.begin(),
+                                              [](const Point& p, const Point& q) { return p.x == q.x && p.y == q.y; });
+  };
+  if (!same(a.outer, b.outer) || a.holes.size() != b.holes.size()) return false;
+  for (std::size_t h = 0; h < a.holes.size(); ++h) {
+    if (!same(a.holes[h], b.holes[h])) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& options, const ProgressFn& progress,
+                          StreetBlockCache* cache) {
   for (const RoadEdge& e : graph.edges) {
     if (!(e.width >= 0)) throw usageError("street blocks: an edge has no width (fill the widths first)");
   }
@@ -575,8 +601,16 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
 
   // Each edge's surface, and an index of their boxes.
   std::vector<std::vector<Polygon>> surfaces(graph.edges.size());
+  std::vector<Key> surfaceKeys(graph.edges.size());
   parallelFor(graph.edges.size(), [&](std::size_t k) {
     const RoadEdge& e = graph.edges[k];
+    surfaceKeys[k] = doubleKey(e.width, bitsKey(e.line, static_cast<Key>(options.quadrantSegments)));
+    if (cache) {
+      if (const auto it = cache->surfaces.find(surfaceKeys[k]); it != cache->surfaces.end()) {
+        surfaces[k] = it->second;
+        return;
+      }
+    }
     surfaces[k] = geos::bufferedUnion({&e.line}, {0.5 * e.width}, options.quadrantSegments);
   });
   std::vector<BoxEntry> boxes;
@@ -591,6 +625,8 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
     int tooSmall = 0;
   };
   std::vector<FaceBlocks> perFace(faces.faces.size());
+  std::vector<Key> faceSignature(faces.faces.size(), 0);
+  std::vector<char> computed(faces.faces.size(), 0);
   parallelFor(
       faces.faces.size(),
       [&](std::size_t f) {
@@ -605,6 +641,23 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
           if (!graph.edges[static_cast<std::size_t>(it->second)].boundary) boxed.push_back(it->second);
         }
         std::sort(boxed.begin(), boxed.end());
+        if (cache) {
+          // The face and everything its blocks are made of: the edges near it.
+          Key key = bitsKey(face.outer, 0x9e3779b97f4a7c15ull);
+          for (const Ring& h : face.holes) key = bitsKey(h, key);
+          for (int k : boxed) {
+            key = mixKeys(mixKeys(key, static_cast<Key>(k)), graph.edges[static_cast<std::size_t>(k)].key);
+            key = mixKeys(key, surfaceKeys[static_cast<std::size_t>(k)]);
+          }
+          faceSignature[f] = key;
+          const auto it = cache->faces.find(key);
+          if (it != cache->faces.end() && sameVertexBits(it->second.face, face)) {
+            result.blocks = it->second.blocks;
+            result.tooSmall = it->second.tooSmall;
+            return;
+          }
+        }
+        computed[f] = 1;
         // Of the edges whose boxes meet the face's, those whose surface reaches it.
         std::vector<const Polyline*> lines;
         std::vector<double> reach;
@@ -658,6 +711,14 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
         reportProgress(progress, 0.2 + 0.8 * static_cast<double>(done) / static_cast<double>(faces.faces.size()),
                        "blocks");
       });
+  if (cache) {
+    for (std::size_t k = 0; k < graph.edges.size(); ++k) cache->surfaces.emplace(surfaceKeys[k], surfaces[k]);
+    for (std::size_t f = 0; f < perFace.size(); ++f) {
+      if (computed[f]) {
+        cache->faces[faceSignature[f]] = {faces.faces[f], perFace[f].blocks, perFace[f].tooLarge, perFace[f].tooSmall};
+      }
+    }
+  }
   for (FaceBlocks& f : perFace) {
     out.facesTooLarge += f.tooLarge;
     out.partsTooSmall += f.tooSmall;

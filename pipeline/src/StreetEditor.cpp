@@ -401,13 +401,20 @@ StreetEditor::StreetEditor(const GenerateRequest& request, const ProgressFn& pro
   if (request_.fromParcels) throw usageError("editing works on a street network without observed parcels");
   for (const ParameterDescription& d : streetParameters()) request_.parameters.emplace(d.name, d.defaultValue);
   request_.parameters.emplace("seed", 1.0);
-  auto network = std::make_shared<const StreetNetwork>(
+  auto network = std::make_shared<StreetNetwork>(
       buildStreetNetwork(*request_.streets, request_.parameters, nullptr, scaledProgress(progress, 0, 0.5)));
+  network->blocks = analysis::streetBlocks(network->graph, blockOptions(), {}, &cache_);  // the same, cached
   current_ = build(network, request_.overrides, {}, nullptr, nullptr);
   reportProgress(progress, 1.0, "subdividing");
 }
 
 StreetEditor::~StreetEditor() = default;
+
+analysis::StreetBlockOptions StreetEditor::blockOptions() const {
+  analysis::StreetBlockOptions options;
+  options.maxArea = request_.parameters.at("max-block-area");
+  return options;
+}
 
 EditReport StreetEditor::apply(const StreetEdit& edit) {
   const auto started = std::chrono::steady_clock::now();
@@ -529,10 +536,9 @@ EditReport StreetEditor::apply(const StreetEdit& edit) {
       case StreetEdit::Op::SetLock:
         break;
     }
-    analysis::StreetBlockOptions options;
-    options.maxArea = request_.parameters.at("max-block-area");
     const auto blocksStarted = std::chrono::steady_clock::now();
-    edited->blocks = analysis::streetBlocks(g, options);
+    if (cache_.faces.size() > 8 * std::max<std::size_t>(1, edited->blocks.blocks.size())) cache_ = {};
+    edited->blocks = analysis::streetBlocks(g, blockOptions(), {}, &cache_);
     report.secondsBlocks = std::chrono::duration<double>(std::chrono::steady_clock::now() - blocksStarted).count();
     network = std::move(edited);
   }

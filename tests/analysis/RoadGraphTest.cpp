@@ -11,6 +11,7 @@
 #include <map>
 #include <random>
 
+#include "TestUtil.h"
 #include "parcelscope/analysis/RoadGraph.h"
 #include "parcelscope/core/GeosOps.h"
 
@@ -350,6 +351,47 @@ TEST(RoadGraph, CurvedEdgesAreFlattenedAndTheirBlocksFollowTheCurve) {
   setCurve(g, south, std::nullopt);
   EXPECT_EQ(g.edges[south].line.size(), 2u);
   EXPECT_NEAR(area(streetBlocks(g).blocks.at(0).shape), flatArea, 1e-6);
+}
+
+// The cache gives the blocks a call without it gives, for a graph an edit
+// changed (a node moved, a width changed), and overlays again only the faces
+// the edit reached.
+TEST(RoadGraph, CachedBlocksAreTheBlocksOfACallWithoutTheCache) {
+  RoadGraph g = buildRoadGraph(grid(5, 100));
+  StreetBlockCache cache;
+  const StreetBlocks first = streetBlocks(g, {}, {}, &cache);
+  const std::size_t facesCached = cache.faces.size();
+  ASSERT_GT(facesCached, 0u);
+  auto same = [](const StreetBlocks& a, const StreetBlocks& b) {
+    if (a.blocks.size() != b.blocks.size()) return false;
+    for (std::size_t i = 0; i < a.blocks.size(); ++i) {
+      if (a.blocks[i].key != b.blocks[i].key || a.blocks[i].faced != b.blocks[i].faced ||
+          !test::sameBits(a.blocks[i].shape, b.blocks[i].shape)) {
+        return false;
+      }
+    }
+    return a.faces == b.faces && a.facesTooLarge == b.facesTooLarge && a.partsTooSmall == b.partsTooSmall;
+  };
+  EXPECT_TRUE(same(first, streetBlocks(g)));
+  EXPECT_TRUE(same(streetBlocks(g, {}, {}, &cache), first));
+  EXPECT_EQ(cache.faces.size(), facesCached);  // nothing new to overlay
+  // A node in the middle moved by 3 m, its edges' ends with it; then a width.
+  std::size_t middle = 0;
+  for (std::size_t i = 0; i < g.nodes.size(); ++i) {
+    if (std::hypot(g.nodes[i].at.x - 200, g.nodes[i].at.y - 200) < 1e-9) middle = i;
+  }
+  g.nodes[middle].at = {203, 201};
+  for (RoadEdge& e : g.edges) {
+    if (e.from == static_cast<int>(middle)) e.line.front() = g.nodes[middle].at;
+    if (e.to == static_cast<int>(middle)) e.line.back() = g.nodes[middle].at;
+  }
+  const StreetBlocks moved = streetBlocks(g, {}, {}, &cache);
+  EXPECT_TRUE(same(moved, streetBlocks(g)));
+  const std::size_t added = cache.faces.size() - facesCached;
+  EXPECT_GE(added, 4u);   // the four faces around the node
+  EXPECT_LE(added, 12u);  // and the faces whose nearby edges changed, not all 36
+  g.edges[3].width = 16;
+  EXPECT_TRUE(same(streetBlocks(g, {}, {}, &cache), streetBlocks(g)));
 }
 
 TEST(RoadGraph, FacesAboveTheLimitAreDropped) {

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "parcelscope/core/GeosOps.h"
@@ -142,6 +143,23 @@ struct StreetBlocks {
   std::int64_t partsTooSmall = 0;   ///< pieces under minArea or minWidth (dropped)
 };
 
+/// What streetBlocks may reuse from its earlier calls on graphs that differ
+/// by edits: each edge's street surface, by its line and width; each face's
+/// blocks, by the face and the edges near it (their indices, keys, lines and
+/// widths). A face an edit did not reach is not overlaid again: an interactive
+/// editor rebuilds only the faces around what it changed. The blocks are
+/// those of a call without the cache.
+struct StreetBlockCache {
+  struct Face {
+    Polygon face;  ///< the face, compared vertex for vertex on a hit
+    std::vector<StreetBlock> blocks;
+    bool tooLarge = false;
+    int tooSmall = 0;
+  };
+  std::unordered_map<Key, Face> faces;
+  std::unordered_map<Key, std::vector<Polygon>> surfaces;
+};
+
 /// The blocks of `graph` (every edge width must be known: see
 /// fillStreetWidths). Faces come from the lines noded in full (a bridge's
 /// crossings included, so that the land under it is street); each face minus
@@ -151,7 +169,7 @@ struct StreetBlocks {
 /// it. Throws Error(Geometry) if GEOS fails, Error(Cancelled) when `progress`
 /// asks to stop.
 StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& options = {},
-                          const ProgressFn& progress = {});
+                          const ProgressFn& progress = {}, StreetBlockCache* cache = nullptr);
 
 /// The street surface: every edge buffered by its half width, unioned.
 std::vector<Polygon> streetSurface(const RoadGraph& graph, int quadrantSegments = kStreetQuadrantSegments);

@@ -125,12 +125,16 @@ private:
   };
   std::shared_ptr<const State> build(std::shared_ptr<const StreetNetwork> network, BlockOverrides overrides,
                                      Attributes attributes, const State* previous, EditReport* report) const;
+  analysis::StreetBlockOptions blockOptions() const;
   // A copy of the current state with `change` applied to its attributes, made current.
   void changeAttributes(Key parcel, const std::function<void(Attributes&)>& change);
   std::shared_ptr<const State> current_;
   std::vector<std::shared_ptr<const State>> undo_, redo_;
   GenerateRequest request_;
   std::uint64_t serial_ = 0;  // edits applied so far (new parcels' keys)
+  // The faces and street surfaces of the networks built so far: an edit
+  // overlays again only the faces it reached.
+  analysis::StreetBlockCache cache_;
 };
 
 /// Reads an edits file: a JSON list of objects {"op": NAME, ...} with keys as
