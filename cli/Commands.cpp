@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <set>
 
 #include "Args.h"
@@ -276,6 +277,19 @@ int blocksCommand(const std::vector<std::string>& args) {
                        a);
 }
 
+namespace {
+
+// Whether `path` is a session file (its first kilobytes name parcelscope_session).
+bool isSessionFile(const std::string& path) {
+  std::ifstream in(path);
+  std::string head(4096, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  return head.find("\"parcelscope_session\"") != std::string::npos;
+}
+
+}  // namespace
+
 int editCommand(const std::vector<std::string>& args) {
   std::vector<FlagSpec> flags = streetInputFlags();
   flags.push_back(styleFlag());
@@ -285,9 +299,10 @@ int editCommand(const std::vector<std::string>& args) {
   const std::vector<ParameterDescription> params =
       joined(generation::generationParameterDescriptions(), pipeline::streetParameters());
   if (wantsHelp(args)) {
-    std::fputs(usageText("parcelscope edit STREETS [--style S] [--seed N] --edits EDITS.json --out DIR", flags, params)
-                   .c_str(),
-               stdout);
+    std::fputs(
+        usageText("parcelscope edit STREETS|SESSION [--style S] [--seed N] --edits EDITS.json --out DIR", flags, params)
+            .c_str(),
+        stdout);
     std::fputs(
         "\nBuilds the street network of STREETS and subdivides its blocks (as 'generate --streets'),\n"
         "then applies the edits of EDITS.json in order: move_node, move_edge, set_width, set_curve,\n"
@@ -305,10 +320,23 @@ int editCommand(const std::vector<std::string>& args) {
   if (!a.value("out")) throw usageError("--out DIR is required");
   if (!a.value("edits")) throw usageError("--edits EDITS.json is required");
   pipeline::GenerateRequest request;
-  request.streets = streetOptions(a, a.positional()[0], "");
+  const std::string& input = a.positional()[0];
   request.style = a.value("style").value_or("obb");
   request.parameters = a.parameters();
   request.explicitParameters = givenParameters(a, params);
+  if (isSessionFile(input)) {
+    // A session of `compare --streets`: its streets, style, parameters and
+    // block overrides (its observed parcels are not used: edits are of the network).
+    const pipeline::CompareRequest session = pipeline::readSession(input);
+    if (!session.streets) throw inputError(input + ": the session has no streets to edit");
+    request.streets = session.streets;
+    request.style = session.style;
+    for (const auto& [name, value] : session.parameters) request.parameters[name] = value;
+    request.explicitParameters.insert(session.explicitParameters.begin(), session.explicitParameters.end());
+    request.overrides = session.overrides;
+  } else {
+    request.streets = streetOptions(a, input, "");
+  }
   return reportOutcome(pipeline::runEdit(request, *a.value("edits"), *a.value("out"), terminalProgress(a.has("quiet"))),
                        a);
 }

@@ -320,6 +320,33 @@ TEST(EditCommand, EditsByKeyInTheInputsCrsAndWritesValidParcelsAndPersistence) {
   EXPECT_EQ(static_cast<std::int64_t>(keys.size()), n);  // unique
   EXPECT_EQ(labels, 1);
 
+  // A session with streets: its streets, style and parameters; the same edits give the same parcels.
+  const std::string session = dir.write(
+      "session.json", "{\"parcelscope_session\": 2, \"input\": {\"path\": \"" + streets +
+                          "\"}, \"streets\": {\"path\": \"" + streets +
+                          "\", \"width_field\": \"W\", \"name_field\": \"NAME\", \"no_node_where\": \"BR = 'Y'\"}, "
+                          "\"style\": \"skeleton\", \"parameters\": {\"default-width\": 10}}");
+  const CliRun fromSession =
+      run("edit '" + session + "' --quiet --edits '" + editsFile + "' --out '" + dir.file("from-session") + "'");
+  ASSERT_EQ(fromSession.code, 0) << fromSession.output;
+  // Every edit's counts (the columns before the seconds) are the same.
+  auto counts = [](const std::string& text) {
+    std::string out;
+    std::istringstream lines(text);
+    for (std::string line; std::getline(lines, line);) {
+      std::size_t at = 0;
+      for (int field = 0; field < 8 && at != std::string::npos; ++field) at = line.find(',', at + 1);
+      out += line.substr(0, at) + "\n";
+    }
+    return out;
+  };
+  EXPECT_EQ(counts(slurp(dir.file("from-session") + "/persistence.csv")), counts(csv));
+  {
+    auto a = test::openVectorFile(dir.file("from-session") + "/parcels.gpkg");
+    ASSERT_TRUE(a);
+    EXPECT_EQ(a->GetLayer(0)->GetFeatureCount(), n);
+  }
+
   // An edit naming a node the network does not have: one line naming the file and the edit, nothing written.
   const std::string bad = dir.write("bad.json", R"([{"op": "move_node", "node": "0123456789abcdef", "to": [0, 0]}])");
   const CliRun b = run("edit '" + streets + "'" + kFlags + " --edits '" + bad + "' --out '" + dir.file("bad") + "'");
