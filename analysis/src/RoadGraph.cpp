@@ -568,18 +568,6 @@ Key doubleKey(double x, Key basis) {
   return hashBytes(std::string_view(reinterpret_cast<const char*>(&x), sizeof x), basis);
 }
 
-bool sameVertexBits(const Polygon& a, const Polygon& b) {
-  auto same = [](const Ring& x, const Ring& y) {
-    return x.size() == y.size() && std::equal(x.begin(), x.end(), y.begin(),
-                                              [](const Point& p, const Point& q) { return p.x == q.x && p.y == q.y; });
-  };
-  if (!same(a.outer, b.outer) || a.holes.size() != b.holes.size()) return false;
-  for (std::size_t h = 0; h < a.holes.size(); ++h) {
-    if (!same(a.holes[h], b.holes[h])) return false;
-  }
-  return true;
-}
-
 }  // namespace
 
 StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& options, const ProgressFn& progress,
@@ -651,7 +639,7 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
           }
           faceSignature[f] = key;
           const auto it = cache->faces.find(key);
-          if (it != cache->faces.end() && sameVertexBits(it->second.face, face)) {
+          if (it != cache->faces.end() && sameVertices(it->second.face, face)) {
             result.blocks = it->second.blocks;
             result.tooSmall = it->second.tooSmall;
             return;

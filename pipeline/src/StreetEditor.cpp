@@ -63,22 +63,6 @@ struct StreetEditor::State {
 
 namespace {
 
-bool sameRing(const Ring& a, const Ring& b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (a[i].x != b[i].x || a[i].y != b[i].y) return false;
-  }
-  return true;
-}
-
-bool sameShape(const Polygon& a, const Polygon& b) {
-  if (!sameRing(a.outer, b.outer) || a.holes.size() != b.holes.size()) return false;
-  for (std::size_t h = 0; h < a.holes.size(); ++h) {
-    if (!sameRing(a.holes[h], b.holes[h])) return false;
-  }
-  return true;
-}
-
 bool sameWidths(const StreetWidths& a, const StreetWidths& b) {
   if (a.size() != b.size()) return false;
   for (std::size_t r = 0; r < a.size(); ++r) {
@@ -158,22 +142,27 @@ analysis::RoadGraph renoded(const analysis::RoadGraph& graph, const std::set<std
   for (analysis::RoadNode& n : out.nodes) {
     if (const auto it = nodeAt.find({n.at.x, n.at.y}); it != nodeAt.end()) n.key = it->second;
   }
-  auto sameLine = [](const std::vector<Point>& a, const std::vector<Point>& b) {
-    if (a.size() != b.size()) return false;
-    const bool forward = std::equal(a.begin(), a.end(), b.begin(),
-                                    [](const Point& p, const Point& q) { return p.x == q.x && p.y == q.y; });
-    return forward || std::equal(a.begin(), a.end(), b.rbegin(),
-                                 [](const Point& p, const Point& q) { return p.x == q.x && p.y == q.y; });
+  // The edges before by their vertices, either way along.
+  auto vertices = [](const std::vector<Point>& line) {
+    std::vector<std::pair<double, double>> v;
+    for (const Point& p : line) v.emplace_back(p.x, p.y);
+    return v;
   };
+  std::map<std::vector<std::pair<double, double>>, std::size_t> edgeAlong;
+  for (std::size_t k = 0; k < graph.edges.size(); ++k) {
+    if (removed.count(k)) continue;
+    auto v = vertices(graph.edges[k].line);
+    edgeAlong.emplace(v, k);
+    std::reverse(v.begin(), v.end());
+    edgeAlong.emplace(std::move(v), k);
+  }
   for (analysis::RoadEdge& e : out.edges) {
-    for (std::size_t k = 0; k < graph.edges.size(); ++k) {
-      const analysis::RoadEdge& old = graph.edges[k];
-      if (removed.count(k) || !sameLine(e.line, old.line)) continue;
-      e.key = old.key;
-      if (old.controls && e.line.front().x == old.line.front().x && e.line.front().y == old.line.front().y) {
-        e.controls = old.controls;
-      }
-      break;
+    const auto it = edgeAlong.find(vertices(e.line));
+    if (it == edgeAlong.end()) continue;
+    const analysis::RoadEdge& old = graph.edges[it->second];
+    e.key = old.key;
+    if (old.controls && e.line.front().x == old.line.front().x && e.line.front().y == old.line.front().y) {
+      e.controls = old.controls;
     }
   }
   // Sorted by key again, as buildRoadGraph leaves them.
@@ -196,10 +185,6 @@ analysis::RoadGraph renoded(const analysis::RoadGraph& graph, const std::set<std
             [](const analysis::RoadEdge& a, const analysis::RoadEdge& b) { return a.key < b.key; });
   return out;
 }
-
-}  // namespace
-
-namespace {
 
 // Block entry `entry` subdivided by `plan` around the parcels `anchored` (kept
 // as they are, first): the rest of the block, in pieces, each subdivided with
@@ -260,7 +245,7 @@ std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<c
     if (it != before.end()) {
       const std::size_t p = it->second;
       counterpart[k] = static_cast<long>(p);
-      if (sameShape(e.shape, previous->inputs.entries[p].shape) &&
+      if (sameVertices(e.shape, previous->inputs.entries[p].shape) &&
           sameWidths(s->inputs.widths[k], previous->inputs.widths[p]) && s->plans[k] == previous->plans[p]) {
         s->outcomes[k] = previous->outcomes[p];
         s->entryKeys[k] = previous->entryKeys[p];
