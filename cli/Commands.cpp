@@ -306,10 +306,10 @@ int editCommand(const std::vector<std::string>& args) {
     std::fputs(
         "\nBuilds the street network of STREETS and subdivides its blocks (as 'generate --streets'),\n"
         "then applies the edits of EDITS.json in order: move_node, move_edge, set_width, set_curve,\n"
-        "transform_nodes, insert_node, add_street, delete_street, set_block, set_label. Only the\n"
-        "blocks an edit changes are subdivided again; their\n"
-        "parcels are matched to those before, and a matched parcel keeps its key. Writes\n"
-        "DIR/parcels.gpkg (with parcel_key and label), DIR/blocks.gpkg, DIR/streets.gpkg,\n"
+        "transform_nodes, insert_node, add_street, delete_street, set_block, set_label, set_lock.\n"
+        "Only the blocks an edit changes are subdivided again; their parcels are matched to those\n"
+        "before, and a matched parcel keeps its key. Writes DIR/parcels.gpkg (with parcel_key,\n"
+        "label and locked), DIR/blocks.gpkg, DIR/streets.gpkg,\n"
         "DIR/street_surface.gpkg, DIR/persistence.csv (per edit: blocks affected, parcels before\n"
         "and after, keys kept) and DIR/run.json.\n",
         stdout);

@@ -51,44 +51,11 @@ std::vector<std::vector<std::vector<int>>> parcelsByBlock(const Leaderboard& boa
   return out;
 }
 
-// The measures over the blocks `blocks`, block b's parcels made by entry `entryOf[b]`.
-FitMeasures measure(const Leaderboard& board, const std::vector<std::vector<std::vector<int>>>& parcels,
-                    const std::vector<std::size_t>& blocks, const std::vector<std::size_t>& entryOf) {
-  const analysis::ObservedAnalysis& a = board.observed->analysis;
-  std::array<std::vector<double>, 3> observed, generated;
-  auto add = [](std::array<std::vector<double>, 3>& to, const analysis::ParcelMetrics& m) {
-    to[0].push_back(m.area);
-    to[1].push_back(m.width);
-    to[2].push_back(m.aspectRatio);
-  };
-  std::vector<double> countErrors;
-  for (std::size_t b : blocks) {
-    for (int i : a.blocks[b].parcels) add(observed, a.metrics[static_cast<std::size_t>(i)]);
-    const GeneratedParcels& g = board.entries[entryOf[b]].result.generated;
-    for (int i : parcels[entryOf[b]][b]) add(generated, g.metrics[static_cast<std::size_t>(i)]);
-    if (!a.blocks[b].parcels.empty()) {
-      countErrors.push_back(std::fabs(
-          static_cast<double>(parcels[entryOf[b]][b].size()) / static_cast<double>(a.blocks[b].parcels.size()) - 1));
-    }
-  }
-  FitMeasures f;
-  f.blocks = static_cast<std::int64_t>(blocks.size());
-  f.ksArea = analysis::ksStatistic(observed[0], generated[0]);
-  f.ksWidth = analysis::ksStatistic(observed[1], generated[1]);
-  f.ksAspectRatio = analysis::ksStatistic(observed[2], generated[2]);
-  if (!countErrors.empty()) {
-    std::nth_element(countErrors.begin(), countErrors.begin() + static_cast<long>(countErrors.size() / 2),
-                     countErrors.end());
-    f.medianCountError = countErrors[countErrors.size() / 2];
-  }
-  return f;
-}
-
-// measure() for the many evaluations of the refinement: each sample sorted
-// once (the observed parcels of the blocks, each entry's parcels in each
-// block), and the pooled generated samples of the current choice kept sorted,
-// so that measuring a change of one block's style is a merge rather than a
-// sort. The values are exactly measure()'s: the same sorted samples.
+// The measures of a choice of entries over some blocks, for the many
+// evaluations of the refinement: each sample sorted once (the observed
+// parcels of the blocks, each entry's parcels in each block), and the pooled
+// generated samples of the current choice kept sorted, so that measuring a
+// change of one block's style is a merge rather than a sort.
 class ChoiceMeasure {
 public:
   ChoiceMeasure(const Leaderboard& board, const std::vector<std::vector<std::vector<int>>>& parcels,
@@ -202,6 +169,12 @@ private:
   Samples observed_, pooled_;
   std::vector<double> countError_;  // per position in blocks_
 };
+
+// The measures over the blocks `blocks`, block b's parcels made by entry `entryOf[b]`.
+FitMeasures measure(const Leaderboard& board, const std::vector<std::vector<std::vector<int>>>& parcels,
+                    const std::vector<std::size_t>& blocks, const std::vector<std::size_t>& entryOf) {
+  return ChoiceMeasure(board, parcels, blocks, {}, entryOf).current();
+}
 
 // What the auto rule knows of observed block b: its largest part's shape and
 // its observed parcels.

@@ -81,19 +81,16 @@ Key freshKey(Key blockKey, int part, std::uint64_t serial, std::size_t index) {
   return mixKeys(mixKeys(partKey(blockKey, part), serial), static_cast<Key>(index));
 }
 
-std::size_t indexOf(const std::vector<analysis::RoadNode>& nodes, Key key) {
-  for (std::size_t i = 0; i < nodes.size(); ++i) {
-    if (nodes[i].key == key) return i;
+// Index of the node or edge of key `key`; Error(Usage) naming it (`what`) when none.
+template <typename Item>
+std::size_t indexOf(const std::vector<Item>& items, Key key, const char* what) {
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (items[i].key == key) return i;
   }
-  throw usageError("the network has no node " + keyText(key));
+  throw usageError(std::string("the network has no ") + what + " " + keyText(key));
 }
-
-std::size_t indexOf(const std::vector<analysis::RoadEdge>& edges, Key key) {
-  for (std::size_t i = 0; i < edges.size(); ++i) {
-    if (edges[i].key == key) return i;
-  }
-  throw usageError("the network has no edge " + keyText(key));
-}
+std::size_t indexOf(const std::vector<analysis::RoadNode>& nodes, Key key) { return indexOf(nodes, key, "node"); }
+std::size_t indexOf(const std::vector<analysis::RoadEdge>& edges, Key key) { return indexOf(edges, key, "edge"); }
 
 // Moves the nodes of `graph` by `move` (a node's new position from its old),
 // the ends of the edges at them with them; the inner vertices and control
