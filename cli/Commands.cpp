@@ -311,7 +311,9 @@ int editCommand(const std::vector<std::string>& args) {
         "before, and a matched parcel keeps its key. Writes DIR/parcels.gpkg (with parcel_key,\n"
         "label and locked), DIR/blocks.gpkg, DIR/streets.gpkg,\n"
         "DIR/street_surface.gpkg, DIR/persistence.csv (per edit: blocks affected, parcels before\n"
-        "and after, keys kept) and DIR/run.json.\n",
+        "and after, keys kept) and DIR/run.json. A SESSION (of 'compare --streets', or saved by the\n"
+        "application) edits the network it compares: its observed parcels give each block its bounds\n"
+        "and the first parcels are those 'compare' generates, as in the application's Edit > Edit streets.\n",
         stdout);
     return 0;
   }
@@ -325,15 +327,28 @@ int editCommand(const std::vector<std::string>& args) {
   request.parameters = a.parameters();
   request.explicitParameters = givenParameters(a, params);
   if (isSessionFile(input)) {
-    // A session of `compare --streets`: its streets, style, parameters and
-    // block overrides (its observed parcels are not used: edits are of the network).
-    const pipeline::CompareRequest session = pipeline::readSession(input);
+    // A session of `compare --streets`: the network it compares, with its
+    // observed parcels' per-block bounds, style, parameters and overrides (as
+    // the application edits it); flags given here override the session's.
+    pipeline::CompareRequest session = pipeline::readSession(input);
     if (!session.streets) throw inputError(input + ": the session has no streets to edit");
-    request.streets = session.streets;
-    request.style = session.style;
-    for (const auto& [name, value] : session.parameters) request.parameters[name] = value;
-    request.explicitParameters.insert(session.explicitParameters.begin(), session.explicitParameters.end());
-    request.overrides = session.overrides;
+    if (session.input.path == session.streets->path) {
+      // A session naming its streets as its input has no observed parcels: the network alone.
+      request.streets = session.streets;
+      request.style = session.style;
+      for (const auto& [name, value] : session.parameters) request.parameters[name] = value;
+      request.explicitParameters.insert(session.explicitParameters.begin(), session.explicitParameters.end());
+      request.overrides = session.overrides;
+      return reportOutcome(
+          pipeline::runEdit(request, *a.value("edits"), *a.value("out"), terminalProgress(a.has("quiet"))), a);
+    }
+    if (a.value("style")) session.style = *a.value("style");
+    for (const std::string& name : givenParameters(a, params)) {
+      session.parameters[name] = request.parameters.at(name);
+      session.explicitParameters.insert(name);
+    }
+    return reportOutcome(
+        pipeline::runEdit(session, *a.value("edits"), *a.value("out"), terminalProgress(a.has("quiet"))), a);
   } else {
     request.streets = streetOptions(a, input, "");
   }

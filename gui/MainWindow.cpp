@@ -57,6 +57,7 @@
 #include <utility>
 
 #include "BackgroundTask.h"
+#include "Laps.h"
 #include "LeaderboardDialog.h"
 #include "MapView.h"
 #include "ParameterPanel.h"
@@ -86,23 +87,6 @@ public:
 vtkStandardNewMacro(ChartStyle);
 
 namespace {
-
-// Milliseconds since the last call (the first: since construction), for
-// MainWindow::UpdateTimings.
-class Laps {
-public:
-  Laps() { timer_.start(); }
-  double operator()() {
-    const double now = total(), ms = now - last_;
-    last_ = now;
-    return ms;
-  }
-  double total() const { return static_cast<double>(timer_.nsecsElapsed()) / 1e6; }
-
-private:
-  QElapsedTimer timer_;
-  double last_ = 0;
-};
 
 // The parameters a block override offers.
 const char* kBlockParameters[] = {"a-min", "a-max", "w-min", "w-max", "omega", "offset", "seed"};
@@ -274,13 +258,38 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new Sessi
   maps->addWidget(proceduralView_);
   for (MapView* v : {observedView_, proceduralView_}) {
     const bool procedural = v == proceduralView_;
-    connect(v, &MapView::clicked, this, [this, procedural](double x, double y) { inspectAt(procedural, x, y); });
+    connect(v, &MapView::clicked, this, [this, procedural](double x, double y) {
+      if (procedural && editing_) return editClickAt(x, y);
+      inspectAt(procedural, x, y);
+    });
     connect(v, &MapView::pointerMoved, this, [this](double x, double y) {
       const QString text = coordinateText(x, y);
       observedView_->setReadout(text);
       proceduralView_->setReadout(text);
     });
   }
+
+  // Street editing in the procedural view: a press on a node or a control point drags it.
+  proceduralView_->setGrab([this](double x, double y) { return pressAt(x, y); });
+  connect(proceduralView_, &MapView::dragged, this, [this](double x, double y) { dragTo(x, y); });
+  connect(proceduralView_, &MapView::dropped, this, [this](double x, double y) { dropAt(x, y); });
+  editWorker_ = new StreetEditWorker;
+  editWorker_->moveToThread(&editThread_);
+  connect(&editThread_, &QThread::finished, editWorker_, &QObject::deleteLater);
+  connect(editWorker_, &StreetEditWorker::updated, this,
+          [this](const StreetEditState& state) { drawEditState(state); });
+  connect(editWorker_, &StreetEditWorker::failed, this, [this](const QString& message, qint64 serial) {
+    editStarted_.erase(serial);
+    if (!editing_) return;
+    if (!editState_) {
+      // The editor could not be built.
+      showError("Edit streets: " + message);
+      setEditing(false);
+      return;
+    }
+    showError("Edit: " + message);
+  });
+  editThread_.start();
 
   // Histogram and numbers.
   histogramWidget_ = new QVTKOpenGLStereoWidget;
@@ -382,6 +391,9 @@ MainWindow::~MainWindow() {
   worker_->cancel();
   thread_.quit();
   thread_.wait();
+  editWorker_->stop();
+  editThread_.quit();
+  editThread_.wait();
 }
 
 QWidget* MainWindow::buildControls() {
@@ -559,6 +571,7 @@ void MainWindow::buildMenus() {
   });
   file->addSeparator();
   file->addAction("&Quit", this, &QWidget::close, QKeySequence::Quit);
+  buildEditMenu();
   QMenu* analysis = menuBar()->addMenu("&Analysis");
   leaderboardAction_ = analysis->addAction("Compare every &style...", this, [this] { showLeaderboard(); });
   leaderboardAction_->setEnabled(false);
@@ -952,6 +965,7 @@ void MainWindow::inspectAt(bool procedural, double x, double y) {
 QString MainWindow::parcelInfoText() const { return parcelInfo_->toPlainText(); }
 
 void MainWindow::showParcel() {
+  if (editing_) return showEditParcel();
   QString html;
   const auto& shown = controller_.shownResult();
   if (!shown || selectedParcel_ < 0) {
@@ -1148,21 +1162,12 @@ void MainWindow::drawReport(const UpdateReport& report) {
       }
       surface = analysis::streetSurface(network->graph);
     }
-    for (MapView* view : {observedView_, proceduralView_}) view->streets().setStreets(lines, surface);
+    observedView_->streets().setStreets(lines, surface);
+    if (!editing_) proceduralView_->streets().setStreets(lines, surface);
   }
-  {
-    // Grouped by block, so that only the layer parts holding changed blocks are built again.
-    std::vector<const Polygon*> shapes;
-    std::vector<double> values;
-    std::vector<int> blocks(r.generated.parcels.size(), -1);
-    for (std::size_t b = 0; b < r.generated.blocks.size(); ++b) {
-      for (int p : r.generated.blocks[b].parcels) blocks[static_cast<std::size_t>(p)] = static_cast<int>(b);
-    }
-    for (std::size_t i = 0; i < r.generated.parcels.size(); ++i) {
-      shapes.push_back(&r.generated.parcels[i]);
-      values.push_back(r.generated.isUnassigned(i) ? std::nan("") : q.value(r.generated.metrics[i]));
-    }
-    proceduralView_->layer().setShapes(shapes, values, blocks);
+  if (first && editing_) setEditing(false);  // another input: its network is not the one edited
+  if (!editing_) {
+    drawProceduralLayer(r.generated);
     // The layer reads these shapes again when the zoom changes.
     releaseInBackground(std::exchange(layerResult_, controller_.shownResult()));
   }
@@ -1240,6 +1245,22 @@ void MainWindow::drawReport(const UpdateReport& report) {
   emit viewsUpdated(report.serial);
 }
 
+void MainWindow::drawProceduralLayer(const pipeline::GeneratedParcels& generated) {
+  // Grouped by block, so that only the layer parts holding changed blocks are built again.
+  const analysis::ParcelQuantity& q = analysis::parcelQuantity(controller_.request().metric);
+  std::vector<const Polygon*> shapes;
+  std::vector<double> values;
+  std::vector<int> blocks(generated.parcels.size(), -1);
+  for (std::size_t b = 0; b < generated.blocks.size(); ++b) {
+    for (int p : generated.blocks[b].parcels) blocks[static_cast<std::size_t>(p)] = static_cast<int>(b);
+  }
+  for (std::size_t i = 0; i < generated.parcels.size(); ++i) {
+    shapes.push_back(&generated.parcels[i]);
+    values.push_back(generated.isUnassigned(i) ? std::nan("") : q.value(generated.metrics[i]));
+  }
+  proceduralView_->layer().setShapes(shapes, values, blocks);
+}
+
 void MainWindow::noteContextCompleted(qint64 serial) {
   if (const auto it = completeStarted_.find(serial); it != completeStarted_.end()) {
     lastCompleteMs_ = static_cast<double>(it->second.nsecsElapsed()) / 1e6;
@@ -1263,10 +1284,13 @@ bool MainWindow::recolour(bool observedChanged) {
     observedView_->layer().setValues(observed);
     shownQuantity_ = q.name;
   }
+  // The procedural view shows the comparison's parcels, or the edited network's.
+  const pipeline::GeneratedParcels& shownParcels =
+      editing_ && editState_ ? editState_->snapshot->parcels() : r.generated;
   std::vector<double> generated;
-  generated.reserve(r.generated.metrics.size());
-  for (std::size_t i = 0; i < r.generated.metrics.size(); ++i) {
-    generated.push_back(r.generated.isUnassigned(i) ? std::nan("") : q.value(r.generated.metrics[i]));  // grey
+  generated.reserve(shownParcels.metrics.size());
+  for (std::size_t i = 0; i < shownParcels.metrics.size(); ++i) {
+    generated.push_back(shownParcels.isUnassigned(i) ? std::nan("") : q.value(shownParcels.metrics[i]));  // grey
   }
   proceduralView_->layer().setValues(generated);
   const pipeline::CompareRequest shown = controller_.shownRequest();
@@ -1284,7 +1308,7 @@ bool MainWindow::recolour(bool observedChanged) {
 }
 
 void MainWindow::titleProcedural() {
-  if (!controller_.shownResult()) return;
+  if (!controller_.shownResult() || editing_) return;
   const pipeline::CompareResult& r = *controller_.shownResult();
   if (!partialCancelled_) {
     const auto unassigned = static_cast<std::size_t>(r.generated.unassignedParcels);
@@ -1541,6 +1565,7 @@ void MainWindow::updateActions() {
   const bool shown = controller_.shownResult() != nullptr;
   overrideBlock_->setEnabled(shown);
   clearOverride_->setEnabled(shown);
+  updateEditActions();
 }
 
 void MainWindow::dragEnterEvent(QDragEnterEvent* event) {

@@ -13,6 +13,7 @@
 #include <QStringList>
 #include <QThread>
 
+#include <array>
 #include <functional>
 #include <map>
 #include <memory>
@@ -22,6 +23,7 @@
 #include <vtkSmartPointer.h>
 
 #include "SessionWorker.h"
+#include "StreetEditWorker.h"
 #include "parcelscope/pipeline/CompareSession.h"
 #include "parcelscope/pipeline/Controller.h"
 #include "parcelscope/viz/Figures.h"
@@ -170,6 +172,57 @@ public:
   /// True while an update is queued or under way.
   bool busy() const { return controller_.busy(); }
 
+  // ---- Street editing (Edit menu; Vanegas et al. 2012, section 5) ------------
+  // The procedural view shows the shown comparison's street network, edited:
+  // drag a node and the parcels of the blocks around it follow; draw a street,
+  // delete one, change its width, curve it by dragging its control points;
+  // click a parcel to label or lock it (its key, label and lock follow it
+  // across edits). The same pipeline::StreetEditor as `parcelscope edit`, on
+  // its own thread (StreetEditWorker). Save edits writes them as the command
+  // line's edits file.
+
+  /// Starts (or ends) editing the streets of the comparison shown; false when
+  /// it has no street network. The parameter panel is disabled meanwhile.
+  bool setEditing(bool on);
+  bool editing() const { return editing_; }
+  /// The editor's state shown; null before the first arrives.
+  const StreetEditState* editState() const { return editState_ ? &*editState_ : nullptr; }
+  /// The gestures of the procedural view, in local metres: a press on a node
+  /// or a control point starts a drag (true), each move applies it, the drop
+  /// ends it; a press elsewhere pans. A drag is one step of undo.
+  bool pressAt(double x, double y);
+  void dragTo(double x, double y);
+  void dropAt(double x, double y);
+  /// A click while editing: drawing a street, its end; else selects the node,
+  /// the street or the parcel there (in that order, within a few pixels).
+  void editClickAt(double x, double y);
+  void undoEdit();
+  void redoEdit();
+  /// Edit > Draw street: the next two clicks are a new street's ends (a click
+  /// on a node joins it there).
+  void setDrawingStreet(bool on);
+  void deleteSelectedStreet();
+  void setSelectedStreetWidth(double width);
+  /// Curves the selected street (control points at its thirds) or straightens it.
+  void setSelectedStreetCurved(bool curved);
+  void labelSelectedParcel(const QString& label);
+  void lockSelectedParcel(bool locked);
+  /// Writes the edits applied (undone ones left out) as the edits file of
+  /// `parcelscope edit SESSION --edits FILE` (keys, coordinates in the input's CRS).
+  void saveEdits(const QString& path);
+  /// Edits submitted whose state is not drawn yet.
+  bool editBusy() const { return !editStarted_.empty(); }
+  Key selectedNode() const { return selectedNode_; }
+  Key selectedStreet() const { return selectedStreet_; }
+  Key selectedEditParcel() const { return selectedEditParcel_; }
+  /// Milliseconds from the last drag move (or other edit) submitted to the
+  /// procedural view drawn with its result, and where they went.
+  double lastEditLatencyMs() const { return lastEditLatencyMs_; }
+  struct EditTimings {
+    double library = 0, editor = 0, layers = 0, views = 0;
+  };
+  EditTimings lastEditTimings() const { return lastEditTimings_; }
+
 signals:
   /// Views, histograms and numbers show the result of request serial `serial`.
   void viewsUpdated(qint64 serial);
@@ -179,6 +232,8 @@ signals:
   /// The numbers of request serial `serial` are complete (its neighbours and
   /// street access were measured after its views were drawn).
   void contextCompleted(qint64 serial);
+  /// The procedural view shows the editor's state that answers command `serial` (0: the first state).
+  void editShown(qint64 serial);
 
 protected:
   /// With unsaved block overrides, asks Save / Discard / Cancel first.
@@ -188,6 +243,21 @@ protected:
 
 private:
   void buildMenus();
+  void buildEditMenu();
+  /// The procedural layer from `generated` (grouped by block, so that only
+  /// the layer parts of changed blocks are built again).
+  void drawProceduralLayer(const pipeline::GeneratedParcels& generated);
+  void drawEditState(const StreetEditState& state);
+  /// The handles of the editor's network and selection.
+  void drawHandles();
+  void showEditParcel();
+  qint64 submitEdit(const StreetEditWorker::Command& command);
+  void updateEditActions();
+  /// The node, the street or the control point of the selected street within
+  /// `pixels` of (x, y); -1 when none.
+  int nodeNear(double x, double y, double pixels) const;
+  int streetNear(double x, double y, double pixels) const;
+  int controlNear(double x, double y, double pixels) const;
   QWidget* buildControls();
   void submit();
   void showReport(const UpdateReport& report);
@@ -302,6 +372,36 @@ private:
   double blockValue(const pipeline::CompareResult& result, int block, const std::string& name) const;
   /// Fills the override panel with the selected block's values.
   void fillOverridePanel(const pipeline::CompareResult& result);
+  // Street editing.
+  QThread editThread_;
+  StreetEditWorker* editWorker_;
+  bool editing_ = false;
+  std::optional<StreetEditState> editState_;
+  Key selectedNode_ = 0, selectedStreet_ = 0, selectedEditParcel_ = 0;
+  /// The drag under way: its gesture, what it moves (a node, or control point
+  /// `control` of the selected street).
+  qint64 gesture_ = 0, gestures_ = 0;
+  Key dragNode_ = 0;
+  int dragControl_ = -1;
+  Point dragStart_;
+  bool dragMoved_ = false;
+  std::optional<std::array<Point, 2>> dragControls_;  ///< the street's control points when the drag began
+  std::optional<Point> streetStart_;                  ///< drawing a street: its first end
+  Key streetStartNode_ = 0;
+  bool drawingStreet_ = false;
+  std::map<qint64, QElapsedTimer> editStarted_;
+  double lastEditLatencyMs_ = 0;
+  EditTimings lastEditTimings_;
+  QAction* editAction_ = nullptr;
+  QAction* undoAction_ = nullptr;
+  QAction* redoAction_ = nullptr;
+  QAction* drawStreetAction_ = nullptr;
+  QAction* deleteStreetAction_ = nullptr;
+  QAction* widthAction_ = nullptr;
+  QAction* curveAction_ = nullptr;
+  QAction* labelAction_ = nullptr;
+  QAction* lockAction_ = nullptr;
+  QAction* saveEditsAction_ = nullptr;
   QMenu* recentMenu_;
   QAction* setCrsAction_;
   QAction* filterAction_;

@@ -66,10 +66,20 @@ public:
   static PanZoomStyle* New();
   vtkTypeMacro(PanZoomStyle, vtkInteractorStyleTrackballCamera) std::function<void(int, int)> onClick;
   std::function<void(int, int)> onMove;
+  /// A left press at a display point: true when the owner takes it as the
+  /// start of a drag of its own (then onDrag follows each move and onDrop the
+  /// release, and the map does not pan).
+  std::function<bool(int, int)> onPress;
+  std::function<void(int, int)> onDrag, onDrop;
 
   void OnMouseMove() override {
-    vtkInteractorStyleTrackballCamera::OnMouseMove();
     const int* p = GetInteractor()->GetEventPosition();
+    if (grabbing_) {
+      if (onDrag) onDrag(p[0], p[1]);
+      if (onMove) onMove(p[0], p[1]);
+      return;
+    }
+    vtkInteractorStyleTrackballCamera::OnMouseMove();
     if (onMove) onMove(p[0], p[1]);
   }
 
@@ -90,14 +100,24 @@ public:
     FindPokedRenderer(p[0], p[1]);
     if (!CurrentRenderer) return;
     GrabFocus(EventCallbackCommand);
+    if (onPress && onPress(p[0], p[1])) {
+      grabbing_ = true;
+      return;
+    }
     StartPan();
   }
   void OnLeftButtonUp() override {
+    int* p = GetInteractor()->GetEventPosition();
+    if (grabbing_) {
+      grabbing_ = false;
+      if (Interactor) ReleaseFocus();
+      if (onDrop) onDrop(p[0], p[1]);
+      return;
+    }
     if (State == VTKIS_PAN) {
       EndPan();
       if (Interactor) ReleaseFocus();
     }
-    int* p = GetInteractor()->GetEventPosition();
     if (std::abs(p[0] - pressX_) + std::abs(p[1] - pressY_) <= 3 && onClick) onClick(p[0], p[1]);
   }
 
@@ -144,6 +164,7 @@ private:
   }
 
   int pressX_ = 0, pressY_ = 0;
+  bool grabbing_ = false;
 };
 vtkStandardNewMacro(PanZoomStyle);
 
@@ -200,6 +221,7 @@ MapView::MapView(const QString& title, bool withColourBar, QWidget* parent) : QW
   layer_.addTo(renderer_);
   streets_.addTo(renderer_);
   outline_.addTo(renderer_);
+  handles_.addTo(renderer_);
   // Before every frame, whoever asks for it (a change, a pan or zoom of the
   // shared camera): outlines for the shapes large enough at this zoom.
   vtkNew<vtkCallbackCommand> scale;
@@ -231,18 +253,20 @@ MapView::MapView(const QString& title, bool withColourBar, QWidget* parent) : QW
   }
   vtkNew<PanZoomStyle> style;
   style->onMove = [this](int x, int y) {
-    renderer_->SetDisplayPoint(x, y, 0);
-    renderer_->DisplayToWorld();
-    double w[4];
-    renderer_->GetWorldPoint(w);
-    if (w[3] != 0) emit pointerMoved(w[0] / w[3], w[1] / w[3]);
+    if (const auto w = worldAt(x, y)) emit pointerMoved(w->x, w->y);
   };
   style->onClick = [this](int x, int y) {
-    renderer_->SetDisplayPoint(x, y, 0);
-    renderer_->DisplayToWorld();
-    double w[4];
-    renderer_->GetWorldPoint(w);
-    if (w[3] != 0) emit clicked(w[0] / w[3], w[1] / w[3]);
+    if (const auto w = worldAt(x, y)) emit clicked(w->x, w->y);
+  };
+  style->onPress = [this](int x, int y) {
+    const auto w = worldAt(x, y);
+    return w && grab_ && grab_(w->x, w->y);
+  };
+  style->onDrag = [this](int x, int y) {
+    if (const auto w = worldAt(x, y)) emit dragged(w->x, w->y);
+  };
+  style->onDrop = [this](int x, int y) {
+    if (const auto w = worldAt(x, y)) emit dropped(w->x, w->y);
   };
   window_->GetInteractor()->SetInteractorStyle(style);
   useCamera(renderer_->GetActiveCamera());
@@ -251,6 +275,15 @@ MapView::MapView(const QString& title, bool withColourBar, QWidget* parent) : QW
 MapView::~MapView() {
   if (camera_ && observer_) camera_->RemoveObserver(observer_);
   renderer_->RemoveObserver(scaleObserver_);
+}
+
+std::optional<Point> MapView::worldAt(int x, int y) {
+  renderer_->SetDisplayPoint(x, y, 0);
+  renderer_->DisplayToWorld();
+  double w[4];
+  renderer_->GetWorldPoint(w);
+  if (w[3] == 0) return std::nullopt;
+  return Point{w[0] / w[3], w[1] / w[3]};
 }
 
 void MapView::setTitle(const QString& title) { title_->setText(title); }

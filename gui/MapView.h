@@ -6,6 +6,9 @@
 // Below the map: a scale bar and the coordinates of the point under the cursor.
 #include <QWidget>
 
+#include <functional>
+#include <optional>
+
 #include <vtkNew.h>
 #include <vtkSmartPointer.h>
 
@@ -28,6 +31,11 @@ public:
   viz::MapLayer& layer() { return layer_; }
   viz::OutlineLayer& outline() { return outline_; }
   viz::StreetLayer& streets() { return streets_; }
+  viz::HandleLayer& handles() { return handles_; }
+  /// Asked at each left press with its world point (local metres): true takes
+  /// the press as the start of a drag (dragged follows each move, dropped the
+  /// release, and the map does not pan). None: every drag pans.
+  void setGrab(std::function<bool(double x, double y)> grab) { grab_ = std::move(grab); }
   void setTitle(const QString& title);
   QString title() const;
   /// Shares `camera` with this view (linked views follow each other).
@@ -52,8 +60,12 @@ public:
 signals:
   void clicked(double x, double y);       ///< local metres
   void pointerMoved(double x, double y);  ///< local metres of the point under the cursor
+  void dragged(double x, double y);       ///< a drag the grab took moved here (local metres)
+  void dropped(double x, double y);       ///< and ended here
 
 private:
+  /// The world point (local metres) at display point (x, y), if any.
+  std::optional<Point> worldAt(int x, int y);
   void scheduleRender();
   /// Chooses the scale bar's length (1, 2 or 5 times a power of ten metres, at most 120 px).
   void updateScaleBar();
@@ -69,6 +81,8 @@ private:
   viz::MapLayer layer_;
   viz::OutlineLayer outline_;
   viz::StreetLayer streets_;
+  viz::HandleLayer handles_;
+  std::function<bool(double, double)> grab_;
   bool renderPending_ = false;
   unsigned long observer_ = 0;
   unsigned long scaleObserver_ = 0;

@@ -1,5 +1,6 @@
 #include "parcelscope/core/Json.h"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -137,9 +138,11 @@ void Json::write(std::string& out, int indent, int depth) const {
     if (!std::isfinite(*d)) {
       out += "null";
     } else {
+      // The shortest text that reads back as the same double: coordinates
+      // and parameters written here are read back bit for bit.
       char buf[32];
-      std::snprintf(buf, sizeof buf, "%.10g", *d);
-      out += buf;
+      const auto written = std::to_chars(buf, buf + sizeof buf, *d);
+      out.append(buf, written.ptr);
     }
   } else if (auto* s = std::get_if<std::string>(&value_)) {
     escape(out, *s);

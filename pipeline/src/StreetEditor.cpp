@@ -9,6 +9,7 @@
 #include <sstream>
 #include <utility>
 
+#include "CompareStages.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/GeosOps.h"
 #include "parcelscope/core/Parallel.h"
@@ -134,32 +135,71 @@ analysis::RoadGraph renoded(const analysis::RoadGraph& graph, const std::set<std
   analysis::RoadGraphOptions options;
   options.snap = snap;
   analysis::RoadGraph out = analysis::buildRoadGraph(lines, options);
-  std::map<std::pair<double, double>, Key> nodeAt;
-  for (const analysis::RoadNode& n : graph.nodes) nodeAt.emplace(std::make_pair(n.at.x, n.at.y), n.key);
-  for (analysis::RoadNode& n : out.nodes) {
-    if (const auto it = nodeAt.find({n.at.x, n.at.y}); it != nodeAt.end()) n.key = it->second;
-  }
-  // The edges before by their vertices, either way along.
-  auto vertices = [](const std::vector<Point>& line) {
-    std::vector<std::pair<double, double>> v;
-    for (const Point& p : line) v.emplace_back(p.x, p.y);
-    return v;
+  // A node within the noding grid's cell (1 mm) of a node before is that node:
+  // noding may move a node by a rounding, and an edit replayed from a file
+  // (coordinates through the input's CRS and back) by about as little.
+  constexpr double kSame = 1e-3;
+  std::map<std::pair<long long, long long>, std::vector<std::size_t>> cells;
+  const auto cellOf = [](const Point& p) {
+    return std::make_pair(static_cast<long long>(std::floor(p.x / kSame)),
+                          static_cast<long long>(std::floor(p.y / kSame)));
   };
-  std::map<std::vector<std::pair<double, double>>, std::size_t> edgeAlong;
+  for (std::size_t i = 0; i < graph.nodes.size(); ++i) cells[cellOf(graph.nodes[i].at)].push_back(i);
+  std::set<std::size_t> taken;
+  for (analysis::RoadNode& n : out.nodes) {
+    const auto [cx, cy] = cellOf(n.at);
+    double nearest = kSame;
+    long best = -1;
+    for (long long dx = -1; dx <= 1; ++dx) {
+      for (long long dy = -1; dy <= 1; ++dy) {
+        const auto it = cells.find({cx + dx, cy + dy});
+        if (it == cells.end()) continue;
+        for (std::size_t i : it->second) {
+          const double d = std::hypot(graph.nodes[i].at.x - n.at.x, graph.nodes[i].at.y - n.at.y);
+          if (d <= nearest && !taken.count(i)) {
+            nearest = d;
+            best = static_cast<long>(i);
+          }
+        }
+      }
+    }
+    if (best < 0) continue;
+    taken.insert(static_cast<std::size_t>(best));
+    n.key = graph.nodes[static_cast<std::size_t>(best)].key;
+  }
+  // An edge whose end nodes are those of an edge before (by key) and whose
+  // vertices lie within 1 mm of its vertices, either way along, is that edge.
+  const auto along = [&](const std::vector<Point>& a, const std::vector<Point>& b, bool reversed) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const Point& q = reversed ? b[b.size() - 1 - i] : b[i];
+      if (std::hypot(a[i].x - q.x, a[i].y - q.y) > kSame) return false;
+    }
+    return true;
+  };
+  std::map<std::pair<Key, Key>, std::vector<std::size_t>> edgesBetween;
   for (std::size_t k = 0; k < graph.edges.size(); ++k) {
     if (removed.count(k)) continue;
-    auto v = vertices(graph.edges[k].line);
-    edgeAlong.emplace(v, k);
-    std::reverse(v.begin(), v.end());
-    edgeAlong.emplace(std::move(v), k);
+    const analysis::RoadEdge& e = graph.edges[k];
+    const Key a = graph.nodes[static_cast<std::size_t>(e.from)].key,
+              b = graph.nodes[static_cast<std::size_t>(e.to)].key;
+    edgesBetween[std::minmax(a, b)].push_back(k);
   }
+  std::set<std::size_t> edgeTaken;
   for (analysis::RoadEdge& e : out.edges) {
-    const auto it = edgeAlong.find(vertices(e.line));
-    if (it == edgeAlong.end()) continue;
-    const analysis::RoadEdge& old = graph.edges[it->second];
-    e.key = old.key;
-    if (old.controls && e.line.front().x == old.line.front().x && e.line.front().y == old.line.front().y) {
-      e.controls = old.controls;
+    const Key a = out.nodes[static_cast<std::size_t>(e.from)].key, b = out.nodes[static_cast<std::size_t>(e.to)].key;
+    const auto it = edgesBetween.find(std::minmax(a, b));
+    if (it == edgesBetween.end()) continue;
+    for (std::size_t k : it->second) {
+      const analysis::RoadEdge& old = graph.edges[k];
+      if (edgeTaken.count(k)) continue;
+      const bool forward = along(e.line, old.line, false);
+      if (!forward && !along(e.line, old.line, true)) continue;
+      edgeTaken.insert(k);
+      e.key = old.key;
+      if (old.controls && forward && graph.nodes[static_cast<std::size_t>(old.from)].key == a)
+        e.controls = old.controls;
+      break;
     }
   }
   // Sorted by key again, as buildRoadGraph leaves them.
@@ -211,6 +251,16 @@ std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<c
   auto s = std::make_shared<State>();
   s->network = network;
   s->inputs = streetNetworkInputs(network);
+  for (BlockInputs::Entry& e : s->inputs.entries) {
+    const auto it = derived_.find({e.blockKey, e.part});
+    if (it == derived_.end()) continue;
+    Polygon shape = std::move(e.shape);
+    const std::int64_t id = e.blockId;
+    e = it->second;
+    e.shape = std::move(shape);
+    e.blockId = id;
+  }
+  if (observed_) s->inputs.source = std::make_shared<const io::ParcelLayer>(observed_->layer);
   // An override stays with its block's key; a block gone takes its override with it.
   std::set<Key> keys;
   for (const BlockInputs::Entry& e : s->inputs.entries) keys.insert(e.blockKey);
@@ -390,7 +440,46 @@ StreetEditor::StreetEditor(const GenerateRequest& request, const ProgressFn& pro
   reportProgress(progress, 1.0, "subdividing");
 }
 
+StreetEditor::StreetEditor(const CompareRequest& request, std::shared_ptr<const ObservedData> observed,
+                           const ProgressFn& progress)
+    : request_(detail::generateRequest(request, observed.get())), observed_(std::move(observed)) {
+  if (!observed_ || !observed_->streets) throw usageError("editing needs a street network (--streets)");
+  request_.streets = request.streets;
+  for (const ParameterDescription& d : streetParameters()) request_.parameters.emplace(d.name, d.defaultValue);
+  request_.parameters.emplace("seed", 1.0);
+  // The values each block part takes from its observed parcels, as generate() derives them.
+  GenerateRequest derive = request_;
+  derive.fromParcels = true;
+  derive.observed = observed_.get();
+  derive.overrides.clear();
+  derive.overridesById.clear();
+  BlockInputs inputs = prepareBlocks(derive, scaledProgress(progress, 0, 0.3));
+  for (BlockInputs::Entry& e : inputs.entries) {
+    e.shape = {};
+    derived_.emplace(std::make_pair(e.blockKey, e.part), std::move(e));
+  }
+  // The network as compared, its blocks from the cache from now on.
+  auto network = std::make_shared<StreetNetwork>(*observed_->streets);
+  network->blocks = analysis::streetBlocks(network->graph, blockOptions(), {}, &cache_);
+  request_.fromParcels = false;
+  request_.observed = nullptr;
+  current_ = build(network, request_.overrides, {}, nullptr, nullptr);
+  reportProgress(progress, 1.0, "subdividing");
+}
+
 StreetEditor::~StreetEditor() = default;
+
+StreetEditor::Snapshot StreetEditor::snapshot() const {
+  Snapshot s;
+  s.state_ = current_;
+  return s;
+}
+const StreetNetwork& StreetEditor::Snapshot::network() const { return *state_->network; }
+const GeneratedParcels& StreetEditor::Snapshot::parcels() const { return state_->parcels; }
+const std::vector<Key>& StreetEditor::Snapshot::parcelKeys() const { return state_->parcelKeys; }
+const std::map<Key, std::string>& StreetEditor::Snapshot::labels() const { return state_->attributes.labels; }
+const std::set<Key>& StreetEditor::Snapshot::locked() const { return state_->attributes.locked; }
+const BlockOverrides& StreetEditor::Snapshot::overrides() const { return state_->overrides; }
 
 analysis::StreetBlockOptions StreetEditor::blockOptions() const {
   analysis::StreetBlockOptions options;
@@ -524,7 +613,9 @@ EditReport StreetEditor::apply(const StreetEdit& edit) {
     report.secondsBlocks = std::chrono::duration<double>(std::chrono::steady_clock::now() - blocksStarted).count();
     network = std::move(edited);
   }
-  ++serial_;
+  // The depth of the state this edit makes: an edit undone and made again
+  // (as a drag does with each move) gives its new parcels the same keys.
+  serial_ = undo_.size() + 1;
   std::shared_ptr<const State> next = build(network, std::move(overrides), now.attributes, &now, &report);
   undo_.push_back(current_);
   redo_.clear();
@@ -740,6 +831,75 @@ std::vector<StreetEdit> readEdits(const std::string& path, const std::function<P
   return edits;
 }
 
+Json editsJson(const std::vector<StreetEdit>& edits, const io::LocalFrame& frame) {
+  const auto point = [&](const Point& local) {
+    const Point p = frame.toSource(local);
+    return Json::array().push(p.x).push(p.y);
+  };
+  // readEdit's displacement is toLocal(d) - toLocal(0, 0): its inverse.
+  const Point zero = frame.toLocal(0, 0);
+  const auto vector = [&](const Point& by) { return point({by.x + zero.x, by.y + zero.y}); };
+  Json list = Json::array();
+  for (const StreetEdit& e : edits) {
+    Json j = Json::object().set("op", editOpName(e.op));
+    switch (e.op) {
+      case StreetEdit::Op::MoveNode:
+        j.set("node", keyText(e.node)).set("to", point(e.to));
+        break;
+      case StreetEdit::Op::MoveEdge:
+        j.set("edge", keyText(e.edge)).set("by", vector(e.by));
+        break;
+      case StreetEdit::Op::SetWidth:
+        j.set("edge", keyText(e.edge)).set("width", e.width);
+        break;
+      case StreetEdit::Op::SetCurve:
+        j.set("edge", keyText(e.edge));
+        j.set("controls",
+              e.controls ? Json::array().push(point((*e.controls)[0])).push(point((*e.controls)[1])) : Json());
+        break;
+      case StreetEdit::Op::TransformNodes: {
+        Json nodes = Json::array();
+        for (Key k : e.nodes) nodes.push(keyText(k));
+        j.set("nodes", nodes).set("centre", point(e.centre)).set("by", vector(e.by));
+        j.set("rotate", e.rotate).set("scale", e.scale);
+        break;
+      }
+      case StreetEdit::Op::SetBlock: {
+        Json parameters = Json::object();
+        for (const auto& [name, value] : e.parameters) parameters.set(name, value);
+        j.set("block", keyText(e.block)).set("style", e.style).set("parameters", parameters);
+        break;
+      }
+      case StreetEdit::Op::SetLabel:
+        j.set("parcel", keyText(e.parcel)).set("label", e.label);
+        break;
+      case StreetEdit::Op::InsertNode:
+        j.set("edge", keyText(e.edge)).set("at", point(e.to));
+        break;
+      case StreetEdit::Op::AddStreet:
+        j.set("from", e.node != 0 ? Json(keyText(e.node)) : point(e.from));
+        j.set("to", e.node2 != 0 ? Json(keyText(e.node2)) : point(e.to));
+        j.set("width", e.width).set("name", e.name);
+        break;
+      case StreetEdit::Op::DeleteStreet:
+        j.set("edge", keyText(e.edge));
+        break;
+      case StreetEdit::Op::SetLock:
+        j.set("parcel", keyText(e.parcel)).set("locked", e.locked);
+        break;
+    }
+    list.push(j);
+  }
+  return list;
+}
+
+void writeEdits(const std::string& path, const std::vector<StreetEdit>& edits, const io::LocalFrame& frame,
+                const std::vector<std::string>& inputs) {
+  io::StagedFile file(path, inputs);
+  io::writeJson(file.path(), editsJson(edits, frame));
+  file.commit();
+}
+
 Table persistenceTable(const std::vector<EditReport>& reports) {
   Table t;
   using T = Column::Type;
@@ -784,13 +944,17 @@ Table editedParcelTable(const StreetEditor& editor, std::vector<std::vector<Poly
   return t;
 }
 
-JobOutcome runEdit(const GenerateRequest& request, const std::string& editsPath, const std::string& outDir,
-                   const ProgressFn& progress) {
-  std::vector<std::string> inputs{editsPath};
-  if (request.streets) inputs.push_back(request.streets->path);
+namespace {
+
+// runEdit with the editor `make` builds (given its share of the progress).
+JobOutcome runEditWith(const std::function<std::unique_ptr<StreetEditor>(const ProgressFn&)>& make,
+                       const std::string& style, const ParameterValues& parameters, std::vector<std::string> inputs,
+                       const std::string& editsPath, const std::string& outDir, const ProgressFn& progress) {
+  inputs.push_back(editsPath);
   io::OutputDirectory out(outDir, inputs);
   try {
-    StreetEditor editor(request, scaledProgress(progress, 0.0, 0.3));
+    const std::unique_ptr<StreetEditor> made = make(scaledProgress(progress, 0.0, 0.3));
+    StreetEditor& editor = *made;
     const std::vector<StreetEdit> edits = readEdits(editsPath, [&](const Point& p) { return editor.toLocal(p); });
     std::vector<EditReport> reports;
     for (std::size_t i = 0; i < edits.size(); ++i) {
@@ -810,8 +974,8 @@ JobOutcome runEdit(const GenerateRequest& request, const std::string& editsPath,
     written.emplace_back("parcels.gpkg", io::writePolygonLayer(out.stage("parcels.gpkg"), "parcels", geometries,
                                                                parcels, g.source->frame, g.source->crs));
     io::writeCsv(out.stage("persistence.csv"), persistenceTable(reports));
-    Json run = runRecord("edit", request.parameters)
-                   .set("style", request.style)
+    Json run = runRecord("edit", parameters)
+                   .set("style", style)
                    .set("edits",
                         Json::object().set("path", editsPath).set("applied", static_cast<std::int64_t>(reports.size())))
                    .set("counts", Json::object()
@@ -843,6 +1007,28 @@ JobOutcome runEdit(const GenerateRequest& request, const std::string& editsPath,
   } catch (const Error& e) {
     throw out.explain(e);
   }
+}
+
+}  // namespace
+
+JobOutcome runEdit(const GenerateRequest& request, const std::string& editsPath, const std::string& outDir,
+                   const ProgressFn& progress) {
+  std::vector<std::string> inputs;
+  if (request.streets) inputs.push_back(request.streets->path);
+  return runEditWith([&](const ProgressFn& p) { return std::make_unique<StreetEditor>(request, p); }, request.style,
+                     request.parameters, inputs, editsPath, outDir, progress);
+}
+
+JobOutcome runEdit(const CompareRequest& request, const std::string& editsPath, const std::string& outDir,
+                   const ProgressFn& progress) {
+  if (!request.streets) throw usageError("editing needs a street network (--streets)");
+  return runEditWith(
+      [&](const ProgressFn& p) {
+        auto observed = std::make_shared<const ObservedData>(loadObservedInStreetBlocks(
+            request.input, &*request.streets, request.parameters, scaledProgress(p, 0, 0.6)));
+        return std::make_unique<StreetEditor>(request, observed, scaledProgress(p, 0.6, 1.0));
+      },
+      request.style, request.parameters, inputPaths(request), editsPath, outDir, progress);
 }
 
 }  // namespace parcelscope::pipeline

@@ -438,6 +438,130 @@ TEST(StreetEditor, ALockedParcelKeepsItsGeometryWhileItsBlockIsSubdividedAroundI
   EXPECT_TRUE(editor.locked().empty());
 }
 
+// The application edits the network it compares: the editor of a comparison
+// starts from the comparison's parcels, bit for bit (per-block bounds from the
+// observed parcels included), and a block keeps its derived bounds while it
+// keeps its key.
+TEST(StreetEditor, TheEditorOfAComparisonStartsFromItsParcelsAndKeepsEachBlocksBounds) {
+  CompareRequest request;
+  request.input.path = std::string(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_town.geojson";
+  request.input.where = "use <> 'ROW'";
+  request.streets = sampleStreets().streets;
+  request.style = "skeleton";
+  request.parameters["seed"] = 3;
+  auto observed = std::make_shared<const ObservedData>(
+      loadObservedInStreetBlocks(request.input, &*request.streets, request.parameters));
+  const CompareResult compared = compare(request, observed);
+  StreetEditor editor(request, observed);
+  const GeneratedParcels& g = editor.parcels();
+  ASSERT_EQ(g.parcels.size(), compared.generated.parcels.size());
+  for (std::size_t i = 0; i < g.parcels.size(); ++i) {
+    ASSERT_TRUE(test::sameBits(g.parcels[i], compared.generated.parcels[i])) << "parcel " << i;
+  }
+  EXPECT_EQ(g.blockKeys, compared.generated.blockKeys);
+  // The editor draws in the comparison's frame.
+  const Point p = editor.toLocal({-71.1, 42.37});
+  const Point q = observed->layer.frame.toLocal(-71.1, 42.37);
+  EXPECT_EQ(p.x, q.x);
+  EXPECT_EQ(p.y, q.y);
+  // After a move, the blocks not affected keep their parcels and the affected
+  // ones are subdivided with their own bounds again (as a fresh comparison of
+  // the moved network would, were its observed parcels the same).
+  const Key node = busiestNode(editor);
+  const EditReport r = editor.apply(moveNodeBy(editor, node, 1.5, -1));
+  EXPECT_FALSE(r.blocksAffected.empty());
+  EXPECT_GE(static_cast<double>(r.matched), 0.8 * static_cast<double>(std::min(r.parcelsBefore, r.parcelsAfter)));
+  ASSERT_TRUE(editor.undo());
+  for (std::size_t i = 0; i < g.parcels.size(); ++i) {
+    ASSERT_TRUE(test::sameBits(editor.parcels().parcels[i], compared.generated.parcels[i])) << "parcel " << i;
+  }
+  // A snapshot stays as it was while the editor goes on.
+  const StreetEditor::Snapshot shot = editor.snapshot();
+  const std::size_t count = shot.parcels().parcels.size();
+  editor.apply(moveNodeBy(editor, node, 3, 3));
+  EXPECT_EQ(shot.parcels().parcels.size(), count);
+  EXPECT_EQ(shot.parcelKeys().size(), count);
+}
+
+// The edits written as an edits file (coordinates through the input's
+// geographic CRS and back) and replayed on a fresh editor give the same
+// network, parcels and keys.
+TEST(StreetEditor, EditsWrittenAndReplayedGiveTheSameParcelsAndKeys) {
+  CompareRequest request;
+  request.input.path = std::string(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_town.geojson";
+  request.input.where = "use <> 'ROW'";
+  request.streets = sampleStreets().streets;
+  auto observed = std::make_shared<const ObservedData>(
+      loadObservedInStreetBlocks(request.input, &*request.streets, request.parameters));
+  StreetEditor editor(request, observed);
+  ASSERT_TRUE(editor.network().layer.frame.isGeographic());
+  std::vector<StreetEdit> edits;
+  const Key node = busiestNode(editor);
+  edits.push_back(moveNodeBy(editor, node, 3, 1));
+  editor.apply(edits.back());
+  StreetEdit label;
+  label.op = StreetEdit::Op::SetLabel;
+  label.parcel = editor.parcelKeys().back();
+  label.label = "blue house";
+  edits.push_back(label);
+  editor.apply(label);
+  const auto& g = editor.network().graph;
+  Key street = 0;
+  for (const auto& e : g.edges) {
+    if (!e.boundary && e.line.size() == 2 && g.nodes[static_cast<std::size_t>(e.from)].key != node &&
+        g.nodes[static_cast<std::size_t>(e.to)].key != node) {
+      street = e.key;
+    }
+  }
+  ASSERT_NE(street, 0u);
+  StreetEdit width;
+  width.op = StreetEdit::Op::SetWidth;
+  width.edge = street;
+  width.width = 21;
+  edits.push_back(width);
+  editor.apply(width);
+  StreetEdit remove;
+  remove.op = StreetEdit::Op::DeleteStreet;
+  remove.edge = street;
+  edits.push_back(remove);
+  editor.apply(remove);
+  StreetEdit add;
+  add.op = StreetEdit::Op::AddStreet;
+  add.node = node;
+  for (const auto& n : editor.network().graph.nodes) {
+    if (n.key == node) add.to = {n.at.x + 40, n.at.y};
+  }
+  add.width = 10;
+  edits.push_back(add);
+  editor.apply(add);
+
+  test::TempDir dir;
+  const std::string path = dir.file("edits.json");
+  writeEdits(path, edits, editor.network().layer.frame, {});
+  StreetEditor replay(request, observed);
+  const std::vector<StreetEdit> read = readEdits(path, [&](const Point& p) { return replay.toLocal(p); });
+  ASSERT_EQ(read.size(), edits.size());
+  for (std::size_t i = 0; i < read.size(); ++i) {
+    EXPECT_EQ(read[i].op, edits[i].op);
+    EXPECT_NEAR(read[i].to.x, edits[i].to.x, 1e-6);
+    EXPECT_NEAR(read[i].to.y, edits[i].to.y, 1e-6);
+    replay.apply(read[i]);
+    EXPECT_EQ(replay.network().graph.nodes.size(), replay.network().graph.nodes.size());
+  }
+  std::vector<Key> a, b;
+  for (const auto& n : editor.network().graph.nodes) a.push_back(n.key);
+  for (const auto& n : replay.network().graph.nodes) b.push_back(n.key);
+  EXPECT_EQ(a, b) << "node keys";
+  a.clear();
+  b.clear();
+  for (const auto& e : editor.network().graph.edges) a.push_back(e.key);
+  for (const auto& e : replay.network().graph.edges) b.push_back(e.key);
+  EXPECT_EQ(a, b) << "edge keys";
+  EXPECT_EQ(editor.parcels().blockKeys, replay.parcels().blockKeys);
+  EXPECT_EQ(editor.parcelKeys(), replay.parcelKeys());
+  EXPECT_EQ(editor.labels(), replay.labels());
+}
+
 TEST(StreetEditor, ABadEditNamesWhatIsWrongAndChangesNothing) {
   StreetEditor editor(sampleStreets());
   const Snapshot before = snapshot(editor);

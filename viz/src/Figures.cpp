@@ -1183,6 +1183,88 @@ void StreetLayer::addTo(vtkRenderer* renderer) {
 
 std::size_t StreetLayer::lines() const { return impl_->lines; }
 
+namespace {
+
+// Points as vertices and polylines as lines of one polydata.
+void fillPolyData(vtkPolyData* out, const std::vector<Point>& points, const std::vector<std::vector<Point>>& lines) {
+  vtkNew<vtkPoints> xyz;
+  vtkNew<vtkCellArray> verts, cells;
+  for (const Point& p : points) {
+    const vtkIdType id = xyz->InsertNextPoint(p.x, p.y, 0);
+    verts->InsertNextCell(1, &id);
+  }
+  for (const auto& line : lines) {
+    if (line.size() < 2) continue;
+    cells->InsertNextCell(static_cast<vtkIdType>(line.size()));
+    for (const Point& p : line) cells->InsertCellPoint(xyz->InsertNextPoint(p.x, p.y, 0));
+  }
+  vtkNew<vtkPolyData> data;
+  data->SetPoints(xyz);
+  data->SetVerts(verts);
+  data->SetLines(cells);
+  out->ShallowCopy(data);
+}
+
+}  // namespace
+
+struct HandleLayer::Impl {
+  vtkNew<vtkPolyData> nodes, street, handles;
+  vtkNew<vtkPolyDataMapper> nodeMapper, streetMapper, handleMapper;
+  vtkNew<vtkActor> nodeActor, streetActor, handleActor;
+  std::size_t nodeCount = 0, selected = 0;
+};
+
+HandleLayer::HandleLayer() : impl_(std::make_unique<Impl>()) {
+  auto style = [](vtkPolyDataMapper* mapper, vtkPolyData* data, vtkActor* actor, const double rgb[3], float size,
+                  double z) {
+    mapper->SetInputData(data);
+    mapper->ScalarVisibilityOff();
+    actor->SetMapper(mapper);
+    actor->SetPosition(0, 0, z);
+    actor->GetProperty()->SetColor(rgb[0], rgb[1], rgb[2]);
+    actor->GetProperty()->SetPointSize(size);
+    actor->GetProperty()->SetLineWidth(size / 2);
+    actor->GetProperty()->LightingOff();
+  };
+  const double dark[3] = {0.15, 0.15, 0.15}, orange[3] = {0.95, 0.45, 0.05};
+  style(impl_->nodeMapper, impl_->nodes, impl_->nodeActor, dark, 5.0f, 3);
+  style(impl_->streetMapper, impl_->street, impl_->streetActor, orange, 8.0f, 3.5);
+  style(impl_->handleMapper, impl_->handles, impl_->handleActor, orange, 10.0f, 4);
+  impl_->handleActor->GetProperty()->SetLineWidth(1.5f);
+  setVisible(false);
+}
+
+HandleLayer::~HandleLayer() = default;
+
+void HandleLayer::setNodes(const std::vector<Point>& nodes) {
+  fillPolyData(impl_->nodes, nodes, {});
+  impl_->nodeCount = nodes.size();
+}
+
+void HandleLayer::setSelection(const std::vector<Point>& street, const std::vector<std::vector<Point>>& arms,
+                               const std::vector<Point>& points) {
+  fillPolyData(impl_->street, {}, {street});
+  fillPolyData(impl_->handles, points, arms);
+  impl_->selected = points.size();
+}
+
+void HandleLayer::setVisible(bool visible) {
+  for (vtkActor* a : {impl_->nodeActor.Get(), impl_->streetActor.Get(), impl_->handleActor.Get()}) {
+    a->SetVisibility(visible);
+  }
+}
+
+bool HandleLayer::visible() const { return impl_->nodeActor->GetVisibility() != 0; }
+
+void HandleLayer::addTo(vtkRenderer* renderer) {
+  renderer->AddActor(impl_->streetActor);
+  renderer->AddActor(impl_->nodeActor);
+  renderer->AddActor(impl_->handleActor);
+}
+
+std::size_t HandleLayer::nodes() const { return impl_->nodeCount; }
+std::size_t HandleLayer::selectedPoints() const { return impl_->selected; }
+
 void fitCamera(vtkRenderer* renderer, const Box& extent, double viewAspect) {
   const double margin = 0.03 * std::max(extent.width(), extent.height());
   const double halfHeight =

@@ -21,6 +21,7 @@
 
 #include "parcelscope/core/Json.h"
 #include "parcelscope/core/Table.h"
+#include "parcelscope/pipeline/CompareJob.h"
 #include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/pipeline/StreetsJob.h"
 
@@ -79,6 +80,17 @@ public:
   /// without observed parcels, its style, parameters and overrides. Throws as
   /// generate().
   explicit StreetEditor(const GenerateRequest& request, const ProgressFn& progress = {});
+  /// The network of observed parcels grouped in the blocks of their streets
+  /// (loadObservedInStreetBlocks; `observed->streets` is required), as the
+  /// application compares them: the editor starts from that network (its
+  /// frame, measured widths and closing boundary) with `request`'s style,
+  /// parameters and overrides, and its first parcels are those `compare`
+  /// generates for it. A block keeps the bounds and observed sample its
+  /// observed parcels gave it for as long as it keeps its key; a block new to
+  /// the network takes the run's values. `observed` is what compare() reads
+  /// for `request`. Throws Error(Usage) without streets.
+  StreetEditor(const CompareRequest& request, std::shared_ptr<const ObservedData> observed,
+               const ProgressFn& progress = {});
   ~StreetEditor();
   StreetEditor(const StreetEditor&) = delete;
   StreetEditor& operator=(const StreetEditor&) = delete;
@@ -115,8 +127,25 @@ public:
   /// A point of the input's CRS in the editor's local metres.
   Point toLocal(const Point& source) const;
 
-private:
   struct State;
+  /// The current state, kept alive and unchanged while the editor goes on
+  /// (for another thread to draw).
+  class Snapshot {
+  public:
+    const StreetNetwork& network() const;
+    const GeneratedParcels& parcels() const;
+    const std::vector<Key>& parcelKeys() const;
+    const std::map<Key, std::string>& labels() const;
+    const std::set<Key>& locked() const;
+    const BlockOverrides& overrides() const;
+
+  private:
+    friend class StreetEditor;
+    std::shared_ptr<const State> state_;
+  };
+  Snapshot snapshot() const;
+
+private:
   // The state of `network` with `overrides` and `labels`, reusing what
   // `previous` holds for unchanged entries (see StreetEditor.cpp).
   struct Attributes {
@@ -131,7 +160,11 @@ private:
   std::shared_ptr<const State> current_;
   std::vector<std::shared_ptr<const State>> undo_, redo_;
   GenerateRequest request_;
-  std::uint64_t serial_ = 0;  // edits applied so far (new parcels' keys)
+  // With observed parcels: their data, and each block part's values derived
+  // from them, by block key and part (BlockInputs::Entry without its shape).
+  std::shared_ptr<const ObservedData> observed_;
+  std::map<std::pair<Key, int>, BlockInputs::Entry> derived_;
+  std::uint64_t serial_ = 0;  // the depth in the undo history of the state being built (new parcels' keys)
   // The faces and street surfaces of the networks built so far: an edit
   // overlays again only the faces it reached.
   analysis::StreetBlockCache cache_;
@@ -142,6 +175,13 @@ private:
 /// coordinates [x, y] in the input's CRS, converted with `toLocal`. Throws
 /// Error(Input) naming the file, the edit's index and the member that is wrong.
 std::vector<StreetEdit> readEdits(const std::string& path, const std::function<Point(const Point&)>& toLocal);
+
+/// The edits file that readEdits reads back as `edits` (with `frame`'s
+/// conversions): keys as 16 hexadecimal digits, points in the input's CRS.
+Json editsJson(const std::vector<StreetEdit>& edits, const io::LocalFrame& frame);
+/// Writes editsJson atomically into `path`, which must not be one of `inputs`. Throws Error(Io).
+void writeEdits(const std::string& path, const std::vector<StreetEdit>& edits, const io::LocalFrame& frame,
+                const std::vector<std::string>& inputs);
 
 /// persistence.csv: per edit, its index and op, the blocks it subdivided again
 /// and removed (counts, and the keys joined by ';'), the parcels of those
@@ -160,6 +200,13 @@ Table editedParcelTable(const StreetEditor& editor, std::vector<std::vector<Poly
 /// DIR/persistence.csv and DIR/run.json. An edit that fails stops the run
 /// with its index and nothing written.
 JobOutcome runEdit(const GenerateRequest& request, const std::string& editsPath, const std::string& outDir,
+                   const ProgressFn& progress = {});
+/// The same on the street network of comparison `request` (a session of
+/// `compare --streets`): its observed parcels are read and grouped in the
+/// network's blocks, and the editor starts from the parcels the comparison
+/// generates (see StreetEditor's constructor from observed parcels), as the
+/// application's editing mode does.
+JobOutcome runEdit(const CompareRequest& request, const std::string& editsPath, const std::string& outDir,
                    const ProgressFn& progress = {});
 
 }  // namespace parcelscope::pipeline

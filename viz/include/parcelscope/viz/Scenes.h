@@ -96,6 +96,33 @@ private:
   std::unique_ptr<Impl> impl_;
 };
 
+/// The handles of street editing, above everything else on a map: the
+/// network's nodes (small dark squares), the selected street (thick, orange),
+/// the control points of its curve (orange squares joined to the street's
+/// ends) and the selected node (a larger orange square).
+class HandleLayer {
+public:
+  HandleLayer();
+  ~HandleLayer();
+  HandleLayer(const HandleLayer&) = delete;
+  HandleLayer& operator=(const HandleLayer&) = delete;
+  void setNodes(const std::vector<Point>& nodes);
+  /// `street`: the selected street's polyline (empty: none); `arms`: lines
+  /// from a street end to a control point; `points`: selected handles.
+  void setSelection(const std::vector<Point>& street, const std::vector<std::vector<Point>>& arms,
+                    const std::vector<Point>& points);
+  void setVisible(bool visible);
+  bool visible() const;
+  void addTo(vtkRenderer* renderer);
+  /// Nodes and selected handles drawn (for tests).
+  std::size_t nodes() const;
+  std::size_t selectedPoints() const;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 /// Points the renderer's (parallel-projection) camera at `extent` with a margin.
 void fitCamera(vtkRenderer* renderer, const Box& extent, double viewAspect);
 
