@@ -183,12 +183,18 @@ void MainWindow::drawEditState(const StreetEditState& state) {
   editState_ = state;
   const pipeline::StreetEditor::Snapshot& s = *state.snapshot;
   drawProceduralLayer(s.parcels());
-  // The edited network: centre lines and kerbs.
+  timings.parcels = lap();
+  // The edited network: centre lines, and the blocks' outlines as kerbs (the
+  // street surface's rings that face a block; the union of the whole
+  // surface would take about a second per edit on a city).
   std::vector<std::vector<Point>> lines;
   for (const analysis::RoadEdge& e : s.network().graph.edges) {
     if (!e.boundary) lines.push_back(e.line);
   }
-  proceduralView_->streets().setStreets(lines, analysis::streetSurface(s.network().graph));
+  std::vector<Polygon> kerbs;
+  for (const analysis::StreetBlock& b : s.network().blocks.blocks) kerbs.push_back(b.shape);
+  proceduralView_->streets().setStreets(lines, kerbs);
+  timings.streets = lap();
   recolour(false);
   // Selections follow their keys; what is gone is no longer selected.
   const auto& g = s.network().graph;
@@ -201,7 +207,7 @@ void MainWindow::drawEditState(const StreetEditState& state) {
   if (selectedEditParcel_ && indexOfKey(s.parcelKeys(), selectedEditParcel_) < 0) selectedEditParcel_ = 0;
   drawHandles();
   showEditParcel();
-  timings.layers = lap();
+  timings.handles = lap();
   proceduralView_->render();
   timings.views = lap();
   if (const auto it = editStarted_.find(state.serial); it != editStarted_.end()) {

@@ -317,7 +317,9 @@ int main(int argc, char** argv) {
           row.ms.push_back(w.lastEditLatencyMs() + toScreen);
           row.library.push_back(t.library);
           editor.push_back(t.editor);
-          row.layers.push_back(t.layers);
+          row.layers.push_back(t.parcels);
+          row.histogram.push_back(t.streets);
+          row.text.push_back(t.handles);
           row.views.push_back(t.views);
           row.toScreen.push_back(toScreen);
         }
@@ -328,9 +330,10 @@ int main(int argc, char** argv) {
       std::printf("%-58s n=%2zu  median %8.1f ms  p90 %8.1f ms  max %8.1f ms\n", row.change.c_str(), v.size(),
                   median(v), v[static_cast<std::size_t>(0.9 * static_cast<double>(v.size() - 1) + 0.5)], v.back());
       std::printf(
-          "%-58s medians: submitted to state %.1f (editor %.1f), layers and handles %.1f, views %.1f, to "
-          "screen %.1f ms\n",
-          "", median(row.library), median(editor), median(row.layers), median(row.views), median(row.toScreen));
+          "%-58s medians: submitted to state %.1f (editor %.1f), parcel layer %.1f, streets %.1f, colours, "
+          "handles and inspector %.1f, views %.1f, to screen %.1f ms\n",
+          "", median(row.library), median(editor), median(row.layers), median(row.histogram), median(row.text),
+          median(row.views), median(row.toScreen));
       w.setEditing(false);
     }
     w.removeStreets();
