@@ -619,6 +619,7 @@ void MainWindow::askForFilter() {
 }
 
 void MainWindow::setFilter(const QString& where) {
+  setEditing(false);  // the network edited is no longer the one shown
   if (!controller_.loaded()) return showError("open a dataset first");
   const io::ReadOptions& input = controller_.request().input;
   openFile(QString::fromStdString(input.path), QString::fromStdString(input.layer), where,
@@ -653,6 +654,7 @@ void MainWindow::askForStreets() {
 }
 
 void MainWindow::openStreets(const QString& path, const QString& widthField, const QString& nameField) {
+  setEditing(false);  // the network edited is no longer the one shown
   if (!controller_.loaded()) return showError("open a dataset first");
   if (path.isEmpty()) return removeStreets();
   io::StreetReadOptions streets;
@@ -668,6 +670,7 @@ void MainWindow::openStreets(const QString& path, const QString& widthField, con
 }
 
 void MainWindow::removeStreets() {
+  setEditing(false);  // the network edited is no longer the one shown
   if (!controller_.loaded() || !controller_.request().streets) return;
   controller_.setStreets(std::nullopt);
   selected_ = -1;
@@ -688,6 +691,7 @@ void MainWindow::askForCrs(const io::ReadOptions& input) {
 }
 
 void MainWindow::openFile(const QString& path, const QString& layer, const QString& where, const QString& crs) {
+  setEditing(false);  // the network edited is no longer the one shown
   io::ReadOptions input;
   input.path = path.toStdString();
   input.where = where.toStdString();
@@ -724,6 +728,7 @@ void MainWindow::openFile(const QString& path, const QString& layer, const QStri
 void MainWindow::openSample() { openFile(sampleDirectory() + "/sample_town.geojson", {}, "use <> 'ROW'"); }
 
 void MainWindow::openSession(const QString& path) {
+  setEditing(false);  // the network edited is no longer the one shown
   try {
     controller_.openSession(path.toStdString());
   } catch (const std::exception& e) {
