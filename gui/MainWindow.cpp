@@ -1159,16 +1159,14 @@ void MainWindow::drawReport(const UpdateReport& report) {
     }
     observedView_->layer().setShapes(shapes, values, blocks);
     // The street network the blocks come from, over both views.
-    std::vector<std::vector<Point>> lines;
-    std::vector<Polygon> surface;
+    comparisonLines_.clear();
+    comparisonSurface_.clear();
     if (const auto& network = r.observed->streets) {
-      for (const analysis::RoadEdge& e : network->graph.edges) {
-        if (!e.boundary) lines.push_back(e.line);
-      }
-      surface = analysis::streetSurface(network->graph);
+      comparisonLines_ = centreLines(network->graph);
+      comparisonSurface_ = analysis::streetSurface(network->graph);
     }
-    observedView_->streets().setStreets(lines, surface);
-    if (!editing_) proceduralView_->streets().setStreets(lines, surface);
+    observedView_->streets().setStreets(comparisonLines_, comparisonSurface_);
+    if (!editing_) proceduralView_->streets().setStreets(comparisonLines_, comparisonSurface_);
   }
   if (first && editing_) setEditing(false);  // another input: its network is not the one edited
   if (!editing_) {

@@ -24,6 +24,7 @@
 
 #include "SessionWorker.h"
 #include "StreetEditWorker.h"
+#include "parcelscope/analysis/RoadGraph.h"
 #include "parcelscope/pipeline/CompareSession.h"
 #include "parcelscope/pipeline/Controller.h"
 #include "parcelscope/viz/Figures.h"
@@ -250,6 +251,8 @@ private:
   /// the layer parts of changed blocks are built again).
   void drawProceduralLayer(const pipeline::GeneratedParcels& generated);
   void drawEditState(const StreetEditState& state);
+  /// The centre lines of `graph`'s streets (its boundary left out), as the views draw them.
+  static std::vector<std::vector<Point>> centreLines(const analysis::RoadGraph& graph);
   /// The handles of the editor's network and selection.
   void drawHandles();
   void showEditParcel();
@@ -374,6 +377,10 @@ private:
   double blockValue(const pipeline::CompareResult& result, int block, const std::string& name) const;
   /// Fills the override panel with the selected block's values.
   void fillOverridePanel(const pipeline::CompareResult& result);
+  /// The comparison's street network as drawn (centre lines, street surface),
+  /// drawn again in the procedural view when editing ends.
+  std::vector<std::vector<Point>> comparisonLines_;
+  std::vector<Polygon> comparisonSurface_;
   // Street editing.
   QThread editThread_;
   StreetEditWorker* editWorker_;
@@ -385,7 +392,6 @@ private:
   qint64 gesture_ = 0, gestures_ = 0;
   Key dragNode_ = 0;
   int dragControl_ = -1;
-  Point dragStart_;
   bool dragMoved_ = false;
   std::optional<std::array<Point, 2>> dragControls_;  ///< the street's control points when the drag began
   std::optional<Point> streetStart_;                  ///< drawing a street: its first end

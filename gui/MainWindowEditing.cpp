@@ -44,12 +44,29 @@ std::array<Point, 2> controlsOf(const analysis::RoadGraph& g, const analysis::Ro
           Point{a.x + 2 * (b.x - a.x) / 3, a.y + 2 * (b.y - a.y) / 3}};
 }
 
+// Per node of `g`, 1 where a street ends (the study area's boundary is not edited).
+std::vector<char> streetNodes(const analysis::RoadGraph& g) {
+  std::vector<char> onStreet(g.nodes.size(), 0);
+  for (const auto& e : g.edges) {
+    if (!e.boundary) onStreet[static_cast<std::size_t>(e.from)] = onStreet[static_cast<std::size_t>(e.to)] = 1;
+  }
+  return onStreet;
+}
+
 int indexOfKey(const std::vector<Key>& keys, Key key) {
   const auto it = std::find(keys.begin(), keys.end(), key);
   return it == keys.end() ? -1 : static_cast<int>(it - keys.begin());
 }
 
 }  // namespace
+
+std::vector<std::vector<Point>> MainWindow::centreLines(const analysis::RoadGraph& graph) {
+  std::vector<std::vector<Point>> lines;
+  for (const analysis::RoadEdge& e : graph.edges) {
+    if (!e.boundary) lines.push_back(e.line);
+  }
+  return lines;
+}
 
 void MainWindow::buildEditMenu() {
   QMenu* edit = menuBar()->addMenu("&Edit");
@@ -147,15 +164,7 @@ bool MainWindow::setEditing(bool on) {
     if (const auto shown = controller_.shownResult()) {
       // The comparison's parcels and streets again.
       drawProceduralLayer(shown->generated);
-      std::vector<std::vector<Point>> lines;
-      std::vector<Polygon> surface;
-      if (const auto& network = shown->observed->streets) {
-        for (const analysis::RoadEdge& e : network->graph.edges) {
-          if (!e.boundary) lines.push_back(e.line);
-        }
-        surface = analysis::streetSurface(network->graph);
-      }
-      proceduralView_->streets().setStreets(lines, surface);
+      proceduralView_->streets().setStreets(comparisonLines_, comparisonSurface_);
       recolour(false);
       showParcel();
     }
@@ -187,13 +196,9 @@ void MainWindow::drawEditState(const StreetEditState& state) {
   // The edited network: centre lines, and the blocks' outlines as kerbs (the
   // street surface's rings that face a block; the union of the whole
   // surface would take about a second per edit on a city).
-  std::vector<std::vector<Point>> lines;
-  for (const analysis::RoadEdge& e : s.network().graph.edges) {
-    if (!e.boundary) lines.push_back(e.line);
-  }
   std::vector<Polygon> kerbs;
   for (const analysis::StreetBlock& b : s.network().blocks.blocks) kerbs.push_back(b.shape);
-  proceduralView_->streets().setStreets(lines, kerbs);
+  proceduralView_->streets().setStreets(centreLines(s.network().graph), kerbs);
   timings.streets = lap();
   recolour(false);
   // Selections follow their keys; what is gone is no longer selected.
@@ -245,12 +250,7 @@ void MainWindow::drawHandles() {
     return;
   }
   const analysis::RoadGraph& g = editState_->snapshot->network().graph;
-  // Nodes of streets (the study area's boundary is not edited).
-  std::vector<char> onStreet(g.nodes.size(), 0);
-  for (const auto& e : g.edges) {
-    if (e.boundary) continue;
-    onStreet[static_cast<std::size_t>(e.from)] = onStreet[static_cast<std::size_t>(e.to)] = 1;
-  }
+  const std::vector<char> onStreet = streetNodes(g);
   std::vector<Point> nodes;
   for (std::size_t i = 0; i < g.nodes.size(); ++i) {
     if (onStreet[i]) nodes.push_back(g.nodes[i].at);
@@ -278,10 +278,7 @@ int MainWindow::nodeNear(double x, double y, double pixels) const {
   if (!editState_) return -1;
   const double reach = pixels * proceduralView_->metresPerPixel();
   const analysis::RoadGraph& g = editState_->snapshot->network().graph;
-  std::vector<char> onStreet(g.nodes.size(), 0);
-  for (const auto& e : g.edges) {
-    if (!e.boundary) onStreet[static_cast<std::size_t>(e.from)] = onStreet[static_cast<std::size_t>(e.to)] = 1;
-  }
+  const std::vector<char> onStreet = streetNodes(g);
   int best = -1;
   double nearest = reach;
   for (std::size_t i = 0; i < g.nodes.size(); ++i) {
@@ -337,7 +334,6 @@ bool MainWindow::pressAt(double x, double y) {
     dragNode_ = editState_->snapshot->network().graph.nodes[static_cast<std::size_t>(node)].key;
   }
   gesture_ = ++gestures_;
-  dragStart_ = Point{x, y};
   dragMoved_ = false;
   return true;
 }
@@ -368,25 +364,17 @@ void MainWindow::dragTo(double x, double y) {
   submitEdit(c);
 }
 
-void MainWindow::dropAt(double x, double y) {
+void MainWindow::dropAt(double, double) {
+  // The drag's last move was applied by dragTo; a press on a node without a move selects it.
   if (gesture_ == 0) return;
-  const bool moved = dragMoved_;
-  const Key node = dragNode_;
   gesture_ = 0;
   dragControls_.reset();
-  if (!moved) {
-    // A press on a node without a move selects it.
-    if (node != 0) {
-      selectedNode_ = node;
-      selectedStreet_ = 0;
-      drawHandles();
-      updateEditActions();
-      proceduralView_->render();
-    }
-    return;
-  }
-  (void)x;
-  (void)y;
+  if (dragMoved_ || dragNode_ == 0) return;
+  selectedNode_ = dragNode_;
+  selectedStreet_ = 0;
+  drawHandles();
+  updateEditActions();
+  proceduralView_->render();
 }
 
 void MainWindow::editClickAt(double x, double y) {

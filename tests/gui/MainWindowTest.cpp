@@ -1120,7 +1120,8 @@ private slots:
       QCOMPARE(n.at.y, node.at.y + 1);
     }
     QVERIFY(moved->report && !moved->report->blocksAffected.empty());
-    QVERIFY2(moved->report->matched >= 0.8 * std::min(moved->report->parcelsBefore, moved->report->parcelsAfter),
+    QVERIFY2(static_cast<double>(moved->report->matched) >=
+                 0.8 * static_cast<double>(std::min(moved->report->parcelsBefore, moved->report->parcelsAfter)),
              qPrintable(QString("%1 of %2").arg(moved->report->matched).arg(moved->report->parcelsBefore)));
     QVERIFY(!sameParcels(moved->snapshot->parcels().parcels, compared->generated.parcels));
     QVERIFY(window_->lastEditLatencyMs() > 0);
@@ -1129,7 +1130,8 @@ private slots:
     const auto& parcels = moved->snapshot->parcels();
     const parcelscope::Polygon& lot = parcels.parcels[parcels.blocks.back().parcels.front()];
     parcelscope::Point inside{0, 0};
-    for (const auto& p : lot.outer) inside = {inside.x + p.x / lot.outer.size(), inside.y + p.y / lot.outer.size()};
+    const auto vertices = static_cast<double>(lot.outer.size());
+    for (const auto& p : lot.outer) inside = {inside.x + p.x / vertices, inside.y + p.y / vertices};
     const int at = parcelscope::pipeline::generatedParcelAt(parcels, inside);
     QVERIFY(at >= 0);
     const parcelscope::Key lotKey = moved->snapshot->parcelKeys()[static_cast<std::size_t>(at)];
@@ -1233,7 +1235,7 @@ private slots:
     std::size_t sameKeys = 0;
     for (std::size_t i = 0; i < shown.parcelKeys().size(); ++i)
       sameKeys += replay.parcelKeys()[i] == shown.parcelKeys()[i];
-    QVERIFY2(sameKeys >= 0.97 * static_cast<double>(shown.parcelKeys().size()),
+    QVERIFY2(static_cast<double>(sameKeys) >= 0.97 * static_cast<double>(shown.parcelKeys().size()),
              qPrintable(QString("%1 of %2 keys").arg(sameKeys).arg(shown.parcelKeys().size())));
     QCOMPARE(replay.parcels().parcels.size(), shown.parcels().parcels.size());
     // Coordinates went through the input's CRS and back: areas equal to within 0.001 m².
