@@ -6,6 +6,7 @@
 #include <set>
 
 #include "Args.h"
+#include "Mpi.h"
 #include "TermProgress.h"
 #include "parcelscope/analysis/Comparison.h"
 #include "parcelscope/core/Error.h"
@@ -14,6 +15,7 @@
 #include "parcelscope/pipeline/CompareSession.h"
 #include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/pipeline/Inspect.h"
+#include "parcelscope/pipeline/Shards.h"
 #include "parcelscope/pipeline/StatsJob.h"
 #include "parcelscope/pipeline/StreetEditor.h"
 #include "parcelscope/pipeline/StreetsJob.h"
@@ -37,6 +39,7 @@ const char* kOverview =
     "            per-block and city-wide tables, distances, layers and figures\n"
     "  calibrate give each block the style closest to its observed parcels (a session file)\n"
     "  edit      edit a street network (JSON list of edits); parcels follow, keeping their keys\n"
+    "  merge     merge the shards of 'compare --shard I/N' into the outputs of one run\n"
     "  inspect   print one observed parcel's attributes, metrics and block statistics\n"
     "  metrics   print the table of parcel metrics (Markdown, as in docs/user/metrics.md)\n"
     "  version   print the version\n"
@@ -194,8 +197,9 @@ int dispatch(const std::vector<std::string>& args) {
   if (args[0] == "inspect") return inspectCommand(rest);
   if (args[0] == "calibrate") return calibrateCommand(rest);
   if (args[0] == "edit") return editCommand(rest);
+  if (args[0] == "merge") return mergeCommand(rest);
   throw usageError("unknown command '" + args[0] +
-                   "' (commands: stats, blocks, generate, compare, calibrate, edit, inspect, metrics, version)");
+                   "' (commands: stats, blocks, generate, compare, calibrate, edit, merge, inspect, metrics, version)");
 }
 
 int metricsCommand(const std::vector<std::string>& args) {
@@ -398,6 +402,11 @@ int generateCommand(const std::vector<std::string>& args) {
   return reportOutcome(pipeline::runGenerate(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
 }
 
+namespace {
+// `compare` under mpirun: each rank one shard, rank 0 merges and writes.
+int compareOnRanks(const pipeline::CompareRequest& request, const std::string& out, const Args& a);
+}  // namespace
+
 int compareCommand(const std::vector<std::string>& args) {
   auto flags = inputFlags();
   flags.push_back(styleFlag());
@@ -414,6 +423,9 @@ int compareCommand(const std::vector<std::string>& args) {
                    "      parameters, per-block overrides (the only way to give those here) and seed;\n"
                    "      INPUT and options given here win"});
   flags = joined(flags, streetFlags("streets-"));
+  flags.push_back({"shard",
+                   "I/N: analyse only shard I (0 to N-1) of N vertical strips of INPUT and write it\n"
+                   "      to --out (shard.bin); 'parcelscope merge' of the N folders writes the run"});
   flags.push_back({"out", "output directory (created; files appear only when the run succeeds)"});
   flags.push_back({"quiet", "no progress or summary on stderr", false});
   const auto params = joined(pipeline::compareParameters(), pipeline::streetParameters());
@@ -429,7 +441,9 @@ int compareCommand(const std::vector<std::string>& args) {
         "are given; both sets are measured alike and compared. Writes DIR/parcels.gpkg, blocks.gpkg,\n"
         "observed_parcels.csv, generated_parcels.csv, blocks.csv, summary.csv, distances.csv,\n"
         "summary.json, run.json and DIR/figures/*.png and *.svg or *.pdf (figures need an X server: use\n"
-        "'xvfb-run -a' without a screen, or --figures no).\n",
+        "'xvfb-run -a' without a screen, or --figures no).\n"
+        "\nUnder 'mpirun -n N', the N ranks each read and analyse one vertical strip of INPUT (a GDAL\n"
+        "spatial filter) and rank 0 writes the outputs one process writes (run.json adds \"ranks\").\n",
         stdout);
     return 0;
   }
@@ -460,10 +474,62 @@ int compareCommand(const std::vector<std::string>& args) {
   if (auto v = a.value("metric")) request.metric = *v;
   if (auto v = a.value("vector")) request.vectorFormat = *v;
   if (auto v = a.value("parcels-format")) request.parcelsFormat = *v;
+  if (const auto shard = a.value("shard")) {
+    const auto [index, count] = pipeline::parseShard(*shard);
+    if (request.style == "all") throw usageError("--shard: runs one style (not --style all)");
+    return reportOutcome(pipeline::runShard(request, index, count, *a.value("out"), terminalProgress(a.has("quiet"))),
+                         a);
+  }
+  if (mpiSize() > 1) {
+    if (request.style == "all") throw usageError("mpirun: compare runs one style (not --style all)");
+    return compareOnRanks(request, *a.value("out"), a);
+  }
   if (request.style == "all") {
     return reportOutcome(viz::runLeaderboard(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
   }
   return reportOutcome(viz::runCompare(request, *a.value("out"), terminalProgress(a.has("quiet"))), a);
+}
+
+namespace {
+int compareOnRanks(const pipeline::CompareRequest& request, const std::string& out, const Args& a) {
+  const int rank = mpiRank(), size = mpiSize();
+  const std::string who = "parcelscope compare (rank " + std::to_string(rank) + " of " + std::to_string(size) + ")";
+  std::vector<std::string> parts;
+  try {
+    const ProgressFn progress = rank == 0 ? terminalProgress(a.has("quiet")) : ProgressFn{};
+    parts = gatherParts(pipeline::encodeShard(
+        pipeline::analyseShard(request, rank, size, rankReading(), scaledProgress(progress, 0.0, 0.5))));
+  } catch (const std::exception& e) {
+    abortRanks(who + ": " + e.what() + "; every rank stopped, nothing was written");
+  }
+  if (rank != 0) return 0;
+  std::vector<pipeline::ShardPart> decoded;
+  for (std::size_t r = 0; r < parts.size(); ++r) {
+    decoded.push_back(pipeline::decodeShard(parts[r], "rank " + std::to_string(r)));
+    parts[r] = std::string();
+  }
+  const pipeline::PreparedObserved prepared = pipeline::prepareMerged(std::move(decoded), size);
+  return reportOutcome(viz::runCompare(request, out, terminalProgress(a.has("quiet")), &prepared), a);
+}
+}  // namespace
+
+int mergeCommand(const std::vector<std::string>& args) {
+  const std::vector<FlagSpec> flags = {{"out", "output directory (created; files appear only when the merge succeeds)"},
+                                       {"quiet", "no progress or summary on stderr", false}};
+  if (wantsHelp(args)) {
+    std::fputs(usageText("parcelscope merge SHARD_DIR... --out DIR", flags, {}).c_str(), stdout);
+    std::fputs(
+        "\nMerges the folders written by 'parcelscope compare ... --shard I/N --out SHARD_DIR' for every I\n"
+        "of N (array jobs of a scheduler without MPI): the observed blocks of the shards are joined as\n"
+        "one process reads them, then parcels are generated and compared and DIR receives what\n"
+        "'compare' without --shard writes (run.json adds \"ranks\" and \"shards\").\n",
+        stdout);
+    return 0;
+  }
+  const Args a(args, flags, {});
+  if (!a.value("out")) throw usageError("--out DIR is required");
+  auto [request, prepared] = pipeline::readShards(a.positional());
+  return reportOutcome(viz::runCompare(request, *a.value("out"), terminalProgress(a.has("quiet")), &prepared), a);
 }
 
 int calibrateCommand(const std::vector<std::string>& args) {

@@ -15,5 +15,6 @@ int compareCommand(const std::vector<std::string>& args);
 int inspectCommand(const std::vector<std::string>& args);
 int calibrateCommand(const std::vector<std::string>& args);
 int editCommand(const std::vector<std::string>& args);
+int mergeCommand(const std::vector<std::string>& args);
 
 }  // namespace parcelscope::cli

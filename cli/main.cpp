@@ -7,10 +7,12 @@
 #include <vector>
 
 #include "Commands.h"
+#include "Mpi.h"
 #include "TermProgress.h"
 #include "parcelscope/core/Error.h"
 
 int main(int argc, char** argv) {
+  const parcelscope::cli::MpiSession mpi(argc, argv);
   std::vector<std::string> args(argv + 1, argv + argc);
   const std::string command = args.empty() ? "" : args.front();
   parcelscope::cli::installInterruptHandler();

@@ -2,6 +2,7 @@
 
 #include <GeographicLib/TransverseMercator.hpp>
 #include <sstream>
+#include <stdexcept>
 
 namespace parcelscope::io {
 
@@ -44,6 +45,17 @@ Point LocalFrame::toSource(const Point& p) const {
     return {lon / unit_, lat / unit_};
   }
   return {p.x / unit_ + x0_, p.y / unit_ + y0_};
+}
+
+std::vector<double> LocalFrame::state() const {
+  if (tm_) return {1.0, lon0_, lat0_, tm_->EquatorialRadius(), tm_->Flattening(), unit_};
+  return {0.0, x0_, y0_, unit_};
+}
+
+LocalFrame LocalFrame::fromState(const std::vector<double>& s) {
+  if (s.size() == 6 && s[0] == 1.0) return geographic(s[1], s[2], s[3], s[4], s[5]);
+  if (s.size() == 4 && s[0] == 0.0) return projected(s[3], s[1], s[2]);
+  throw std::invalid_argument("LocalFrame::fromState: not a frame's state");
 }
 
 std::string LocalFrame::describe() const {

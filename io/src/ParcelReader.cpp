@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string_view>
 #include <unordered_map>
@@ -41,6 +42,16 @@ struct Feature {
   int stackCount = 1;
   std::vector<double> values;  // ReadOptions::numericFields
   Key key = 0;                 // Parcel::featureKey
+  bool owned = true;           // counted in the report (its shard's, see ShardRead)
+  bool inWindow = true;        // cleaned and returned
+};
+
+// A feature as read, before duplicates are collapsed.
+struct RawFeature {
+  std::int64_t fid = -1;
+  std::unique_ptr<OGRGeometry> geometry;
+  std::vector<double> values;
+  std::optional<Key> fieldKey;  // from ReadOptions::keyField; none: the geometry's
 };
 
 // Projects every vertex of `g` to the local frame, in place.
@@ -156,6 +167,19 @@ std::vector<FieldInfo> layerFields(const std::string& path, const std::string& l
   return fields;
 }
 
+Box layerExtent(const ReadOptions& options) {
+  const GDALDatasetUniquePtr ds = openVector(options.path);
+  OGRLayer* layer = options.layer.empty() ? ds->GetLayer(0) : ds->GetLayerByName(options.layer.c_str());
+  if (!layer) throw inputError(options.path + ": no layer named '" + options.layer + "'");
+  OGREnvelope e;
+  QuietErrors quiet;
+  if (layer->GetExtent(&e, TRUE) != OGRERR_NONE || !std::isfinite(e.MinX) || !std::isfinite(e.MaxX) ||
+      !std::isfinite(e.MinY) || !std::isfinite(e.MaxY)) {
+    throw inputError(options.path + ": layer " + layer->GetName() + " has no extent (" + lastGdalMessage() + ")");
+  }
+  return {e.MinX, e.MinY, e.MaxX, e.MaxY};
+}
+
 ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) {
   const std::string& path = options.path;
   Timings timings;
@@ -203,8 +227,8 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
   if (!options.keyField.empty() && keyIndex < 0 && !options.keyFieldOptional) {
     throw inputError(path + ": layer " + result.layerName + " has no field '" + options.keyField + "' (--key-field)");
   }
-  // A feature's key: its key field's value, else its geometry (see Parcel::featureKey).
-  auto featureKey = [&](const OGRFeature& feature, const std::string& geometryWkb) -> Key {
+  // A feature's key field's value as a key (none: its geometry gives the key; see Parcel::featureKey).
+  auto fieldKey = [&](const OGRFeature& feature) -> std::optional<Key> {
     if (keyIndex >= 0 && feature.IsFieldSetAndNotNull(keyIndex)) {
       const char* value = feature.GetFieldAsString(keyIndex);
       if (const auto parsed = parseKey(value)) return *parsed;
@@ -214,7 +238,19 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
       throw inputError(path + ": feature " + std::to_string(feature.GetFID()) + " has no value in key field '" +
                        options.keyField + "'");
     }
-    return hashBytes(geometryWkb);
+    return std::nullopt;
+  };
+  const ShardRead* shard = options.shard ? &*options.shard : nullptr;
+  const bool filtered = shard && shard->spatialFilter;
+  if (filtered) {
+    layer->SetSpatialFilterRect(shard->window.minX, shard->window.minY, shard->window.maxX, shard->window.maxY);
+  }
+  // In a shard, a feature belongs to the strip of its envelope's smallest x; one
+  // without a usable envelope to the first strip.
+  auto ownedBy = [&](const OGREnvelope* e) {
+    if (!shard) return true;
+    if (!e || !std::isfinite(e->MinX)) return shard->tileMinX == -std::numeric_limits<double>::infinity();
+    return e->MinX >= shard->tileMinX && e->MinX < shard->tileMaxX;
   };
 
   // Pass 1: read features, collapse exact duplicate geometries, find the extent.
@@ -233,26 +269,29 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
   // A read error stops the loop as if the layer had ended (SQLite's "database
   // disk image is malformed" after a few features of a corrupt GeoPackage), so
   // GDAL's error state is checked for every feature and after the last one.
+  std::int64_t featuresRead = 0;
   auto throwIfReadFailed = [&] {
     if (CPLGetLastErrorType() != CE_Failure && CPLGetLastErrorType() != CE_Fatal) return;
     throw inputError(path + ": reading layer " + result.layerName +
                      (options.where.empty() ? "" : " with --where \"" + options.where + "\"") + " failed after " +
-                     std::to_string(report.features) + " features (" + lastGdalMessage() + ")");
+                     std::to_string(featuresRead) + " features (" + lastGdalMessage() + ")");
   };
-  CPLErrorReset();
-  layer->ResetReading();
-  for (auto& feature : *layer) {
-    throwIfReadFailed();
-    ++report.features;
-    if (report.features % 2000 == 0 && total > 0) {
-      reportProgress(progress, 0.6 * static_cast<double>(report.features) / static_cast<double>(total), "reading");
-    }
-    OGRGeometry* g = feature->GetGeometryRef();
+  // One feature into `features` (or onto the stack of its copy), counted when owned.
+  auto take = [&](RawFeature raw) {
+    OGRGeometry* g = raw.geometry.get();
     if (!g || g->IsEmpty()) {
-      ++report.nullOrEmpty;
-      continue;
+      if (ownedBy(nullptr)) {
+        ++report.features;
+        ++report.nullOrEmpty;
+      }
+      return;
     }
+    OGREnvelope e;
+    g->getEnvelope(&e);
+    const bool owned = ownedBy(&e);
+    report.features += owned;
     exportWkb(*g, wkb);
+    const Key key = raw.fieldKey ? *raw.fieldKey : hashBytes(wkb);
     const std::size_t hash = std::hash<std::string_view>{}(wkb);
     Feature* original = nullptr;
     for (auto [it, end] = byHash.equal_range(hash); it != end && !original; ++it) {
@@ -260,49 +299,110 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
       if (earlier == wkb) original = &features[it->second];
     }
     if (original) {
-      if (original->stackCount == 1) ++report.duplicateStacks;
+      if (owned) {
+        if (original->stackCount == 1) ++report.duplicateStacks;
+        ++report.duplicatesCollapsed;
+      }
       ++original->stackCount;
-      ++report.duplicatesCollapsed;
       // The stack's key is the least of its features' keys, whatever their order.
-      original->key = std::min(original->key, featureKey(*feature, wkb));
-      continue;
+      original->key = std::min(original->key, key);
+      return;
     }
-    OGREnvelope e;
-    g->getEnvelope(&e);
     if (!coordinatesFinite(*g) || !std::isfinite(e.MinX) || !std::isfinite(e.MinY) || !std::isfinite(e.MaxX) ||
         !std::isfinite(e.MaxY) || std::fabs(e.MinX) > 1e12 || std::fabs(e.MaxX) > 1e12 || std::fabs(e.MinY) > 1e12 ||
         std::fabs(e.MaxY) > 1e12) {
-      ++report.nonFiniteSkipped;  // NaN, infinite or absurd coordinates
-      continue;
+      report.nonFiniteSkipped += owned;  // NaN, infinite or absurd coordinates
+      return;
     }
-    env.merge(e);
-    std::vector<double> values;
-    for (int idx : fieldIndex) {
-      values.push_back(idx >= 0 && feature->IsFieldSetAndNotNull(idx) ? feature->GetFieldAsDouble(idx)
-                                                                      : std::numeric_limits<double>::quiet_NaN());
-    }
+    // The frame's sample: every feature, except in a filtered shard, which
+    // samples its own and exchanges.
+    if (!filtered || owned) env.merge(e);
+    const bool inWindow = !shard || (e.MinX <= shard->window.maxX && e.MaxX >= shard->window.minX &&
+                                     e.MinY <= shard->window.maxY && e.MaxY >= shard->window.minY);
     byHash.emplace(hash, features.size());
-    const Key key = featureKey(*feature, wkb);
-    features.push_back(
-        {feature->GetFID(), std::unique_ptr<OGRGeometry>(feature->StealGeometry()), 1, std::move(values), key});
+    features.push_back({raw.fid, std::move(raw.geometry), 1, std::move(raw.values), key, owned, inWindow});
+  };
+  auto rawOf = [&](OGRFeature& feature) {
+    RawFeature raw;
+    raw.fid = feature.GetFID();
+    for (int idx : fieldIndex) {
+      raw.values.push_back(idx >= 0 && feature.IsFieldSetAndNotNull(idx) ? feature.GetFieldAsDouble(idx)
+                                                                         : std::numeric_limits<double>::quiet_NaN());
+    }
+    OGRGeometry* g = feature.GetGeometryRef();
+    if (g && !g->IsEmpty()) raw.fieldKey = fieldKey(feature);
+    raw.geometry.reset(feature.StealGeometry());
+    return raw;
+  };
+  CPLErrorReset();
+  layer->ResetReading();
+  // A spatial filter may return features in any order (an R-tree's): they are
+  // taken in the order of their ids, as a whole read takes them.
+  std::vector<RawFeature> window;
+  for (auto& feature : *layer) {
+    throwIfReadFailed();
+    ++featuresRead;
+    if (featuresRead % 2000 == 0 && total > 0) {
+      reportProgress(progress, 0.6 * static_cast<double>(featuresRead) / static_cast<double>(total), "reading");
+    }
+    if (filtered) {
+      window.push_back(rawOf(*feature));
+    } else {
+      take(rawOf(*feature));
+    }
   }
   throwIfReadFailed();
-  const std::string featuresRead =
+  if (filtered) {
+    std::stable_sort(window.begin(), window.end(),
+                     [](const RawFeature& a, const RawFeature& b) { return a.fid < b.fid; });
+    for (std::size_t i = 1; i < window.size(); ++i) {
+      if (window[i].fid == window[i - 1].fid) {
+        throw inputError(path + ": layer " + result.layerName + " gives two features the id " +
+                         std::to_string(window[i].fid) + ", so it cannot be read in shards");
+      }
+    }
+    for (RawFeature& raw : window) take(std::move(raw));
+    window.clear();
+  }
+  const std::string featuresText =
       std::to_string(report.features) + " features read" + (options.where.empty() ? "" : " with --where");
-  if (features.empty() && report.nonFiniteSkipped > 0) {
+  if (!shard && features.empty() && report.nonFiniteSkipped > 0) {
     const std::string absurd = "non-finite or absurd coordinates (NaN, infinite or beyond 1e12)";
     throw inputError(path + ": layer " + result.layerName + " holds no usable polygon: every feature was skipped" +
                      (report.nullOrEmpty == 0
                           ? " for " + absurd
                           : ", " + std::to_string(report.nonFiniteSkipped) + " for " + absurd + " and " +
                                 std::to_string(report.nullOrEmpty) + " for a null or empty geometry") +
-                     " (" + featuresRead + ")");
+                     " (" + featuresText + ")");
   }
-  if (features.empty()) {
-    throw inputError(path + ": layer " + result.layerName + " holds no polygon geometry (" + featuresRead + ")");
+  if (!shard && features.empty()) {
+    throw inputError(path + ": layer " + result.layerName + " holds no polygon geometry (" + featuresText + ")");
   }
 
+  if (filtered && !shard->frame && shard->exchange) {
+    FrameSample sample;
+    sample.extent = {env.minX, env.minY, env.maxX, env.maxY};
+    sample.centresX = std::move(env.centresX);
+    sample.centresY = std::move(env.centresY);
+    shard->exchange(sample);
+    env = Envelope{};
+    env.minX = sample.extent.minX;
+    env.minY = sample.extent.minY;
+    env.maxX = sample.extent.maxX;
+    env.maxY = sample.extent.maxY;
+    env.centresX = std::move(sample.centresX);
+    env.centresY = std::move(sample.centresY);
+  }
+  if (env.centresX.empty()) {
+    if (!shard || !shard->frame) {
+      throw inputError(path + ": layer " + result.layerName + " holds no polygon geometry (" + featuresText + ")");
+    }
+    OGREnvelope origin;  // the CRS is still named and checked; the given frame is kept
+    origin.MinX = origin.MaxX = origin.MinY = origin.MaxY = 0;
+    env.merge(origin);
+  }
   result.frame = chooseFrame(path, srs, env, result.crs);
+  if (shard && shard->frame) result.frame = *shard->frame;
   if (srs) {
     char* wkt = nullptr;
     const char* wktOptions[] = {"FORMAT=WKT2_2018", nullptr};
@@ -311,8 +411,15 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
   }
 
   // Pass 2: project, repair, split into parts, normalise; features in parallel,
-  // merged in input order.
+  // merged in input order. A shard cleans its window's features only.
   timings.start("clean");
+  if (shard) {
+    std::vector<Feature> kept;
+    for (Feature& f : features) {
+      if (f.inWindow) kept.push_back(std::move(f));
+    }
+    features = std::move(kept);
+  }
   std::vector<Cleaned> cleaned(features.size());
   parallelFor(
       features.size(), [&](std::size_t k) { cleaned[k] = cleanFeature(features[k], result.frame); },
@@ -325,23 +432,25 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
     if (!options.numericFields.empty()) {
       result.fields.insert(result.fields.end(), c.parcels.size(), features[k].values);
     }
-    report.nonPolygonal += c.nonPolygonal;
-    report.degenerateSkipped += c.degenerate;
-    if (c.repairFailed || (c.repaired && c.parcels.empty())) ++report.invalidSkipped;
-    if (c.repaired && !c.parcels.empty()) ++report.invalidRepaired;
-    report.nonPolygonalParts += c.mixed;
-    if (c.inputParts > 1) {
-      ++report.multipartFeatures;
-      report.partsFromMultipart += static_cast<std::int64_t>(c.parcels.size());
+    if (features[k].owned) {
+      report.nonPolygonal += c.nonPolygonal;
+      report.degenerateSkipped += c.degenerate;
+      if (c.repairFailed || (c.repaired && c.parcels.empty())) ++report.invalidSkipped;
+      if (c.repaired && !c.parcels.empty()) ++report.invalidRepaired;
+      report.nonPolygonalParts += c.mixed;
+      if (c.inputParts > 1) {
+        ++report.multipartFeatures;
+        report.partsFromMultipart += static_cast<std::int64_t>(c.parcels.size());
+      }
+      report.parcels += static_cast<std::int64_t>(c.parcels.size());
     }
     for (Parcel& p : c.parcels) {
       p.featureKey = features[k].key;
-      if (!p.shape.holes.empty()) ++report.withHoles;
+      if (!p.shape.holes.empty() && features[k].owned) ++report.withHoles;
       result.parcels.push_back(std::move(p));
     }
   }
-  report.parcels = static_cast<std::int64_t>(result.parcels.size());
-  if (result.parcels.empty()) {
+  if (result.parcels.empty() && !shard) {
     throw inputError(path + ": layer " + result.layerName + " holds no usable polygon (" +
                      std::to_string(report.features) + " features, all skipped)");
   }

@@ -367,10 +367,12 @@ void exportSession(const CompareRequest& request, const std::string& path) {
 
 namespace {
 JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request, const ProgressFn& progress,
-                        const FigureRenderer* renderer, std::chrono::steady_clock::time_point started) {
+                        const FigureRenderer* renderer, std::chrono::steady_clock::time_point started,
+                        const PreparedObserved* prepared) {
   const bool figures = value(request, "figures") != 0;
   const bool spatialIndex = value(request, "spatial-index") != 0;
-  const CompareResult r = compare(request, scaledProgress(progress, 0.0, 0.8));
+  const CompareResult r = prepared ? compare(request, prepared->data, scaledProgress(progress, 0.0, 0.8))
+                                   : compare(request, scaledProgress(progress, 0.0, 0.8));
   const analysis::ObservedAnalysis& a = r.observed->analysis;
 
   reportProgress(progress, 0.8, "writing");
@@ -448,6 +450,7 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
                  .set("parameters_given", given)
                  .set("session", sessionJson(request));
   addObservedRecord(run, *r.observed);
+  if (prepared) run.set("ranks", prepared->ranks).set("shards", prepared->shards);
   if (r.observed->streets) {
     run.set("streets",
             streetRecord(*r.observed->streets).set("lots_outside_street_blocks", r.observed->outsideStreetBlocks));
@@ -513,14 +516,14 @@ std::vector<std::string> inputPaths(const CompareRequest& request) {
 }
 
 JobOutcome runCompare(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress,
-                      const FigureRenderer* renderer) {
+                      const FigureRenderer* renderer, const PreparedObserved* prepared) {
   const auto started = std::chrono::steady_clock::now();
   const bool figures = value(request, "figures") != 0;
   if (figures && !renderer) throw usageError("compare: this program draws no figures (use --figures 0)");
   if (figures && renderer->check) renderer->check();  // before the long work, not after it
   io::OutputDirectory out(outDir, inputPaths(request));
   try {
-    return writeCompare(out, request, progress, renderer, started);
+    return writeCompare(out, request, progress, renderer, started, prepared);
   } catch (const Error& e) {
     throw out.explain(e);  // a writer's error names --out, not the staging folder, with its cause
   }

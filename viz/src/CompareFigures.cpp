@@ -420,8 +420,9 @@ pipeline::JobOutcome runLeaderboard(const CompareRequest& request, const std::st
   return pipeline::runLeaderboard(request, outDir, progress, drawLeaderboard);
 }
 
-pipeline::JobOutcome runCompare(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress) {
-  return pipeline::runCompare(request, outDir, progress, &compareFigureRenderer());
+pipeline::JobOutcome runCompare(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress,
+                                const pipeline::PreparedObserved* prepared) {
+  return pipeline::runCompare(request, outDir, progress, &compareFigureRenderer(), prepared);
 }
 
 }  // namespace parcelscope::viz

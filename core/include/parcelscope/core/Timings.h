@@ -24,6 +24,8 @@ public:
     current_.clear();
   }
   const std::vector<std::pair<std::string, double>>& stages() const { return stages_; }
+  /// Records a stage timed elsewhere (another process's).
+  void add(const std::string& stage, double seconds) { stages_.emplace_back(stage, seconds); }
 
 private:
   std::string current_;

@@ -10,6 +10,7 @@
 // Working near the origin keeps exact-arithmetic geometry (CGAL) accurate.
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "parcelscope/core/Geometry.h"
 
@@ -36,6 +37,10 @@ public:
   Point toLocal(double x, double y) const;
   /// Local metres back to input coordinates.
   Point toSource(const Point& p) const;
+  /// The frame as numbers, and back: fromState(state()) converts exactly as
+  /// this frame does (frames sent between processes).
+  std::vector<double> state() const;
+  static LocalFrame fromState(const std::vector<double>& state);
   /// One line for logs and run records, e.g. "transverse Mercator at lon 2.35, lat 48.89".
   std::string describe() const;
 

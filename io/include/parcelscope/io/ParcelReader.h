@@ -4,6 +4,9 @@
 // metric plane and cleaning them. Cleaning is never silent: every repair, split,
 // collapse and skip is counted in CleaningReport.
 #include <cstdint>
+#include <functional>
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +16,34 @@
 #include "parcelscope/io/LocalFrame.h"
 
 namespace parcelscope::io {
+
+/// The features' extent and envelope centres from which the local frame is
+/// chosen (its origin is the median centre), input CRS.
+struct FrameSample {
+  Box extent{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+             std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest()};
+  std::vector<double> centresX, centresY;
+};
+
+/// One shard of a layer read by several processes (see pipeline/Shards.h).
+/// The shards' tiles are vertical strips that cover the plane: a feature
+/// belongs to the strip holding its envelope's smallest x, so each feature is
+/// counted once. A shard reads the features whose envelope meets its window.
+struct ShardRead {
+  /// Input CRS: features whose envelope intersects it are cleaned and returned.
+  Box window;
+  /// [tileMinX, tileMaxX): the strip whose features this shard counts (cleaning report).
+  double tileMinX = -std::numeric_limits<double>::infinity();
+  double tileMaxX = std::numeric_limits<double>::infinity();
+  /// true: GDAL reads only the window (a spatial filter), and `exchange` turns
+  /// this shard's frame sample (its own features) into every shard's. false:
+  /// every feature is read to choose the frame, only the window's are cleaned.
+  bool spatialFilter = false;
+  std::function<void(FrameSample&)> exchange;
+  /// When set, the frame (of an earlier read of the same layer) is used as is
+  /// and nothing is exchanged.
+  std::optional<LocalFrame> frame;
+};
 
 struct ReadOptions {
   std::string path;
@@ -29,6 +60,9 @@ struct ReadOptions {
   /// Error(Input) unless `keyFieldOptional` (then that feature's geometry is used).
   std::string keyField;
   bool keyFieldOptional = false;
+  /// Set: read one shard (features in input order of their ids; a window
+  /// without features is no error).
+  std::optional<ShardRead> shard;
 };
 
 struct CleaningReport {
@@ -79,6 +113,11 @@ struct FieldInfo {
   bool numeric = false;
 };
 std::vector<FieldInfo> layerFields(const std::string& path, const std::string& layer = {});
+
+/// The extent of the layer `options` names (input CRS) as GDAL reports it,
+/// without reading every feature where the format stores it; the filter and
+/// the shard are ignored. Throws Error(Input) as readParcels.
+Box layerExtent(const ReadOptions& options);
 
 /// Reads, projects and cleans the polygons of one layer.
 /// Throws Error(Input) with a one-line message naming the file (and the feature

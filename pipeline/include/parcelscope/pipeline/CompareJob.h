@@ -141,8 +141,16 @@ struct FigureRenderer {
 /// also as SVG; the maps map_aspect_ratio and map_blocks as PNG only; with
 /// another request.metric also map_<metric> and hist_<metric>). Throws as compare(), and as
 /// `figures`; the output directory is then left as it was.
-/// `figures` draws them (figures = 1 without one is Error(Usage)).
+/// `figures` draws them (figures = 1 without one is Error(Usage)). With
+/// `prepared`, its data is compared (as compare(request, observed)).
+/// Observed data read and analysed elsewhere (pipeline::mergeShards of the
+/// shards of several processes), and what run.json records of them.
+struct PreparedObserved {
+  std::shared_ptr<const ObservedData> data;
+  int ranks = 1;  ///< run.json's "ranks"
+  Json shards;    ///< run.json's "shards": each one's blocks, parcels and seconds
+};
 JobOutcome runCompare(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress = {},
-                      const FigureRenderer* figures = nullptr);
+                      const FigureRenderer* figures = nullptr, const PreparedObserved* prepared = nullptr);
 
 }  // namespace parcelscope::pipeline

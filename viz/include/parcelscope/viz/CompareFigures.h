@@ -91,6 +91,6 @@ pipeline::JobOutcome runLeaderboard(const CompareRequest& request, const std::st
 
 /// pipeline::runCompare with compareFigureRenderer().
 pipeline::JobOutcome runCompare(const CompareRequest& request, const std::string& outDir,
-                                const ProgressFn& progress = {});
+                                const ProgressFn& progress = {}, const pipeline::PreparedObserved* prepared = nullptr);
 
 }  // namespace parcelscope::viz

@@ -1,0 +1,36 @@
+#pragma once
+// MPI for the command line: `mpirun -n N parcelscope compare ...` splits the
+// run into N spatial shards (pipeline/Shards.h), one per rank; rank 0 merges
+// them and writes what a single process writes. A build without MPI, or a
+// program not started by mpirun, runs as one process.
+#include <string>
+#include <vector>
+
+#include "parcelscope/pipeline/Shards.h"
+
+namespace parcelscope::cli {
+
+/// Initialises MPI when the program was started by an MPI launcher (and the
+/// build has MPI); finalises it on destruction.
+class MpiSession {
+public:
+  MpiSession(int& argc, char**& argv);
+  ~MpiSession();
+  MpiSession(const MpiSession&) = delete;
+  MpiSession& operator=(const MpiSession&) = delete;
+};
+
+/// This process's rank and the number of ranks (0 and 1 without MPI).
+int mpiRank();
+int mpiSize();
+
+/// The reading of a rank: a spatial filter, the frame sample exchanged.
+pipeline::ShardReading rankReading();
+
+/// Every rank's encoded part, on rank 0 (empty elsewhere), in rank order.
+std::vector<std::string> gatherParts(const std::string& mine);
+
+/// Stops every rank at once after printing `message` (a rank's failure).
+[[noreturn]] void abortRanks(const std::string& message);
+
+}  // namespace parcelscope::cli

@@ -1,0 +1,630 @@
+#include "parcelscope/pipeline/Shards.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <type_traits>
+
+#include "parcelscope/core/Error.h"
+#include "parcelscope/io/OutputDirectory.h"
+#include "parcelscope/io/Writers.h"
+#include "parcelscope/pipeline/CompareSession.h"
+
+namespace parcelscope::pipeline {
+
+namespace {
+
+constexpr double kFar = 1e12;  // the reader skips coordinates beyond it: a window this wide holds everything
+constexpr int kMaxReads = 64;
+
+// The strip boundaries: strip k is [cut(k), cut(k + 1)).
+struct Strips {
+  Box extent;
+  int count = 1;
+  double cut(int k) const {
+    if (k <= 0) return -std::numeric_limits<double>::infinity();
+    if (k >= count) return std::numeric_limits<double>::infinity();
+    return extent.minX + extent.width() * static_cast<double>(k) / static_cast<double>(count);
+  }
+  bool holds(int k, double x) const { return x >= cut(k) && x < cut(k + 1); }
+};
+
+// The box, in the input CRS, of a local box: its corners and edge midpoints.
+Box sourceBox(const io::LocalFrame& frame, const Box& b) {
+  Box out{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(), std::numeric_limits<double>::lowest(),
+          std::numeric_limits<double>::lowest()};
+  const double xs[] = {b.minX, 0.5 * (b.minX + b.maxX), b.maxX};
+  const double ys[] = {b.minY, 0.5 * (b.minY + b.maxY), b.maxY};
+  for (double x : xs) {
+    for (double y : ys) {
+      const Point p = frame.toSource({x, y});
+      out = {std::min(out.minX, p.x), std::min(out.minY, p.y), std::max(out.maxX, p.x), std::max(out.maxY, p.y)};
+    }
+  }
+  return out;
+}
+
+bool inside(const Box& inner, const Box& outer) {
+  return inner.minX >= outer.minX && inner.maxX <= outer.maxX && inner.minY >= outer.minY && inner.maxY <= outer.maxY;
+}
+
+Box unite(const Box& a, const Box& b) {
+  return {std::min(a.minX, b.minX), std::min(a.minY, b.minY), std::max(a.maxX, b.maxX), std::max(a.maxY, b.maxY)};
+}
+
+// The lowest vertex (smallest x, then y) of the parcels' outer rings, and their box.
+struct Extent {
+  Point lowest{std::numeric_limits<double>::max(), std::numeric_limits<double>::max()};
+  Box box{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(), std::numeric_limits<double>::lowest(),
+          std::numeric_limits<double>::lowest()};
+  void add(const Polygon& shape) {
+    for (const Point& p : shape.outer) {
+      if (p.x < lowest.x || (p.x == lowest.x && p.y < lowest.y)) lowest = p;
+      box = unite(box, {p.x, p.y, p.x, p.y});
+    }
+  }
+};
+
+// ---- bytes ----
+
+class Writer {
+public:
+  template <class T>
+  void pod(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    bytes_.append(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  template <class T>
+  void pods(const std::vector<T>& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    pod(static_cast<std::uint64_t>(v.size()));
+    bytes_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  }
+  void text(const std::string& s) {
+    pod(static_cast<std::uint64_t>(s.size()));
+    bytes_ += s;
+  }
+  void polygon(const Polygon& p) {
+    pods(p.outer);
+    pod(static_cast<std::uint64_t>(p.holes.size()));
+    for (const Ring& h : p.holes) pods(h);
+  }
+  void timings(const std::vector<std::pair<std::string, double>>& t) {
+    pod(static_cast<std::uint64_t>(t.size()));
+    for (const auto& [name, s] : t) {
+      text(name);
+      pod(s);
+    }
+  }
+  std::string take() { return std::move(bytes_); }
+
+private:
+  std::string bytes_;
+};
+
+class Reader {
+public:
+  Reader(std::string_view bytes, std::string what) : bytes_(bytes), what_(std::move(what)) {}
+  template <class T>
+  T pod() {
+    static_assert(std::is_trivially_copyable_v<T>);
+    need(sizeof(T));
+    T v;
+    std::memcpy(&v, bytes_.data() + at_, sizeof v);
+    at_ += sizeof v;
+    return v;
+  }
+  std::uint64_t count(std::size_t each) {
+    const auto n = pod<std::uint64_t>();
+    if (each > 0 && n > (bytes_.size() - at_) / each) fail();
+    return n;
+  }
+  template <class T>
+  std::vector<T> pods() {
+    const auto n = count(sizeof(T));
+    std::vector<T> v(n);
+    std::memcpy(v.data(), bytes_.data() + at_, n * sizeof(T));
+    at_ += n * sizeof(T);
+    return v;
+  }
+  std::string text() {
+    const auto n = count(1);
+    std::string s(bytes_.substr(at_, n));
+    at_ += n;
+    return s;
+  }
+  Polygon polygon() {
+    Polygon p;
+    p.outer = pods<Point>();
+    p.holes.resize(count(sizeof(std::uint64_t)));
+    for (Ring& h : p.holes) h = pods<Point>();
+    return p;
+  }
+  std::vector<std::pair<std::string, double>> timings() {
+    std::vector<std::pair<std::string, double>> t(count(sizeof(std::uint64_t) + sizeof(double)));
+    for (auto& [name, s] : t) {
+      name = text();
+      s = pod<double>();
+    }
+    return t;
+  }
+  bool done() const { return at_ == bytes_.size(); }
+  [[noreturn]] void fail() const {
+    throw inputError(what_ + ": not a shard of parcelscope " + version() + " (truncated or another version)");
+  }
+
+private:
+  void need(std::size_t n) const {
+    if (bytes_.size() - at_ < n) fail();
+  }
+  std::string_view bytes_;
+  std::string what_;
+  std::size_t at_ = 0;
+};
+
+constexpr char kMagic[] = "parcelscope-shard-1";
+
+void addReport(io::CleaningReport& sum, const io::CleaningReport& r) {
+  sum.features += r.features;
+  sum.nullOrEmpty += r.nullOrEmpty;
+  sum.nonPolygonal += r.nonPolygonal;
+  sum.nonPolygonalParts += r.nonPolygonalParts;
+  sum.nonFiniteSkipped += r.nonFiniteSkipped;
+  sum.multipartFeatures += r.multipartFeatures;
+  sum.partsFromMultipart += r.partsFromMultipart;
+  sum.withHoles += r.withHoles;
+  sum.invalidRepaired += r.invalidRepaired;
+  sum.invalidSkipped += r.invalidSkipped;
+  sum.degenerateSkipped += r.degenerateSkipped;
+  sum.duplicatesCollapsed += r.duplicatesCollapsed;
+  sum.duplicateStacks += r.duplicateStacks;
+  sum.parcels += r.parcels;
+}
+
+}  // namespace
+
+std::pair<int, int> parseShard(const std::string& text) {
+  const auto slash = text.find('/');
+  int i = -1, n = -1;
+  try {
+    std::size_t used = 0;
+    if (slash != std::string::npos) {
+      i = std::stoi(text.substr(0, slash), &used);
+      if (used != slash) i = -1;
+      n = std::stoi(text.substr(slash + 1), &used);
+      if (used != text.size() - slash - 1) n = -1;
+    }
+  } catch (const std::exception&) {
+    i = n = -1;
+  }
+  if (i < 0 || n < 1 || i >= n) throw usageError("--shard " + text + ": expected I/N with 0 <= I < N, e.g. 0/4");
+  return {i, n};
+}
+
+ShardPart analyseShard(const CompareRequest& request, int index, int count, const ShardReading& reading,
+                       const ProgressFn& progress) {
+  if (request.streets) {
+    throw usageError("blocks from street centre lines (--streets) are not split into shards; run in one process");
+  }
+  if (count < 1 || index < 0 || index >= count)
+    throw usageError("shard " + std::to_string(index) + " of " + std::to_string(count) + " does not exist");
+  const auto started = std::chrono::steady_clock::now();
+  const Strips strips{io::layerExtent(request.input), count};
+  const double halo = 0.1 * std::max(strips.extent.width() / count, 1e-9);
+  const analysis::AnalysisOptions options = analysis::analysisOptionsFrom(request.parameters);
+  // Metres around a block within which every parcel must have been read: its
+  // contacts (the block tolerance) and theirs, with room to spare.
+  const double margin = 2.0 * options.blockTolerance + 2.0;
+
+  io::ReadOptions input = request.input;
+  io::ShardRead shard;
+  shard.tileMinX = strips.cut(index);
+  shard.tileMaxX = strips.cut(index + 1);
+  shard.spatialFilter = reading.spatialFilter;
+  shard.exchange = reading.exchange;
+  Box window{index == 0 ? -kFar : shard.tileMinX - halo, -kFar, index == count - 1 ? kFar : shard.tileMaxX + halo,
+             kFar};
+  ShardPart part;
+  part.index = index;
+  part.count = count;
+  for (int read = 1;; ++read) {
+    shard.window = window;
+    input.shard = shard;
+    const ProgressFn step = scaledProgress(progress, read == 1 ? 0.0 : 0.9, 1.0);
+    io::ParcelLayer layer = io::readParcels(input, scaledProgress(step, 0.0, 0.4));
+    shard.frame = layer.frame;  // later reads take it as it is, and exchange nothing
+    shard.exchange = nullptr;
+    const analysis::ObservedAnalysis a =
+        analysis::analyseParcels(layer.parcels, options, scaledProgress(step, 0.4, 1.0));
+    part.parcelsRead += static_cast<std::int64_t>(layer.parcels.size());
+
+    // Blocks, then right-of-way parcels: whole and this shard's, or of this
+    // strip but cut by the window's edge.
+    std::vector<char> keepBlock(a.blocks.size(), 0), keepParcel(layer.parcels.size(), 0);
+    bool cut = false;
+    Box grow{kFar, kFar, -kFar, -kFar};
+    auto judge = [&](const Extent& e) {
+      const Box box = sourceBox(layer.frame, e.box.expanded(margin));
+      if (inside(box, window)) return strips.holds(index, layer.frame.toSource(e.lowest).x);
+      if (box.maxX >= shard.tileMinX && box.minX < shard.tileMaxX) {
+        cut = true;
+        grow = unite(grow, box);
+      }
+      return false;
+    };
+    for (std::size_t b = 0; b < a.blocks.size(); ++b) {
+      Extent e;
+      for (int i : a.blocks[b].parcels) e.add(layer.parcels[i].shape);
+      keepBlock[b] = judge(e);
+    }
+    for (std::size_t i = 0; i < layer.parcels.size(); ++i) {
+      if (a.blockOf[i] >= 0) continue;
+      Extent e;
+      e.add(layer.parcels[i].shape);
+      keepParcel[i] = judge(e);
+    }
+    if (cut) {
+      // Grown by the cut blocks' own size too, so that a large block takes few reads.
+      const Box wider = unite(window, grow.expanded(std::max(halo, 0.5 * std::max(grow.width(), grow.height()))));
+      if (read >= kMaxReads || inside(wider, window)) {
+        throw inputError(request.input.path + ": shard " + std::to_string(index) + " of " + std::to_string(count) +
+                         " found no window holding its blocks whole after " + std::to_string(read) + " reads");
+      }
+      window = wider;
+      continue;
+    }
+    part.reads = read;
+    // This shard's parcels in input order, and its blocks over them.
+    std::vector<int> at(layer.parcels.size(), -1);
+    for (std::size_t i = 0; i < layer.parcels.size(); ++i) {
+      if (a.blockOf[i] >= 0 ? !keepBlock[a.blockOf[i]] : !keepParcel[i]) continue;
+      at[i] = static_cast<int>(part.parcels.size());
+      part.parcels.push_back(std::move(layer.parcels[i]));
+      if (!layer.fields.empty()) part.fields.push_back(layer.fields[i]);
+      part.metrics.push_back(a.metrics[i]);
+      part.rightOfWay.push_back(a.rightOfWay[i]);
+    }
+    for (std::size_t b = 0; b < a.blocks.size(); ++b) {
+      if (!keepBlock[b]) continue;
+      Block block = a.blocks[b];
+      block.id = -1;
+      for (int& i : block.parcels) i = at[i];
+      part.blocks.push_back(std::move(block));
+      part.statistics.push_back(a.statistics[b]);
+    }
+    part.path = layer.path;
+    part.layerName = layer.layerName;
+    part.frame = layer.frame.state();
+    part.crs = layer.crs;
+    part.report = layer.report;
+    part.readTimings = layer.timings.stages();
+    part.analysisTimings = a.timings.stages();
+    break;
+  }
+  part.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return part;
+}
+
+ObservedData mergeShards(std::vector<ShardPart> parts) {
+  if (parts.empty()) throw inputError("merge: no shard given");
+  const int count = parts.front().count;
+  std::sort(parts.begin(), parts.end(), [](const ShardPart& a, const ShardPart& b) { return a.index < b.index; });
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const ShardPart& p = parts[k];
+    const std::string which = "shard " + std::to_string(p.index) + " of " + std::to_string(p.count);
+    if (p.count != count || p.path != parts.front().path || p.layerName != parts.front().layerName) {
+      throw inputError("merge: " + which + " is not of the run of shard 0 of " + std::to_string(count) + " (" +
+                       parts.front().path + ")");
+    }
+    if (p.frame != parts.front().frame) throw inputError("merge: " + which + " chose another local frame");
+    if (k > 0 && p.index == parts[k - 1].index) throw inputError("merge: " + which + " is given twice");
+  }
+  if (static_cast<int>(parts.size()) != count) {
+    std::string missing;
+    for (int i = 0, k = 0; i < count; ++i) {
+      if (k < static_cast<int>(parts.size()) && parts[k].index == i) {
+        ++k;
+      } else {
+        missing += (missing.empty() ? "" : ", ") + std::to_string(i);
+      }
+    }
+    throw inputError("merge: " + std::to_string(parts.size()) + " of " + std::to_string(count) +
+                     " shards given; missing: " + missing);
+  }
+
+  // Every parcel, ordered as one process reads them: by feature id, then part.
+  struct Ref {
+    std::int64_t fid;
+    int partIndex;
+    int shard;
+    int local;
+  };
+  std::vector<Ref> refs;
+  for (std::size_t s = 0; s < parts.size(); ++s) {
+    for (std::size_t i = 0; i < parts[s].parcels.size(); ++i) {
+      const Parcel& p = parts[s].parcels[i];
+      refs.push_back({p.sourceFid, p.part, static_cast<int>(s), static_cast<int>(i)});
+    }
+  }
+  std::sort(refs.begin(), refs.end(),
+            [](const Ref& a, const Ref& b) { return a.fid != b.fid ? a.fid < b.fid : a.partIndex < b.partIndex; });
+  for (std::size_t g = 1; g < refs.size(); ++g) {
+    if (refs[g].fid == refs[g - 1].fid && refs[g].partIndex == refs[g - 1].partIndex) {
+      throw inputError("merge: feature " + std::to_string(refs[g].fid) + " is in shards " +
+                       std::to_string(parts[refs[g - 1].shard].index) + " and " +
+                       std::to_string(parts[refs[g].shard].index));
+    }
+  }
+
+  ObservedData data;
+  io::ParcelLayer& layer = data.layer;
+  analysis::ObservedAnalysis& a = data.analysis;
+  layer.path = parts.front().path;
+  layer.layerName = parts.front().layerName;
+  layer.frame = io::LocalFrame::fromState(parts.front().frame);
+  layer.crs = parts.front().crs;
+  for (const ShardPart& p : parts) addReport(layer.report, p.report);
+  if (layer.report.parcels != static_cast<std::int64_t>(refs.size())) {
+    throw inputError("merge: the shards read " + std::to_string(layer.report.parcels) + " parcels but hold " +
+                     std::to_string(refs.size()) + " in their blocks and right-of-way");
+  }
+  std::vector<std::vector<int>> global(parts.size());
+  for (std::size_t s = 0; s < parts.size(); ++s) global[s].resize(parts[s].parcels.size());
+  const bool fields = std::any_of(parts.begin(), parts.end(), [](const ShardPart& p) { return !p.fields.empty(); });
+  layer.parcels.reserve(refs.size());
+  a.metrics.reserve(refs.size());
+  a.rightOfWay.reserve(refs.size());
+  for (const Ref& r : refs) {
+    ShardPart& p = parts[r.shard];
+    global[r.shard][r.local] = static_cast<int>(layer.parcels.size());
+    layer.parcels.push_back(std::move(p.parcels[r.local]));
+    if (fields) layer.fields.push_back(std::move(p.fields[r.local]));
+    a.metrics.push_back(p.metrics[r.local]);
+    a.rightOfWay.push_back(p.rightOfWay[r.local]);
+  }
+  // Blocks numbered in the order of their first parcel.
+  struct BlockRef {
+    int first;
+    int shard;
+    std::size_t block;
+  };
+  std::vector<BlockRef> blockRefs;
+  for (std::size_t s = 0; s < parts.size(); ++s) {
+    for (std::size_t b = 0; b < parts[s].blocks.size(); ++b) {
+      int first = std::numeric_limits<int>::max();
+      for (int& i : parts[s].blocks[b].parcels) {
+        i = global[s][i];
+        first = std::min(first, i);
+      }
+      blockRefs.push_back({first, static_cast<int>(s), b});
+    }
+  }
+  std::sort(blockRefs.begin(), blockRefs.end(), [](const BlockRef& x, const BlockRef& y) { return x.first < y.first; });
+  a.blockOf.assign(layer.parcels.size(), -1);
+  for (const BlockRef& r : blockRefs) {
+    Block block = std::move(parts[r.shard].blocks[r.block]);
+    analysis::BlockStatistics s = parts[r.shard].statistics[r.block];
+    block.id = s.blockId = static_cast<int>(a.blocks.size());
+    for (int i : block.parcels) a.blockOf[i] = block.id;
+    if (block.parts.size() > 1) ++a.multipartBlocks;
+    a.clampedAMin += s.aMinClamped;
+    a.clampedWMin += s.wMinClamped;
+    a.blocks.push_back(std::move(block));
+    a.statistics.push_back(s);
+  }
+  for (auto r : a.rightOfWay) a.rightOfWayCount += r != analysis::RightOfWay::No;
+  // Stage times: the slowest shard's.
+  auto slowest = [&](auto member) {
+    std::map<std::string, double> most;
+    std::vector<std::string> order;
+    for (const ShardPart& p : parts) {
+      for (const auto& [name, s] : p.*member) {
+        if (!most.count(name)) order.push_back(name);
+        most[name] = std::max(most[name], s);
+      }
+    }
+    Timings t;
+    for (const auto& name : order) t.add(name, most[name]);
+    return t;
+  };
+  layer.timings = slowest(&ShardPart::readTimings);
+  a.timings = slowest(&ShardPart::analysisTimings);
+  return data;
+}
+
+std::string encodeShard(const ShardPart& p) {
+  Writer w;
+  w.text(kMagic);
+  w.text(version());
+  w.pod(p.index);
+  w.pod(p.count);
+  w.text(p.path);
+  w.text(p.layerName);
+  w.pods(p.frame);
+  w.text(p.crs.wkt);
+  w.text(p.crs.name);
+  w.pod(p.crs.assumedLonLat);
+  w.pod(p.crs.overridden);
+  w.pod(p.report);
+  w.pod(static_cast<std::uint64_t>(p.parcels.size()));
+  for (const Parcel& parcel : p.parcels) {
+    w.polygon(parcel.shape);
+    w.pod(parcel.sourceFid);
+    w.pod(parcel.part);
+    w.pod(parcel.stackCount);
+    w.pod(parcel.repaired);
+    w.pod(parcel.featureKey);
+  }
+  w.pod(static_cast<std::uint64_t>(p.fields.size()));
+  for (const auto& f : p.fields) w.pods(f);
+  w.pods(p.metrics);
+  w.pods(p.rightOfWay);
+  w.pod(static_cast<std::uint64_t>(p.blocks.size()));
+  for (const Block& b : p.blocks) {
+    w.pod(static_cast<std::uint64_t>(b.parts.size()));
+    for (const Polygon& part : b.parts) w.polygon(part);
+    w.pods(b.parcels);
+    w.pod(b.key);
+  }
+  w.pods(p.statistics);
+  w.timings(p.readTimings);
+  w.timings(p.analysisTimings);
+  w.pod(p.reads);
+  w.pod(p.parcelsRead);
+  w.pod(p.seconds);
+  return w.take();
+}
+
+ShardPart decodeShard(std::string_view bytes, const std::string& what) {
+  Reader r(bytes, what);
+  if (r.text() != kMagic || r.text() != version()) r.fail();
+  ShardPart p;
+  p.index = r.pod<int>();
+  p.count = r.pod<int>();
+  p.path = r.text();
+  p.layerName = r.text();
+  p.frame = r.pods<double>();
+  p.crs.wkt = r.text();
+  p.crs.name = r.text();
+  p.crs.assumedLonLat = r.pod<bool>();
+  p.crs.overridden = r.pod<bool>();
+  p.report = r.pod<io::CleaningReport>();
+  p.parcels.resize(r.count(1));
+  for (Parcel& parcel : p.parcels) {
+    parcel.shape = r.polygon();
+    parcel.sourceFid = r.pod<std::int64_t>();
+    parcel.part = r.pod<int>();
+    parcel.stackCount = r.pod<int>();
+    parcel.repaired = r.pod<bool>();
+    parcel.featureKey = r.pod<Key>();
+  }
+  p.fields.resize(r.count(sizeof(std::uint64_t)));
+  for (auto& f : p.fields) f = r.pods<double>();
+  p.metrics = r.pods<analysis::ParcelMetrics>();
+  p.rightOfWay = r.pods<analysis::RightOfWay>();
+  p.blocks.resize(r.count(1));
+  for (Block& b : p.blocks) {
+    b.parts.resize(r.count(sizeof(std::uint64_t)));
+    for (Polygon& part : b.parts) part = r.polygon();
+    b.parcels = r.pods<int>();
+    b.key = r.pod<Key>();
+  }
+  p.statistics = r.pods<analysis::BlockStatistics>();
+  p.readTimings = r.timings();
+  p.analysisTimings = r.timings();
+  p.reads = r.pod<int>();
+  p.parcelsRead = r.pod<std::int64_t>();
+  p.seconds = r.pod<double>();
+  if (!r.done() || p.count < 1 || p.index < 0 || p.index >= p.count || p.metrics.size() != p.parcels.size() ||
+      p.rightOfWay.size() != p.parcels.size() || p.statistics.size() != p.blocks.size() ||
+      (!p.fields.empty() && p.fields.size() != p.parcels.size())) {
+    r.fail();
+  }
+  for (const Block& b : p.blocks) {
+    for (int i : b.parcels) {
+      if (i < 0 || static_cast<std::size_t>(i) >= p.parcels.size()) r.fail();
+    }
+  }
+  return p;
+}
+
+PreparedObserved prepareMerged(std::vector<ShardPart> parts, int ranks) {
+  Json shards = Json::array();
+  std::vector<Json> entries(parts.size());
+  for (const ShardPart& p : parts) {
+    std::int64_t blocks = static_cast<std::int64_t>(p.blocks.size());
+    shards.push(Json::object()
+                    .set("shard", p.index)
+                    .set("blocks", blocks)
+                    .set("parcels", static_cast<std::int64_t>(p.parcels.size()))
+                    .set("parcels_read", p.parcelsRead)
+                    .set("windows_read", p.reads)
+                    .set("seconds", p.seconds));
+  }
+  PreparedObserved prepared;
+  prepared.data = std::make_shared<const ObservedData>(mergeShards(std::move(parts)));
+  prepared.ranks = ranks;
+  prepared.shards = std::move(shards);
+  return prepared;
+}
+
+JobOutcome runShard(const CompareRequest& request, int index, int count, const std::string& outDir,
+                    const ProgressFn& progress) {
+  io::OutputDirectory out(outDir, inputPaths(request));
+  try {
+    const ShardPart part = analyseShard(request, index, count, ShardReading{}, scaledProgress(progress, 0.0, 0.95));
+    reportProgress(progress, 0.95, "writing");
+    {
+      std::ofstream file(out.stage("shard.bin"), std::ios::binary);
+      const std::string bytes = encodeShard(part);
+      file.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+      if (!file.flush()) throw ioError(outDir + "/shard.bin: cannot be written");
+    }
+    CompareRequest absolute = request;
+    absolute.input.path = std::filesystem::absolute(request.input.path).lexically_normal().string();
+    io::writeJson(out.stage("session.json"), sessionJson(absolute));
+    const Json record = Json::object()
+                            .set("tool", "parcelscope")
+                            .set("version", version())
+                            .set("command", "compare --shard")
+                            .set("shard", index)
+                            .set("shards", count)
+                            .set("input_as_given", request.input.path)
+                            .set("blocks", static_cast<std::int64_t>(part.blocks.size()))
+                            .set("parcels", static_cast<std::int64_t>(part.parcels.size()))
+                            .set("parcels_read", part.parcelsRead)
+                            .set("windows_read", part.reads)
+                            .set("seconds", part.seconds)
+                            .set("outputs", Json::array().push("shard.bin").push("session.json").push("shard.json"));
+    io::writeJson(out.stage("shard.json"), record);
+    out.commit();
+    reportProgress(progress, 1.0, "writing");
+    return {record, "shard " + std::to_string(index) + " of " + std::to_string(count) + ": " +
+                        std::to_string(part.blocks.size()) + " blocks, " + std::to_string(part.parcels.size()) +
+                        " parcels (" + std::to_string(part.reads) + " windows read); merge the shards with " +
+                        "'parcelscope merge'"};
+  } catch (const Error& e) {
+    throw out.explain(e);
+  }
+}
+
+std::pair<CompareRequest, PreparedObserved> readShards(const std::vector<std::string>& folders) {
+  namespace fs = std::filesystem;
+  if (folders.empty()) throw usageError("merge: give the folders of every shard");
+  auto slurp = [](const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw inputError(file.string() + ": no such file (not a folder of 'compare --shard')");
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+  };
+  std::vector<ShardPart> parts;
+  std::string session;
+  for (const std::string& folder : folders) {
+    const std::string text = slurp(fs::path(folder) / "session.json");
+    if (session.empty()) {
+      session = text;
+    } else if (text != session) {
+      throw inputError(folder + ": a shard of another request (its session.json differs from " + folders.front() +
+                       "'s)");
+    }
+    parts.push_back(decodeShard(slurp(fs::path(folder) / "shard.bin"), (fs::path(folder) / "shard.bin").string()));
+  }
+  CompareRequest request = readSession((fs::path(folders.front()) / "session.json").string());
+  // The input path as the shards were given it, when it names the same file from here.
+  const Json record = io::readJson((fs::path(folders.front()) / "shard.json").string());
+  if (const Json* given = record.find("input_as_given"); given && given->isString()) {
+    std::error_code ec;
+    if (fs::equivalent(given->string(), request.input.path, ec) && !ec) request.input.path = given->string();
+  }
+  const int ranks = parts.front().count;
+  return {std::move(request), prepareMerged(std::move(parts), ranks)};
+}
+
+}  // namespace parcelscope::pipeline
