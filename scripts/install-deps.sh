@@ -7,7 +7,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libvtk9-dev libvtk9-qt-dev qtbase5-dev libqt5opengl5-dev libfreetype-dev
-  libopenmpi-dev
+  libopenmpi-dev openmpi-bin
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev
   libgeographiclib-dev
   libgdal-dev gdal-bin libssl-dev zlib1g-dev

@@ -180,6 +180,18 @@ Box layerExtent(const ReadOptions& options) {
   return {e.MinX, e.MinY, e.MaxX, e.MaxY};
 }
 
+std::int64_t featureCount(const ReadOptions& options) {
+  const GDALDatasetUniquePtr ds = openVector(options.path);
+  OGRLayer* layer = options.layer.empty() ? ds->GetLayer(0) : ds->GetLayerByName(options.layer.c_str());
+  if (!layer) throw inputError(options.path + ": no layer named '" + options.layer + "'");
+  QuietErrors quiet;
+  if (!options.where.empty() && layer->SetAttributeFilter(options.where.c_str()) != OGRERR_NONE) {
+    throw inputError(options.path + ": --where \"" + options.where + "\" is not a valid filter on layer " +
+                     layer->GetName() + " (" + lastGdalMessage() + ")");
+  }
+  return layer->GetFeatureCount(TRUE);
+}
+
 ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) {
   const std::string& path = options.path;
   Timings timings;

@@ -233,6 +233,7 @@ ShardPart analyseShard(const CompareRequest& request, int index, int count, cons
   ShardPart part;
   part.index = index;
   part.count = count;
+  if (reading.spatialFilter && index == 0) part.layerFeatures = io::featureCount(request.input);
   for (int read = 1;; ++read) {
     shard.window = window;
     input.shard = shard;
@@ -370,6 +371,11 @@ ObservedData mergeShards(std::vector<ShardPart> parts) {
   layer.frame = io::LocalFrame::fromState(parts.front().frame);
   layer.crs = parts.front().crs;
   for (const ShardPart& p : parts) addReport(layer.report, p.report);
+  // Features no spatial filter returns have no geometry (or no usable envelope).
+  if (const std::int64_t all = parts.front().layerFeatures; all > layer.report.features) {
+    layer.report.nullOrEmpty += all - layer.report.features;
+    layer.report.features = all;
+  }
   if (layer.report.parcels != static_cast<std::int64_t>(refs.size())) {
     throw inputError("merge: the shards read " + std::to_string(layer.report.parcels) + " parcels but hold " +
                      std::to_string(refs.size()) + " in their blocks and right-of-way");
@@ -475,6 +481,7 @@ std::string encodeShard(const ShardPart& p) {
   w.pods(p.statistics);
   w.timings(p.readTimings);
   w.timings(p.analysisTimings);
+  w.pod(p.layerFeatures);
   w.pod(p.reads);
   w.pod(p.parcelsRead);
   w.pod(p.seconds);
@@ -518,6 +525,7 @@ ShardPart decodeShard(std::string_view bytes, const std::string& what) {
   p.statistics = r.pods<analysis::BlockStatistics>();
   p.readTimings = r.timings();
   p.analysisTimings = r.timings();
+  p.layerFeatures = r.pod<std::int64_t>();
   p.reads = r.pod<int>();
   p.parcelsRead = r.pod<std::int64_t>();
   p.seconds = r.pod<double>();

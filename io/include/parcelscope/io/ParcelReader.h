@@ -119,6 +119,10 @@ std::vector<FieldInfo> layerFields(const std::string& path, const std::string& l
 /// the shard are ignored. Throws Error(Input) as readParcels.
 Box layerExtent(const ReadOptions& options);
 
+/// The number of features of the layer `options` names that pass its filter
+/// (geometry or not), counted by GDAL (an SQL count where the format has one).
+std::int64_t featureCount(const ReadOptions& options);
+
 /// Reads, projects and cleans the polygons of one layer.
 /// Throws Error(Input) with a one-line message naming the file (and the feature
 /// or layer) when the file is missing, empty, neither a regular file nor a folder

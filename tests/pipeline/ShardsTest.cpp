@@ -1,0 +1,273 @@
+// A run split into shards and merged gives the observed data, and so the
+// tables, of one process: on the sample (right-of-way, a null geometry,
+// duplicates, a multipart feature), on a layer whose long block crosses every
+// strip, with both ways of reading (every feature, or a spatial filter with the
+// frame sample exchanged between shards running at once), and on cambridge_ma.
+#include <gtest/gtest.h>
+
+#include <condition_variable>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#include "SampleRequest.h"
+#include "parcelscope/core/Error.h"
+#include "parcelscope/pipeline/CompareJob.h"
+#include "parcelscope/pipeline/Shards.h"
+
+namespace parcelscope::pipeline {
+namespace {
+
+namespace fs = std::filesystem;
+
+void expectSameRing(const Ring& a, const Ring& b) {
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(Point)));
+}
+
+void expectSamePolygon(const Polygon& a, const Polygon& b) {
+  expectSameRing(a.outer, b.outer);
+  ASSERT_EQ(a.holes.size(), b.holes.size());
+  for (std::size_t h = 0; h < a.holes.size(); ++h) expectSameRing(a.holes[h], b.holes[h]);
+}
+
+// Every field of the observed data, to the bit (timings aside).
+void expectSameObserved(const ObservedData& one, const ObservedData& merged) {
+  EXPECT_EQ(one.layer.frame.state(), merged.layer.frame.state());
+  EXPECT_EQ(one.layer.crs.name, merged.layer.crs.name);
+  const io::CleaningReport &r = one.layer.report, &m = merged.layer.report;
+  EXPECT_EQ(0, std::memcmp(&r, &m, sizeof r)) << "cleaning report: features " << r.features << " / " << m.features
+                                              << ", parcels " << r.parcels << " / " << m.parcels;
+  ASSERT_EQ(one.layer.parcels.size(), merged.layer.parcels.size());
+  for (std::size_t i = 0; i < one.layer.parcels.size(); ++i) {
+    const Parcel &a = one.layer.parcels[i], &b = merged.layer.parcels[i];
+    EXPECT_EQ(a.sourceFid, b.sourceFid) << i;
+    EXPECT_EQ(a.part, b.part) << i;
+    EXPECT_EQ(a.stackCount, b.stackCount) << i;
+    EXPECT_EQ(a.repaired, b.repaired) << i;
+    EXPECT_EQ(a.featureKey, b.featureKey) << i;
+    expectSamePolygon(a.shape, b.shape);
+  }
+  const analysis::ObservedAnalysis &x = one.analysis, &y = merged.analysis;
+  ASSERT_EQ(x.metrics.size(), y.metrics.size());
+  for (std::size_t i = 0; i < x.metrics.size(); ++i) {
+    const analysis::ParcelMetrics &p = x.metrics[i], &q = y.metrics[i];
+    EXPECT_EQ(p.area, q.area) << i;
+    EXPECT_EQ(p.width, q.width) << i;
+    EXPECT_EQ(p.perimeter, q.perimeter) << i;
+    EXPECT_EQ(p.pAngle, q.pAngle) << i;
+    EXPECT_EQ(p.neighbours, q.neighbours) << i;
+    EXPECT_EQ(p.frontage, q.frontage) << i;
+    EXPECT_EQ(p.streetAccess, q.streetAccess) << i;
+  }
+  EXPECT_EQ(x.rightOfWay, y.rightOfWay);
+  EXPECT_EQ(x.blockOf, y.blockOf);
+  EXPECT_EQ(x.rightOfWayCount, y.rightOfWayCount);
+  EXPECT_EQ(x.multipartBlocks, y.multipartBlocks);
+  EXPECT_EQ(x.clampedAMin, y.clampedAMin);
+  EXPECT_EQ(x.clampedWMin, y.clampedWMin);
+  ASSERT_EQ(x.blocks.size(), y.blocks.size());
+  for (std::size_t b = 0; b < x.blocks.size(); ++b) {
+    EXPECT_EQ(x.blocks[b].id, y.blocks[b].id);
+    EXPECT_EQ(x.blocks[b].key, y.blocks[b].key) << b;
+    EXPECT_EQ(x.blocks[b].parcels, y.blocks[b].parcels) << b;
+    ASSERT_EQ(x.blocks[b].parts.size(), y.blocks[b].parts.size()) << b;
+    for (std::size_t k = 0; k < x.blocks[b].parts.size(); ++k)
+      expectSamePolygon(x.blocks[b].parts[k], y.blocks[b].parts[k]);
+    EXPECT_EQ(0, std::memcmp(&x.statistics[b], &y.statistics[b], sizeof x.statistics[b]))
+        << "statistics of block " << b;
+  }
+}
+
+// Shards running at once in threads, their frame samples exchanged as MPI
+// ranks exchange them (every shard waits for all, then takes the union).
+class Exchange {
+public:
+  explicit Exchange(int count) : count_(count) {}
+  void operator()(io::FrameSample& sample) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    all_.extent = {std::min(all_.extent.minX, sample.extent.minX), std::min(all_.extent.minY, sample.extent.minY),
+                   std::max(all_.extent.maxX, sample.extent.maxX), std::max(all_.extent.maxY, sample.extent.maxY)};
+    all_.centresX.insert(all_.centresX.end(), sample.centresX.begin(), sample.centresX.end());
+    all_.centresY.insert(all_.centresY.end(), sample.centresY.begin(), sample.centresY.end());
+    if (++arrived_ == count_) done_.notify_all();
+    done_.wait(lock, [&] { return arrived_ == count_; });
+    sample = all_;
+  }
+
+private:
+  int count_, arrived_ = 0;
+  std::mutex mutex_;
+  std::condition_variable done_;
+  io::FrameSample all_;
+};
+
+std::vector<ShardPart> analyseFiltered(const CompareRequest& request, int count) {
+  Exchange exchange(count);
+  std::vector<ShardPart> parts(count);
+  std::vector<std::string> errors(count);
+  std::vector<std::thread> threads;
+  for (int i = 0; i < count; ++i) {
+    threads.emplace_back([&, i] {
+      ShardReading reading;
+      reading.spatialFilter = true;
+      reading.exchange = [&](io::FrameSample& s) { exchange(s); };
+      try {
+        parts[i] = analyseShard(request, i, count, reading);
+      } catch (const std::exception& e) {
+        errors[i] = e.what();
+      }
+    });
+  }
+  for (auto& t : threads) t.join();
+  for (const auto& e : errors) EXPECT_EQ("", e);
+  return parts;
+}
+
+std::vector<ShardPart> analyseWhole(const CompareRequest& request, int count) {
+  std::vector<ShardPart> parts;
+  for (int i = 0; i < count; ++i) parts.push_back(analyseShard(request, i, count, ShardReading{}));
+  return parts;
+}
+
+CompareRequest sampleWithRightOfWay() {
+  CompareRequest r = test::sampleCompareRequest("obb");
+  r.input.where.clear();  // the right-of-way feature, a null geometry, duplicates, a multipart feature
+  return r;
+}
+
+TEST(Shards, MergedShardsGiveTheObservedDataOfOneProcess) {
+  const CompareRequest request = sampleWithRightOfWay();
+  const ObservedData one = loadObserved(request.input, request.parameters);
+  ASSERT_GT(one.layer.report.duplicatesCollapsed, 0);
+  ASSERT_GT(one.layer.report.nullOrEmpty, 0);
+  for (int count : {1, 2, 3, 5}) {
+    SCOPED_TRACE("shards: " + std::to_string(count));
+    expectSameObserved(one, mergeShards(analyseWhole(request, count)));
+  }
+}
+
+TEST(Shards, ShardsWithASpatialFilterAndAnExchangedFrameAgreeWithOneProcess) {
+  CompareRequest request = test::sampleCompareRequest("obb");
+  const ObservedData one = loadObserved(request.input, request.parameters);
+  for (int count : {2, 4}) {
+    SCOPED_TRACE("shards: " + std::to_string(count));
+    std::vector<ShardPart> parts = analyseFiltered(request, count);
+    std::int64_t read = 0;
+    for (const ShardPart& p : parts) read += p.parcelsRead;
+    EXPECT_GT(read, 0);
+    expectSameObserved(one, mergeShards(std::move(parts)));
+  }
+}
+
+// A layer (local metres) of 3 x 3 lot blocks on a grid, and one long block of
+// lots in a row across the whole extent, which every strip cuts.
+std::string writeLongBlockLayer(const fs::path& dir) {
+  fs::create_directories(dir);
+  const fs::path file = dir / "long_block.geojson";
+  std::ofstream out(file);
+  out << "{\"type\":\"FeatureCollection\",\"crs\":{\"type\":\"name\",\"properties\":{\"name\":"
+         "\"urn:ogc:def:crs:EPSG::32631\"}},\"features\":[";
+  bool first = true;
+  auto lot = [&](double x, double y, double w, double h) {
+    out << (first ? "" : ",") << "{\"type\":\"Feature\",\"properties\":{},\"geometry\":{\"type\":\"Polygon\","
+        << "\"coordinates\":[[[" << x << "," << y << "],[" << x + w << "," << y << "],[" << x + w << "," << y + h
+        << "],[" << x << "," << y + h << "],[" << x << "," << y << "]]]}}";
+    first = false;
+  };
+  const double x0 = 500000, y0 = 5000000;
+  for (int bx = 0; bx < 8; ++bx) {
+    for (int by = 0; by < 3; ++by) {
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) lot(x0 + bx * 90 + i * 20, y0 + by * 90 + j * 20, 20, 20);
+      }
+    }
+  }
+  for (int i = 0; i < 36; ++i) lot(x0 + i * 20, y0 - 60, 20, 30);  // 720 m long
+  out << "]}";
+  return file.string();
+}
+
+TEST(Shards, ABlockCrossingEveryStripIsReadWholeByOneShard) {
+  const fs::path dir = fs::temp_directory_path() / "parcelscope-shards-long-block";
+  CompareRequest request = test::sampleCompareRequest("obb");
+  request.input.path = writeLongBlockLayer(dir);
+  request.input.where.clear();
+  const ObservedData one = loadObserved(request.input, request.parameters);
+  ASSERT_EQ(one.analysis.blocks.size(), 25u);
+  for (int count : {2, 3, 4}) {
+    SCOPED_TRACE("shards: " + std::to_string(count));
+    std::vector<ShardPart> parts = analyseFiltered(request, count);
+    int widened = 0;
+    for (const ShardPart& p : parts) widened += p.reads > 1;
+    EXPECT_GE(widened, 1) << "the long block's shard read a wider window";
+    expectSameObserved(one, mergeShards(std::move(parts)));
+    expectSameObserved(one, mergeShards(analyseWhole(request, count)));
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Shards, APartSurvivesEncodingAndBrokenBytesAreNamed) {
+  const CompareRequest request = sampleWithRightOfWay();
+  std::vector<ShardPart> parts = analyseWhole(request, 2);
+  const std::string bytes = encodeShard(parts[1]);
+  const ShardPart back = decodeShard(bytes, "part");
+  EXPECT_EQ(encodeShard(back), bytes);
+  parts[1] = back;
+  expectSameObserved(loadObserved(request.input, request.parameters), mergeShards(std::move(parts)));
+  try {
+    decodeShard(bytes.substr(0, bytes.size() / 2), "half.bin");
+    FAIL() << "a truncated part was decoded";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::Input);
+    EXPECT_NE(std::string(e.what()).find("half.bin"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Shards, AMissingOrRepeatedShardIsRefused) {
+  const CompareRequest request = sampleWithRightOfWay();
+  std::vector<ShardPart> parts = analyseWhole(request, 3);
+  std::vector<ShardPart> missing = {parts[0], parts[2]};
+  try {
+    mergeShards(missing);
+    FAIL() << "two of three shards merged";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("missing: 1"), std::string::npos) << e.what();
+  }
+  std::vector<ShardPart> twice = {parts[0], parts[1], parts[1]};
+  EXPECT_THROW(mergeShards(twice), Error);
+  EXPECT_THROW(parseShard("3/3"), Error);
+  EXPECT_THROW(parseShard("1"), Error);
+  EXPECT_EQ(parseShard("2/5"), std::make_pair(2, 5));
+}
+
+TEST(Shards, StreetBlocksAreNotSplit) {
+  CompareRequest request = test::sampleCompareRequest("obb");
+  request.streets = io::StreetReadOptions{};
+  request.streets->path = request.input.path;
+  EXPECT_THROW(analyseShard(request, 0, 2, ShardReading{}), Error);
+}
+
+const std::string kCambridge =
+    std::string(PARCELSCOPE_SHARED_DATASETS) + "/cambridge_ma/ASSESSING_ParcelsFY2014.topojson";
+
+TEST(SharedDatasetShards, CambridgeInThreeShardsGivesTheTablesOfOneProcess) {
+  if (!fs::exists(kCambridge)) GTEST_SKIP() << "shared dataset not found: " << kCambridge;
+  CompareRequest request = test::sampleCompareRequest("obb");
+  request.input.path = kCambridge;
+  request.input.where = "ML <> 'ROAD'";
+  auto one = std::make_shared<const ObservedData>(loadObserved(request.input, request.parameters));
+  const PreparedObserved merged = prepareMerged(analyseFiltered(request, 3), 3);
+  expectSameObserved(*one, *merged.data);
+  const auto a = comparisonTables(compare(request, one));
+  const auto b = comparisonTables(compare(request, merged.data));
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t t = 0; t < a.size(); ++t) {
+    EXPECT_EQ(a[t].second.rows, b[t].second.rows) << a[t].first;
+  }
+}
+
+}  // namespace
+}  // namespace parcelscope::pipeline
