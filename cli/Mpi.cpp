@@ -1,9 +1,11 @@
 #include "Mpi.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <thread>
 
 #ifdef PARCELSCOPE_MPI
 #include <mpi.h>
@@ -34,7 +36,17 @@ MpiSession::MpiSession(int& argc, char**& argv) {
 }
 
 MpiSession::~MpiSession() {
-  if (started) MPI_Finalize();
+  if (!started) return;
+  // Ranks done early wait for rank 0 asleep: OpenMPI's finalize waits by
+  // spinning, which would take a core from rank 0's generation and writing.
+  MPI_Request done;
+  MPI_Ibarrier(MPI_COMM_WORLD, &done);
+  for (int finished = 0;;) {
+    MPI_Test(&done, &finished, MPI_STATUS_IGNORE);
+    if (finished) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  MPI_Finalize();
 }
 
 int mpiRank() {
