@@ -154,7 +154,7 @@ std::vector<std::string> layerNames(const std::string& path) {
 }
 
 std::vector<FieldInfo> layerFields(const std::string& path, const std::string& layerName) {
-  const GDALDatasetUniquePtr ds = openVector(path);
+  const GDALDatasetUniquePtr ds = openVector(path, layerName);
   OGRLayer* layer = layerName.empty() ? ds->GetLayer(0) : ds->GetLayerByName(layerName.c_str());
   if (!layer) throw inputError(path + ": no layer named '" + layerName + "'");
   std::vector<FieldInfo> fields;
@@ -167,8 +167,10 @@ std::vector<FieldInfo> layerFields(const std::string& path, const std::string& l
   return fields;
 }
 
+std::vector<std::string> inputFiles(const std::string& path) { return detail::inputFiles(path); }
+
 Box layerExtent(const ReadOptions& options) {
-  const GDALDatasetUniquePtr ds = openVector(options.path);
+  const GDALDatasetUniquePtr ds = openVector(options.path, options.layer);
   OGRLayer* layer = options.layer.empty() ? ds->GetLayer(0) : ds->GetLayerByName(options.layer.c_str());
   if (!layer) throw inputError(options.path + ": no layer named '" + options.layer + "'");
   OGREnvelope e;
@@ -181,7 +183,7 @@ Box layerExtent(const ReadOptions& options) {
 }
 
 std::int64_t featureCount(const ReadOptions& options) {
-  const GDALDatasetUniquePtr ds = openVector(options.path);
+  const GDALDatasetUniquePtr ds = openVector(options.path, options.layer);
   OGRLayer* layer = options.layer.empty() ? ds->GetLayer(0) : ds->GetLayerByName(options.layer.c_str());
   if (!layer) throw inputError(options.path + ": no layer named '" + options.layer + "'");
   QuietErrors quiet;
@@ -196,7 +198,7 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
   const std::string& path = options.path;
   Timings timings;
   timings.start("read");
-  auto ds = openVector(path);
+  auto ds = openVector(path, options.layer);
   QuietErrors quiet;
 
   OGRLayer* layer = nullptr;

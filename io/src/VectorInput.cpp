@@ -4,8 +4,10 @@
 #include <ogr_spatialref.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "OgrConvert.h"
@@ -51,7 +53,7 @@ static std::string describeFileType(std::filesystem::file_type type) {
 // Opens `path` as a vector dataset. The path is looked at first (stat), so that
 // what GDAL cannot read is named (an empty file, a folder, a device) and a named
 // pipe without a writer is refused instead of blocking GDAL's open.
-GDALDatasetUniquePtr openVector(const std::string& path) {
+static GDALDatasetUniquePtr openOne(const std::string& path) {
   namespace fs = std::filesystem;
   detail::ensureGdalRegistered();
   std::error_code ec;
@@ -77,6 +79,107 @@ GDALDatasetUniquePtr openVector(const std::string& path) {
                      (why.empty() ? "; no driver recognises its contents" : ": " + why) + ")");
   }
   if (ds->GetLayerCount() == 0) throw inputError(path + ": holds no vector layer");
+  return ds;
+}
+
+namespace {
+
+// Extensions of the vector files a folder input is made of (shapefiles by their .shp).
+bool isVectorFile(const std::filesystem::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  for (const char* known :
+       {".gpkg", ".geojson", ".json", ".topojson", ".shp", ".fgb", ".gml", ".kml", ".sqlite", ".tab", ".mif"}) {
+    if (ext == known) return true;
+  }
+  return false;
+}
+
+std::string xml(const std::string& text) {
+  char* escaped = CPLEscapeString(text.c_str(), -1, CPLES_XML);
+  std::string out = escaped;
+  CPLFree(escaped);
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> inputFiles(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  std::vector<std::string> files;
+  if (fs::is_directory(path, ec)) {
+    std::string name = fs::path(path).filename().string();
+    if (name.empty()) name = fs::path(path).parent_path().filename().string();
+    if (name.size() > 4 && name.substr(name.size() - 4) == ".gdb") return {};  // a File Geodatabase is one dataset
+    for (const auto& entry : fs::directory_iterator(path, ec)) {
+      if (entry.is_regular_file(ec) && isVectorFile(entry.path())) files.push_back(entry.path().string());
+    }
+    std::sort(files.begin(), files.end());
+    return files;
+  }
+  const std::string ext = fs::path(path).extension().string();
+  if (!fs::is_regular_file(path, ec) || (ext != ".txt" && ext != ".lst")) return {};
+  std::ifstream list(path);
+  std::string line;
+  for (int number = 1; std::getline(list, line); ++number) {
+    while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
+    std::size_t start = 0;
+    while (start < line.size() && std::isspace(static_cast<unsigned char>(line[start]))) ++start;
+    line = line.substr(start);
+    if (line.empty() || line[0] == '#') continue;
+    fs::path file(line);
+    if (file.is_relative()) file = fs::path(path).parent_path() / file;
+    if (!fs::exists(file, ec)) {
+      throw inputError(path + ": line " + std::to_string(number) + ": " + file.string() + ": no such file");
+    }
+    files.push_back(file.lexically_normal().string());
+  }
+  if (files.empty()) throw inputError(path + ": lists no file (one path per line; # starts a comment)");
+  return files;
+}
+
+// Opens `path` as a vector dataset; a folder of vector files or a list of
+// them (inputFiles) is opened as one layer, the union of each file's layer
+// `layer` (or first layer), through an in-memory OGR VRT.
+GDALDatasetUniquePtr openVector(const std::string& path, const std::string& layer) {
+  detail::ensureGdalRegistered();
+  const std::vector<std::string> files = inputFiles(path);
+  if (files.empty()) return openOne(path);
+  std::string unionName, sources, geometryName;
+  std::unique_ptr<OGRSpatialReference> firstCrs;
+  for (std::size_t k = 0; k < files.size(); ++k) {
+    const GDALDatasetUniquePtr ds = openOne(files[k]);
+    OGRLayer* l = layer.empty() ? ds->GetLayer(0) : ds->GetLayerByName(layer.c_str());
+    if (!l) throw inputError(files[k] + ": no layer named '" + layer + "' (in " + path + ")");
+    const OGRSpatialReference* crs = l->GetSpatialRef();
+    if (k == 0) {
+      unionName = layer.empty() ? l->GetName() : layer;
+      geometryName = l->GetGeometryColumn();
+      if (crs) firstCrs.reset(crs->Clone());
+    } else if (geometryName != l->GetGeometryColumn()) {
+      // A union layer matches geometries by their column's name: others would read as null.
+      throw inputError(files[k] + ": its geometry column ('" + std::string(l->GetGeometryColumn()) +
+                       "') is not that of " + files.front() + " ('" + geometryName + "'); the files of " + path +
+                       " are read as one layer: give them one format (ogr2ogr)");
+    } else if ((crs == nullptr) != (firstCrs == nullptr) || (crs && !crs->IsSame(firstCrs.get()))) {
+      auto name = [](const OGRSpatialReference* c) { return std::string(c && c->GetName() ? c->GetName() : "none"); };
+      throw inputError(files[k] + ": its CRS (" + name(crs) + ") is not that of " + files.front() + " (" +
+                       name(firstCrs.get()) + "); the files of " + path +
+                       " are read as one layer and must share one CRS (reproject with ogr2ogr -t_srs)");
+    }
+    sources += "<OGRVRTLayer name=\"part" + std::to_string(k) + "\"><SrcDataSource>" + xml(files[k]) +
+               "</SrcDataSource><SrcLayer>" + xml(l->GetName()) + "</SrcLayer></OGRVRTLayer>";
+  }
+  const std::string vrt = "<OGRVRTDataSource><OGRVRTUnionLayer name=\"" + xml(unionName) + "\">" + sources +
+                          "</OGRVRTUnionLayer></OGRVRTDataSource>";
+  QuietErrors quiet;
+  CPLErrorReset();
+  GDALDatasetUniquePtr ds(GDALDataset::Open(vrt.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
+  if (!ds || ds->GetLayerCount() == 0) {
+    throw inputError(path + ": its " + std::to_string(files.size()) + " files cannot be read as one layer (" +
+                     lastGdalMessage() + ")");
+  }
   return ds;
 }
 

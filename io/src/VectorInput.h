@@ -22,7 +22,13 @@ std::string lastGdalMessage();
 /// Opens `path` as a vector dataset, read-only. What GDAL cannot read is named
 /// (missing, empty, a folder, a device; a named pipe is refused before GDAL
 /// opens it). Throws Error(Input).
-GDALDatasetUniquePtr openVector(const std::string& path);
+/// A folder of vector files (by extension, sorted by name; a .gdb folder is one
+/// dataset) or a list file (.txt, .lst: one path per line, relative to the list,
+/// # comments) is read as one layer: the union of each file's `layer` (empty:
+/// its first), whose features are numbered in turn. Their CRSs must agree.
+GDALDatasetUniquePtr openVector(const std::string& path, const std::string& layer = {});
+/// The files of such an input, in order; empty when `path` is one dataset.
+std::vector<std::string> inputFiles(const std::string& path);
 
 /// The CRS of `layer`: `crsOverride` (the --crs flag) when given, parsed into
 /// `storage` (and `overridden` set), else the one the layer declares (null:

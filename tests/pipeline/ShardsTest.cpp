@@ -3,6 +3,7 @@
 // duplicates, a multipart feature), on a layer whose long block crosses every
 // strip, with both ways of reading (every feature, or a spatial filter with the
 // frame sample exchanged between shards running at once), and on cambridge_ma.
+#include <gdal_utils.h>
 #include <gtest/gtest.h>
 
 #include <condition_variable>
@@ -248,6 +249,62 @@ TEST(Shards, StreetBlocksAreNotSplit) {
   request.streets = io::StreetReadOptions{};
   request.streets->path = request.input.path;
   EXPECT_THROW(analyseShard(request, 0, 2, ShardReading{}), Error);
+}
+
+// `source`'s features whose id passes `where`, copied into a new file (GDAL's ogr2ogr).
+void copyFeatures(const std::string& source, const std::string& where, const std::string& format,
+                  const fs::path& target) {
+  GDALAllRegister();
+  GDALDatasetH in = GDALOpenEx(source.c_str(), GDAL_OF_VECTOR, nullptr, nullptr, nullptr);
+  ASSERT_NE(in, nullptr);
+  const char* argv[] = {"-f", format.c_str(), "-where", where.c_str(), nullptr};
+  GDALVectorTranslateOptions* options = GDALVectorTranslateOptionsNew(const_cast<char**>(argv), nullptr);
+  int failed = 0;
+  GDALDatasetH out = GDALVectorTranslate(target.c_str(), nullptr, 1, &in, options, &failed);
+  GDALVectorTranslateOptionsFree(options);
+  ASSERT_NE(out, nullptr);
+  GDALClose(out);
+  GDALClose(in);
+}
+
+TEST(ManyFiles, AFolderOrAListOfFilesIsReadAsOneLayer) {
+  const fs::path dir = fs::temp_directory_path() / "parcelscope-many-files";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "communes");
+  CompareRequest request = sampleWithRightOfWay();
+  const std::string sample = request.input.path;
+  copyFeatures(sample, "FID < 60", "GeoJSON", dir / "communes" / "a.geojson");
+  copyFeatures(sample, "FID >= 60 AND FID < 120", "GeoJSON", dir / "communes" / "b.geojson");
+  copyFeatures(sample, "FID >= 120", "GeoJSON", dir / "communes" / "c.geojson");
+  std::ofstream(dir / "communes.txt") << "# one file per commune\ncommunes/a.geojson\n\ncommunes/b.geojson\n"
+                                      << (dir / "communes" / "c.geojson").string() << "\n";
+  const ObservedData one = loadObserved(request.input, request.parameters);
+  for (const fs::path& input : {dir / "communes", dir / "communes.txt"}) {
+    SCOPED_TRACE(input.string());
+    request.input.path = input.string();
+    EXPECT_EQ(io::inputFiles(request.input.path).size(), 3u);
+    // Features numbered in turn across the files: the ids, and so every table, of the single file.
+    expectSameObserved(one, loadObserved(request.input, request.parameters));
+    EXPECT_THROW(analyseShard(request, 0, 2, ShardReading{}), Error);
+  }
+  // Files that cannot make one layer are named.
+  copyFeatures(sample, "FID < 5", "GPKG", dir / "communes" / "d.gpkg");
+  request.input.path = (dir / "communes").string();
+  try {
+    loadObserved(request.input, request.parameters);
+    FAIL() << "a GeoPackage and GeoJSON files read as one layer";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("d.gpkg"), std::string::npos) << e.what();
+  }
+  std::ofstream(dir / "broken.txt") << "communes/a.geojson\ncommunes/missing.geojson\n";
+  request.input.path = (dir / "broken.txt").string();
+  try {
+    loadObserved(request.input, request.parameters);
+    FAIL() << "a list naming a missing file was read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("line 2"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
 }
 
 const std::string kCambridge =

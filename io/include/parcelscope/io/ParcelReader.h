@@ -114,6 +114,12 @@ struct FieldInfo {
 };
 std::vector<FieldInfo> layerFields(const std::string& path, const std::string& layer = {});
 
+/// The files of a multi-file input, in order: a folder's vector files (by
+/// extension, sorted by name; a .gdb folder is one dataset) or the paths a list
+/// file (.txt, .lst) holds, one per line. Empty when `path` is one dataset.
+/// readParcels reads such an input as one layer (the union of each file's layer).
+std::vector<std::string> inputFiles(const std::string& path);
+
 /// The extent of the layer `options` names (input CRS) as GDAL reports it,
 /// without reading every feature where the format stores it; the filter and
 /// the shard are ignored. Throws Error(Input) as readParcels.
