@@ -442,8 +442,9 @@ int compareCommand(const std::vector<std::string>& args) {
         "observed_parcels.csv, generated_parcels.csv, blocks.csv, summary.csv, distances.csv,\n"
         "summary.json, run.json and DIR/figures/*.png and *.svg or *.pdf (figures need an X server: use\n"
         "'xvfb-run -a' without a screen, or --figures no).\n"
-        "\nUnder 'mpirun -n N', the N ranks each read and analyse one vertical strip of INPUT (a GDAL\n"
-        "spatial filter) and rank 0 writes the outputs one process writes (run.json adds \"ranks\").\n",
+        "\nUnder 'mpirun -n N', the N ranks each read and analyse one vertical strip of INPUT (a\n"
+        "GeoPackage through its R-tree) and rank 0 writes the outputs one process writes (run.json\n"
+        "adds \"ranks\").\n",
         stdout);
     return 0;
   }

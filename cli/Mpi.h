@@ -24,7 +24,7 @@ public:
 int mpiRank();
 int mpiSize();
 
-/// The reading of a rank: a spatial filter, the frame sample exchanged.
+/// The reading of a rank: its window only, the frame sample exchanged.
 pipeline::ShardReading rankReading();
 
 /// Every rank's encoded part, on rank 0 (empty elsewhere), in rank order.

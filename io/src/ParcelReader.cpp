@@ -144,6 +144,39 @@ Cleaned cleanFeature(const Feature& f, const LocalFrame& frame) {
   return c;
 }
 
+// Narrows the reading of a shard's layer to features whose envelope may meet
+// `window` where the format indexes envelopes: a GeoPackage's R-tree, through
+// an SQL attribute filter (its boxes are rounded outwards, so none is missed).
+// GDAL's spatial filter is not used: it tests the geometry itself against the
+// rectangle, and drops an invalid feature that crosses its edge (GEOS finds no
+// intersection). Other formats are read whole; the reader tests envelopes.
+void restrictToWindow(GDALDataset& ds, OGRLayer& layer, const std::string& where, const Box& window) {
+  if (!EQUAL(ds.GetDriverName(), "GPKG") || !*layer.GetFIDColumn() || !*layer.GetGeometryColumn()) return;
+  const std::string rtree = std::string("rtree_") + layer.GetName() + "_" + layer.GetGeometryColumn();
+  auto quoted = [](const std::string& name) {
+    std::string q = "\"";
+    for (char c : name) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return q + "\"";
+  };
+  {
+    const std::string probe = "SELECT name FROM sqlite_master WHERE type = 'table' AND name = '" + rtree + "'";
+    OGRLayer* found = ds.ExecuteSQL(probe.c_str(), nullptr, nullptr);
+    const bool indexed = found && found->GetFeatureCount() > 0;
+    if (found) ds.ReleaseResultSet(found);
+    if (!indexed || rtree.find('\'') != std::string::npos) return;
+  }
+  char box[256];
+  std::snprintf(box, sizeof box, "maxx >= %.17g AND minx <= %.17g AND maxy >= %.17g AND miny <= %.17g", window.minX,
+                window.maxX, window.minY, window.maxY);
+  const std::string filter = (where.empty() ? "" : "(" + where + ") AND ") + quoted(layer.GetFIDColumn()) +
+                             " IN (SELECT id FROM " + quoted(rtree) + " WHERE " + box + ")";
+  CPLErrorReset();
+  if (layer.SetAttributeFilter(filter.c_str()) != OGRERR_NONE) {
+    throw inputError(ds.GetDescription() + std::string(": the R-tree of layer ") + layer.GetName() +
+                     " cannot be queried (" + lastGdalMessage() + ")");
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> layerNames(const std::string& path) {
@@ -256,9 +289,7 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
   };
   const ShardRead* shard = options.shard ? &*options.shard : nullptr;
   const bool filtered = shard && shard->spatialFilter;
-  if (filtered) {
-    layer->SetSpatialFilterRect(shard->window.minX, shard->window.minY, shard->window.maxX, shard->window.maxY);
-  }
+  if (filtered) restrictToWindow(*ds, *layer, options.where, shard->window);
   // In a shard, a feature belongs to the strip of its envelope's smallest x; one
   // without a usable envelope to the first strip.
   auto ownedBy = [&](const OGREnvelope* e) {

@@ -35,7 +35,8 @@ struct ShardRead {
   /// [tileMinX, tileMaxX): the strip whose features this shard counts (cleaning report).
   double tileMinX = -std::numeric_limits<double>::infinity();
   double tileMaxX = std::numeric_limits<double>::infinity();
-  /// true: GDAL reads only the window (a spatial filter), and `exchange` turns
+  /// true: only the window is read (a GeoPackage's R-tree; other formats are
+  /// read whole, their features' envelopes tested), and `exchange` turns
   /// this shard's frame sample (its own features) into every shard's. false:
   /// every feature is read to choose the frame, only the window's are cleaned.
   bool spatialFilter = false;

@@ -39,16 +39,16 @@ struct ShardPart {
   std::vector<Block> blocks;  ///< `parcels` index this part's parcels
   std::vector<analysis::BlockStatistics> statistics;
   std::vector<std::pair<std::string, double>> readTimings, analysisTimings;
-  /// Shard 0 read with a spatial filter: the layer's features as GDAL counts
-  /// them, so that those no window returns (null or empty geometries) are
-  /// counted too. -1 otherwise.
+  /// Shard 0 read through its window: the layer's features as GDAL counts
+  /// them, so that those no window returns (null or empty geometries, absent
+  /// from a GeoPackage's R-tree) are counted too. -1 otherwise.
   std::int64_t layerFeatures = -1;
   int reads = 0;                 ///< windows read (1 when no block crossed the first one's edge)
   std::int64_t parcelsRead = 0;  ///< parcels cleaned over the reads
   double seconds = 0;            ///< reading and analysis
 };
 
-/// How a shard reads: with a GDAL spatial filter and an exchange of the frame
+/// How a shard reads: through its window (io::ShardRead) and an exchange of the frame
 /// sample with the other shards (MPI), or reading every feature for the
 /// frame (one shard alone, as an array job does).
 struct ShardReading {
