@@ -250,18 +250,23 @@ ShardPart analyseShard(const CompareRequest& request, int index, int count, cons
         analysis::analyseParcels(layer.parcels, options, scaledProgress(step, 0.4, 1.0));
     part.parcelsRead += static_cast<std::int64_t>(layer.parcels.size());
 
-    // Blocks, then right-of-way parcels: whole and this shard's, or of this
-    // strip but cut by the window's edge.
+    // Blocks, then right-of-way parcels: kept when whole and this shard's;
+    // the window grows for those of this shard cut by its edge.
     std::vector<char> keepBlock(a.blocks.size(), 0), keepParcel(layer.parcels.size(), 0);
     bool cut = false;
     Box grow{kFar, kFar, -kFar, -kFar};
+    const double slack = 1e-6 * std::max(strips.extent.width() / count, 1e-9);
     auto judge = [&](const Extent& e) {
       const Box box = sourceBox(layer.frame, e.box.expanded(margin));
-      if (inside(box, window)) return strips.holds(index, layer.frame.toSource(e.lowest).x);
-      if (box.maxX >= shard.tileMinX && box.minX < shard.tileMaxX) {
-        cut = true;
-        grow = unite(grow, box);
-      }
+      const double anchor = layer.frame.toSource(e.lowest).x;
+      if (inside(box, window)) return strips.holds(index, anchor);
+      // Cut. Its lowest vertex lies at or left of the one seen: left of this
+      // strip, a shard on the left owns it. Not cut on the left (windows span
+      // every y), the vertex seen is its lowest: it tells the owner.
+      if (anchor < shard.tileMinX - slack) return false;
+      if (box.minX >= window.minX && !strips.holds(index, anchor)) return false;
+      cut = true;
+      grow = unite(grow, box);
       return false;
     };
     for (std::size_t b = 0; b < a.blocks.size(); ++b) {
@@ -276,8 +281,10 @@ ShardPart analyseShard(const CompareRequest& request, int index, int count, cons
       keepParcel[i] = judge(e);
     }
     if (cut) {
-      // Grown by the cut blocks' own size too, so that a large block takes few reads.
-      const Box wider = unite(window, grow.expanded(std::max(halo, 0.5 * std::max(grow.width(), grow.height()))));
+      // Windows span every y: grown in x past the cut items by a halo that
+      // doubles with each read, so that a large block takes few reads.
+      const double by = std::ldexp(halo, read - 1);
+      const Box wider = unite(window, {grow.minX - by, window.minY, grow.maxX + by, window.maxY});
       if (read >= kMaxReads || inside(wider, window)) {
         throw inputError(request.input.path + ": shard " + std::to_string(index) + " of " + std::to_string(count) +
                          " found no window holding its blocks whole after " + std::to_string(read) + " reads");
