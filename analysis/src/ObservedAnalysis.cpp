@@ -416,29 +416,33 @@ std::vector<Value> metricValues(const ParcelMetrics& m) {
   return values;
 }
 
-Table parcelTable(const std::vector<Parcel>& parcels, const ObservedAnalysis& a) {
+RowSource parcelRows(const std::vector<Parcel>& parcels, const ObservedAnalysis& a) {
   using T = Column::Type;
-  Table t;
+  RowSource t;
   t.columns = {{"parcel_id", T::Integer, ""}, {"parcel_key", T::String, ""},   {"source_fid", T::Integer, ""},
                {"part", T::Integer, ""},      {"block_id", T::Integer, ""},    {"block_key", T::String, ""},
                {"role", T::String, ""},       {"stack_count", T::Integer, ""}, {"repaired", T::Integer, ""}};
   for (Column& c : metricColumns()) t.columns.push_back(std::move(c));
-  static const char* roles[] = {"lot", "right_of_way_holes", "right_of_way_network"};
-  for (std::size_t i = 0; i < parcels.size(); ++i) {
+  t.rows = parcels.size();
+  t.row = [&parcels, &a](std::size_t i, std::vector<Value>& row) {
+    static const char* roles[] = {"lot", "right_of_way_holes", "right_of_way_network"};
     const int block = a.blockOf[i];
-    std::vector<Value> row = {std::int64_t(i),
-                              keyText(parcelKey(parcels[i])),
-                              std::int64_t(parcels[i].sourceFid),
-                              std::int64_t(parcels[i].part),
-                              std::int64_t(block),
-                              block >= 0 ? keyText(a.blocks[static_cast<std::size_t>(block)].key) : std::string(),
-                              std::string(roles[static_cast<int>(a.rightOfWay[i])]),
-                              std::int64_t(parcels[i].stackCount),
-                              std::int64_t(parcels[i].repaired)};
+    row = {std::int64_t(i),
+           keyText(parcelKey(parcels[i])),
+           std::int64_t(parcels[i].sourceFid),
+           std::int64_t(parcels[i].part),
+           std::int64_t(block),
+           block >= 0 ? keyText(a.blocks[static_cast<std::size_t>(block)].key) : std::string(),
+           std::string(roles[static_cast<int>(a.rightOfWay[i])]),
+           std::int64_t(parcels[i].stackCount),
+           std::int64_t(parcels[i].repaired)};
     for (Value& v : metricValues(a.metrics[i])) row.push_back(std::move(v));
-    t.rows.push_back(std::move(row));
-  }
+  };
   return t;
+}
+
+Table parcelTable(const std::vector<Parcel>& parcels, const ObservedAnalysis& a) {
+  return parcelRows(parcels, a).table();
 }
 
 Table blockTable(const ObservedAnalysis& a) {

@@ -16,6 +16,32 @@ std::size_t Table::column(const std::string& name) const {
   throw std::out_of_range("no column " + name);
 }
 
+Table RowSource::table() const {
+  Table t;
+  t.columns = columns;
+  t.rows.resize(rows);
+  for (std::size_t i = 0; i < rows; ++i) row(i, t.rows[i]);
+  return t;
+}
+
+RowSource RowSource::of(const Table& table) {
+  RowSource s;
+  s.columns = table.columns;
+  s.rows = table.rows.size();
+  s.row = [&table](std::size_t i, std::vector<Value>& out) { out = table.rows[i]; };
+  return s;
+}
+
+RowSource RowSource::with(Column column, std::function<Value(std::size_t, const std::vector<Value>&)> value) const {
+  RowSource s = *this;
+  s.columns.push_back(std::move(column));
+  s.row = [inner = row, value = std::move(value)](std::size_t i, std::vector<Value>& out) {
+    inner(i, out);
+    out.push_back(value(i, out));
+  };
+  return s;
+}
+
 Json Json::object() {
   Json j;
   j.value_ = std::make_shared<Object>();

@@ -51,28 +51,43 @@ void writeText(const std::string& path, const std::vector<std::string>& chunks) 
 }
 }  // namespace
 
-void writeCsv(const std::string& path, const Table& table) {
-  // Rows formatted in parallel, in chunks written in order.
-  constexpr std::size_t kRowsPerChunk = 4096;
-  const std::size_t chunks = (table.rows.size() + kRowsPerChunk - 1) / kRowsPerChunk;
-  std::vector<std::string> text(chunks + 1);
-  for (std::size_t c = 0; c < table.columns.size(); ++c) {
-    if (c) text[0] += ',';
-    appendCsvField(text[0], table.columns[c].name);
+void writeCsv(const std::string& path, const Table& table) { writeCsv(path, RowSource::of(table)); }
+
+void writeCsv(const std::string& path, const RowSource& rows) {
+  // Rows made and formatted in parallel, in chunks written in order, a batch
+  // of chunks at a time.
+  constexpr std::size_t kRowsPerChunk = 4096, kChunksPerBatch = 16;
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  std::string header;
+  for (std::size_t c = 0; c < rows.columns.size(); ++c) {
+    if (c) header += ',';
+    appendCsvField(header, rows.columns[c].name);
   }
-  text[0] += '\n';
-  parallelFor(chunks, [&](std::size_t k) {
-    std::string& out = text[k + 1];
-    for (std::size_t r = k * kRowsPerChunk, end = std::min(table.rows.size(), r + kRowsPerChunk); r < end; ++r) {
-      const auto& row = table.rows[r];
-      for (std::size_t c = 0; c < row.size(); ++c) {
-        if (c) out += ',';
-        appendCsvField(out, row[c]);
+  header += '\n';
+  out.write(header.data(), static_cast<std::streamsize>(header.size()));
+  const std::size_t chunks = (rows.rows + kRowsPerChunk - 1) / kRowsPerChunk;
+  std::vector<std::string> text(kChunksPerBatch);
+  for (std::size_t first = 0; first < chunks && out; first += kChunksPerBatch) {
+    const std::size_t batch = std::min(kChunksPerBatch, chunks - first);
+    parallelFor(batch, [&](std::size_t k) {
+      std::string& chunk = text[k];
+      chunk.clear();
+      std::vector<Value> row;
+      const std::size_t begin = (first + k) * kRowsPerChunk;
+      for (std::size_t r = begin, end = std::min(rows.rows, begin + kRowsPerChunk); r < end; ++r) {
+        row.clear();
+        rows.row(r, row);
+        for (std::size_t c = 0; c < row.size(); ++c) {
+          if (c) chunk += ',';
+          appendCsvField(chunk, row[c]);
+        }
+        chunk += '\n';
       }
-      out += '\n';
-    }
-  });
-  writeText(path, text);
+    });
+    for (std::size_t k = 0; k < batch; ++k) out.write(text[k].data(), static_cast<std::streamsize>(text[k].size()));
+  }
+  out.close();
+  if (!out) throw ioError(path + ": cannot write");
 }
 
 void writeJson(const std::string& path, const Json& json) { writeText(path, {json.dump() + "\n"}); }
@@ -140,8 +155,8 @@ void setFields(OGRFeature& feature, const std::vector<Value>& row) {
 }
 
 template <typename Fail>
-void createFields(OGRLayer& layer, const Table& attributes, const Fail& fail) {
-  for (const Column& c : attributes.columns) {
+void createFields(OGRLayer& layer, const std::vector<Column>& columns, const Fail& fail) {
+  for (const Column& c : columns) {
     const OGRFieldType type = c.type == Column::Type::Integer ? OFTInteger64
                               : c.type == Column::Type::Real  ? OFTReal
                                                               : OFTString;
@@ -166,6 +181,12 @@ OGRSpatialReference outputSrs(const CrsInfo& crs) {
 LayerWrite writePolygonLayer(const std::string& path, const std::string& layerName,
                              const std::vector<std::vector<Polygon>>& geometries, const Table& attributes,
                              const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex) {
+  return writePolygonLayer(path, layerName, geometries, RowSource::of(attributes), frame, crs, spatialIndex);
+}
+
+LayerWrite writePolygonLayer(const std::string& path, const std::string& layerName,
+                             const std::vector<std::vector<Polygon>>& geometries, const RowSource& attributes,
+                             const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex) {
   detail::ensureGdalRegistered();
   detail::QuietErrors quiet;
   CPLErrorReset();
@@ -188,7 +209,7 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
   if (!geojson && !spatialIndex) layerOptions.SetNameValue("SPATIAL_INDEX", "NO");
   OGRLayer* layer = ds->CreateLayer(layerName.c_str(), &srs, wkbMultiPolygon, layerOptions.List());
   if (!layer) throw fail("cannot create layer " + layerName);
-  createFields(*layer, attributes, fail);
+  createFields(*layer, attributes.columns, fail);
   if (!geojson && ds->StartTransaction() != OGRERR_NONE) throw fail("cannot start transaction");
   // Geometries are taken back to the source CRS, checked and repaired there,
   // and converted in batches on a second thread while this one inserts the
@@ -222,10 +243,13 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
   for (std::size_t from = 0; from < geometries.size(); from += kBatch) {
     Batch batch = next.get();
     if (from + kBatch < geometries.size()) next = std::async(std::launch::async, prepare, from + kBatch);
+    std::vector<Value> row;
     for (std::size_t k = 0; k < batch.size(); ++k) {
       const std::size_t i = from + k;
       OGRFeature feature(layer->GetLayerDefn());
-      setFields(feature, attributes.rows[i]);
+      row.clear();
+      attributes.row(i, row);
+      setFields(feature, row);
       feature.SetGeometryDirectly(batch[k].release());
       if (layer->CreateFeature(&feature) != OGRERR_NONE) {
         throw fail("cannot write feature " + std::to_string(i));
@@ -256,7 +280,7 @@ void writeNetworkLayers(const std::string& path, const std::vector<Point>& nodes
                    const auto& geometry) {
     OGRLayer* layer = ds->CreateLayer(name, &srs, type, nullptr);
     if (!layer) throw fail(std::string("cannot create layer ") + name);
-    createFields(*layer, attributes, fail);
+    createFields(*layer, attributes.columns, fail);
     if (ds->StartTransaction() != OGRERR_NONE) throw fail("cannot start transaction");
     for (std::size_t i = 0; i < count; ++i) {
       OGRFeature feature(layer->GetLayerDefn());

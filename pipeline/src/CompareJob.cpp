@@ -280,28 +280,27 @@ CompareResult compare(const CompareRequest& request, std::shared_ptr<const pipel
 
 namespace {
 
-// Appends the Yang et al. 2013 `undesirable` flag to a parcel table whose
-// parcel_id column indexes `metrics`.
-void addUndesirable(Table& table, const std::vector<ParcelMetrics>& metrics) {
-  const std::size_t id = table.column("parcel_id");
-  table.columns.push_back({"undesirable", Column::Type::Integer, ""});
-  for (auto& row : table.rows) {
-    row.emplace_back(std::int64_t(analysis::isUndesirable(metrics[std::get<std::int64_t>(row[id])])));
-  }
+// The Yang et al. 2013 `undesirable` flag after the columns of a parcel
+// table whose parcel_id column indexes `metrics`.
+RowSource withUndesirable(const RowSource& rows, const std::vector<ParcelMetrics>& metrics) {
+  std::size_t id = 0;
+  while (rows.columns[id].name != "parcel_id") ++id;
+  return rows.with({"undesirable", Column::Type::Integer, ""},
+                   [&metrics, id](std::size_t, const std::vector<Value>& row) -> Value {
+                     return std::int64_t(analysis::isUndesirable(metrics[std::get<std::int64_t>(row[id])]));
+                   });
 }
 
 // observed_parcels.csv and generated_parcels.csv (the latter also the
-// attributes of parcels.gpkg, whose geometries go to `geometries`).
-Table observedTableOf(const CompareResult& r) {
-  Table t = analysis::parcelTable(r.observed->layer.parcels, r.observed->analysis);
-  addUndesirable(t, r.observed->analysis.metrics);
-  return t;
+// attributes of parcels.gpkg, whose geometries go to `geometries`), made
+// row by row as they are written.
+RowSource observedRowsOf(const CompareResult& r) {
+  return withUndesirable(analysis::parcelRows(r.observed->layer.parcels, r.observed->analysis),
+                         r.observed->analysis.metrics);
 }
 
-Table generatedTableOf(const CompareResult& r, std::vector<std::vector<Polygon>>* geometries = nullptr) {
-  Table t = pipeline::generatedParcelTable(r.generated, geometries);
-  addUndesirable(t, r.generated.metrics);
-  return t;
+RowSource generatedRowsOf(const CompareResult& r, std::vector<std::vector<Polygon>>* geometries = nullptr) {
+  return withUndesirable(pipeline::generatedParcelRows(r.generated, geometries), r.generated.metrics);
 }
 
 Json summaryJson(const analysis::SetSummary& s) {
@@ -334,8 +333,8 @@ int blockAt(const CompareResult& r, const Point& p) {
 
 std::vector<std::pair<std::string, Table>> comparisonTables(const CompareResult& r) {
   std::vector<std::pair<std::string, Table>> tables;
-  tables.emplace_back("observed_parcels.csv", observedTableOf(r));
-  tables.emplace_back("generated_parcels.csv", generatedTableOf(r));
+  tables.emplace_back("observed_parcels.csv", observedRowsOf(r).table());
+  tables.emplace_back("generated_parcels.csv", generatedRowsOf(r).table());
   tables.emplace_back("blocks.csv", analysis::blockComparisonTable(r.blocks));
   tables.emplace_back("summary.csv", analysis::summaryTable(r.city));
   tables.emplace_back("distances.csv", analysis::distanceTable(r.city));
@@ -345,7 +344,7 @@ std::vector<std::pair<std::string, Table>> comparisonTables(const CompareResult&
 void exportParcels(const CompareResult& r, const std::string& path, const std::vector<std::string>& inputs) {
   io::StagedFile file(path, inputs);
   std::vector<std::vector<Polygon>> geometries;
-  const Table table = generatedTableOf(r, &geometries);
+  const RowSource table = generatedRowsOf(r, &geometries);
   io::writePolygonLayer(file.path(), "parcels", geometries, table, r.observed->layer.frame, r.observed->layer.crs);
   file.commit();
 }
@@ -391,7 +390,7 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
                                  spatialIndex);
   });
   std::vector<std::vector<Polygon>> geometries;
-  const Table generatedTable = generatedTableOf(r, &geometries);
+  const RowSource generatedTable = generatedRowsOf(r, &geometries);
   const std::string parcelsGpkg = out.stage(parcelsFile);
   std::future<io::LayerWrite> parcelWriting = std::async(std::launch::async, [&] {
     return io::writePolygonLayer(parcelsGpkg, "parcels", geometries, generatedTable, r.observed->layer.frame,
@@ -399,7 +398,7 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
   });
   io::writeCsv(blocksCsv, blocks);
   io::writeCsv(out.stage("generated_parcels.csv"), generatedTable);
-  io::writeCsv(out.stage("observed_parcels.csv"), observedTableOf(r));
+  io::writeCsv(out.stage("observed_parcels.csv"), observedRowsOf(r));
   const io::LayerWrite parcelsWritten = parcelWriting.get();
   const io::LayerWrite blocksWritten = blockWriting.get();
   io::writeCsv(out.stage("summary.csv"), analysis::summaryTable(r.city));

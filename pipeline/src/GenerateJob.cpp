@@ -380,27 +380,44 @@ std::vector<int> GeneratedParcels::assignedOf(const std::vector<int>& list) cons
   return out;
 }
 
-Table generatedParcelTable(const GeneratedParcels& g, std::vector<std::vector<Polygon>>* geometries) {
-  Table table;
+RowSource generatedParcelRows(const GeneratedParcels& g, std::vector<std::vector<Polygon>>* geometries) {
+  RowSource table;
   table.columns = {{"parcel_id", Column::Type::Integer, ""},
                    {"parcel_key", Column::Type::String, ""},
                    {"block_id", Column::Type::Integer, ""},
                    {"block_key", Column::Type::String, ""},
                    {"role", Column::Type::String, ""}};  // "parcel", or "unassigned" land
   for (Column& c : analysis::metricColumns()) table.columns.push_back(std::move(c));
-  std::map<Key, int> inBlock;  // parcels numbered so far per block (multipart blocks span entries)
+  // Per row: its parcel, its entry of g.blocks and its index in the block
+  // (multipart blocks span entries and number their parcels on).
+  struct Place {
+    int parcel;
+    int entry;
+    int index;
+  };
+  auto places = std::make_shared<std::vector<Place>>();
+  std::map<Key, int> inBlock;
   for (std::size_t b = 0; b < g.blocks.size(); ++b) {
-    const std::string blockKey = keyText(g.blockKeys[b]);
     int& index = inBlock[g.blockKeys[b]];
     for (int i : g.blocks[b].parcels) {
-      std::vector<Value> row = {std::int64_t(i), blockKey + "-" + std::to_string(index++), g.blockIds[b], blockKey,
-                                std::string(g.isUnassigned(static_cast<std::size_t>(i)) ? "unassigned" : "parcel")};
-      for (Value& v : analysis::metricValues(g.metrics[i])) row.push_back(std::move(v));
-      table.rows.push_back(std::move(row));
+      places->push_back({i, static_cast<int>(b), index++});
       if (geometries) geometries->push_back({g.parcels[i]});
     }
   }
+  table.rows = places->size();
+  table.row = [&g, places](std::size_t r, std::vector<Value>& row) {
+    const Place& p = (*places)[r];
+    const auto b = static_cast<std::size_t>(p.entry);
+    const std::string blockKey = keyText(g.blockKeys[b]);
+    row = {std::int64_t(p.parcel), blockKey + "-" + std::to_string(p.index), g.blockIds[b], blockKey,
+           std::string(g.isUnassigned(static_cast<std::size_t>(p.parcel)) ? "unassigned" : "parcel")};
+    for (Value& v : analysis::metricValues(g.metrics[static_cast<std::size_t>(p.parcel)])) row.push_back(std::move(v));
+  };
   return table;
+}
+
+Table generatedParcelTable(const GeneratedParcels& g, std::vector<std::vector<Polygon>>* geometries) {
+  return generatedParcelRows(g, geometries).table();
 }
 
 namespace {

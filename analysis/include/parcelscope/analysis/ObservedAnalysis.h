@@ -125,6 +125,8 @@ std::vector<Value> metricValues(const ParcelMetrics& m);
 
 /// One row per parcel: ids, block, role and every metric (the parcels.csv columns).
 Table parcelTable(const std::vector<Parcel>& parcels, const ObservedAnalysis& analysis);
+/// The same rows, made when read; `parcels` and `analysis` must outlive it.
+RowSource parcelRows(const std::vector<Parcel>& parcels, const ObservedAnalysis& analysis);
 /// One row per block: statistics and derived parameters (the blocks.csv columns).
 Table blockTable(const ObservedAnalysis& analysis);
 

@@ -17,6 +17,9 @@ namespace parcelscope::io {
 /// RFC 4180 CSV with a header row; reals with up to 10 significant digits.
 /// Throws Error(IO) on failure.
 void writeCsv(const std::string& path, const Table& table);
+/// The same, rows made in parallel batches as they are written (a few
+/// thousand rows held at a time).
+void writeCsv(const std::string& path, const RowSource& rows);
 
 /// Writes `json.dump()` followed by a newline. Throws Error(IO) on failure.
 void writeJson(const std::string& path, const Json& json);
@@ -49,6 +52,10 @@ struct LayerWrite {
 };
 LayerWrite writePolygonLayer(const std::string& path, const std::string& layerName,
                              const std::vector<std::vector<Polygon>>& geometries, const Table& attributes,
+                             const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex = true);
+/// The same with attributes made row by row as features are written.
+LayerWrite writePolygonLayer(const std::string& path, const std::string& layerName,
+                             const std::vector<std::vector<Polygon>>& geometries, const RowSource& attributes,
                              const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex = true);
 
 /// Writes a GeoPackage with a point layer `nodes` (one point per row of

@@ -216,6 +216,8 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
 /// "<block_key>-<index>") and, when
 /// `geometries` is given, each row's geometry.
 Table generatedParcelTable(const GeneratedParcels& g, std::vector<std::vector<Polygon>>* geometries = nullptr);
+/// The same rows, made when read; `g` must outlive it.
+RowSource generatedParcelRows(const GeneratedParcels& g, std::vector<std::vector<Polygon>>* geometries = nullptr);
 
 /// Runs `generate` and writes DIR/parcels.gpkg (layer `parcels`, input CRS, field
 /// block_id and the metrics), DIR/parcels.csv and DIR/run.json, all at once when
