@@ -263,12 +263,42 @@ PairMeasure measureEdges(const std::vector<NearEdge>& ea, const std::vector<Near
   return m;
 }
 
+// Every edge of a polygon with many vertices (a street network stored as a
+// parcel has tens of thousands), gathered and indexed once: each of its pairs
+// then finds the edges near the other polygon without testing them all.
+struct IndexedEdges {
+  static constexpr std::size_t kFromVertices = 256;
+  std::vector<NearEdge> all;  // ring order, as edgesNear gives them
+  EdgeIndex index;
+  IndexedEdges(const Polygon& polygon, double grow) {
+    const Box everything{-HUGE_VAL, -HUGE_VAL, HUGE_VAL, HUGE_VAL};
+    edgesNear(polygon, grow, everything, all);
+    index.build(all);
+  }
+  // edgesNear(polygon, grow, box, out): the same edges, in the same order.
+  void near(const Box& box, std::vector<NearEdge>& out) const {
+    thread_local std::vector<std::size_t> found;
+    index.meeting(all, box, found);
+    out.clear();
+    for (std::size_t j : found) out.push_back(all[j]);
+  }
+};
+
 PairMeasure measurePair(const Polygon& a, const Polygon& b, const Box& boxA, const Box& boxB, double closeTolerance,
-                        double sharedTolerance, bool closeness = true, double enough = HUGE_VAL) {
+                        double sharedTolerance, bool closeness = true, double enough = HUGE_VAL,
+                        const IndexedEdges* indexedA = nullptr, const IndexedEdges* indexedB = nullptr) {
   thread_local std::vector<NearEdge> ea, eb;
   const double grow = 0.5 * closeTolerance;
-  edgesNear(a, grow, boxB, ea);
-  edgesNear(b, grow, boxA, eb);
+  if (indexedA) {
+    indexedA->near(boxB, ea);
+  } else {
+    edgesNear(a, grow, boxB, ea);
+  }
+  if (indexedB) {
+    indexedB->near(boxA, eb);
+  } else {
+    edgesNear(b, grow, boxA, eb);
+  }
   return measureEdges(ea, eb, closeTolerance, sharedTolerance, closeness, enough);
 }
 
@@ -287,12 +317,19 @@ std::vector<Contact> contacts(const std::vector<const Polygon*>& polygons,
   if (sharedTolerance < 0 || sharedTolerance > tolerance) sharedTolerance = tolerance;
   std::vector<Box> boxes(polygons.size());
   for (std::size_t i = 0; i < polygons.size(); ++i) boxes[i] = contactBox(*polygons[i], tolerance);
+  std::vector<std::unique_ptr<IndexedEdges>> indexed(polygons.size());
+  for (std::size_t i = 0; i < polygons.size(); ++i) {
+    std::size_t vertices = polygons[i]->outer.size();
+    for (const Ring& h : polygons[i]->holes) vertices += h.size();
+    if (vertices >= IndexedEdges::kFromVertices)
+      indexed[i] = std::make_unique<IndexedEdges>(*polygons[i], 0.5 * tolerance);
+  }
   std::vector<PairMeasure> measured(candidates.size());
   auto measureRange = [&](std::size_t from, std::size_t to) {
     for (std::size_t k = from; k < to; ++k) {
       const auto [i, j] = candidates[k];
-      measured[k] =
-          measurePair(*polygons[i], *polygons[j], boxes[i], boxes[j], tolerance, sharedTolerance, true, enough);
+      measured[k] = measurePair(*polygons[i], *polygons[j], boxes[i], boxes[j], tolerance, sharedTolerance, true,
+                                enough, indexed[i].get(), indexed[j].get());
     }
   };
   // Small inputs (one block, one parcel pair) stay on the calling thread.
