@@ -293,14 +293,31 @@ TEST(ManyFiles, AFolderOrAListOfFilesIsReadAsOneLayer) {
   copyFeatures(sample, "FID >= 120", "GeoJSON", dir / "communes" / "c.geojson");
   std::ofstream(dir / "communes.txt") << "# one file per commune\ncommunes/a.geojson\n\ncommunes/b.geojson\n"
                                       << (dir / "communes" / "c.geojson").string() << "\n";
+  // An OGR VRT of the three, as a user writes one.
+  {
+    std::ofstream vrt(dir / "communes.vrt");
+    vrt << "<OGRVRTDataSource><OGRVRTUnionLayer name=\"parcels\">";
+    for (const char* name : {"a", "b", "c"}) {
+      vrt << "<OGRVRTLayer name=\"" << name << "\"><SrcDataSource relativeToVRT=\"1\">communes/" << name
+          << ".geojson</SrcDataSource><SrcLayer>" << io::layerNames((dir / "communes" / "a.geojson").string()).front()
+          << "</SrcLayer></OGRVRTLayer>";
+    }
+    vrt << "</OGRVRTUnionLayer></OGRVRTDataSource>\n";
+  }
   const ObservedData one = loadObserved(request.input, request.parameters);
-  for (const fs::path& input : {dir / "communes", dir / "communes.txt"}) {
+  for (const fs::path& input : {dir / "communes", dir / "communes.txt", dir / "communes.vrt"}) {
     SCOPED_TRACE(input.string());
     request.input.path = input.string();
-    EXPECT_EQ(io::inputFiles(request.input.path).size(), 3u);
+    const bool vrt = input.extension() == ".vrt";
+    EXPECT_EQ(io::inputFiles(request.input.path).size(), vrt ? 0u : 3u);
     // Features numbered in turn across the files: the ids, and so every table, of the single file.
     expectSameObserved(one, loadObserved(request.input, request.parameters));
-    EXPECT_THROW(analyseShard(request, 0, 2, ShardReading{}), Error);
+    if (vrt) {
+      expectSameObserved(one, mergeShards(analyseWhole(request, 2)));  // GDAL's union numbers them in turn
+      expectSameObserved(one, mergeShards(analyseFiltered(request, 3)));
+    } else {
+      EXPECT_THROW(analyseShard(request, 0, 2, ShardReading{}), Error);
+    }
   }
   // Files that cannot make one layer are named.
   copyFeatures(sample, "FID < 5", "GPKG", dir / "communes" / "d.gpkg");
