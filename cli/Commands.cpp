@@ -4,12 +4,14 @@
 #include <cstdio>
 #include <fstream>
 #include <set>
+#include <thread>
 
 #include "Args.h"
 #include "Mpi.h"
 #include "TermProgress.h"
 #include "parcelscope/analysis/Comparison.h"
 #include "parcelscope/core/Error.h"
+#include "parcelscope/core/Parallel.h"
 #include "parcelscope/pipeline/Calibrate.h"
 #include "parcelscope/pipeline/CompareJob.h"
 #include "parcelscope/pipeline/CompareSession.h"
@@ -495,6 +497,12 @@ namespace {
 int compareOnRanks(const pipeline::CompareRequest& request, const std::string& out, const Args& a) {
   const int rank = mpiRank(), size = mpiSize();
   const std::string who = "parcelscope compare (rank " + std::to_string(rank) + " of " + std::to_string(size) + ")";
+  if (rank == 0 && workerCount() < std::thread::hardware_concurrency() && !a.has("quiet")) {
+    std::fprintf(stderr,
+                 "parcelscope compare: rank 0 may use %u of this machine's %u cores, and alone generates and "
+                 "writes; 'mpirun --bind-to none' (or more cores per rank) lets it use more\n",
+                 workerCount(), std::thread::hardware_concurrency());
+  }
   std::vector<std::string> parts;
   try {
     const ProgressFn progress = rank == 0 ? terminalProgress(a.has("quiet")) : ProgressFn{};

@@ -10,12 +10,25 @@
 #include <thread>
 #include <vector>
 
+#include <sched.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
 namespace parcelscope {
 
-unsigned workerCount() { return std::max(1u, std::thread::hardware_concurrency()); }
+unsigned workerCount() {
+  // The cores this process may run on (taskset, a cgroup, Slurm's
+  // --cpus-per-task, an MPI launcher's binding), not all the machine's.
+  static const unsigned count = [] {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0) {
+      return static_cast<unsigned>(CPU_COUNT(&set));
+    }
+    return std::max(1u, std::thread::hardware_concurrency());
+  }();
+  return count;
+}
 
 namespace {
 // True on a thread running a parallelFor's body: a loop nested in it runs on

@@ -7,7 +7,8 @@
 
 namespace parcelscope {
 
-/// Number of worker threads parallelFor uses (hardware threads, at least 1).
+/// Number of worker threads parallelFor uses: the cores this process may run on
+/// (its CPU affinity: taskset, cgroups, Slurm, an MPI binding), at least 1.
 unsigned workerCount();
 
 /// Calls body(i) for every i in [0, n) on up to workerCount() threads. Between
