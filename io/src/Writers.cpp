@@ -9,6 +9,7 @@
 #include <charconv>
 #include <fstream>
 #include <future>
+#include <stdexcept>
 
 #include "OgrConvert.h"
 #include "parcelscope/core/Error.h"
@@ -187,6 +188,15 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
 LayerWrite writePolygonLayer(const std::string& path, const std::string& layerName,
                              const std::vector<std::vector<Polygon>>& geometries, const RowSource& attributes,
                              const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex) {
+  if (geometries.size() != attributes.rows) throw std::logic_error("writePolygonLayer: geometries and rows differ");
+  return writePolygonLayer(
+      path, layerName, [&](std::size_t i, std::vector<Polygon>& parts) { parts = geometries[i]; }, attributes, frame,
+      crs, spatialIndex);
+}
+
+LayerWrite writePolygonLayer(const std::string& path, const std::string& layerName, const PolygonSource& geometries,
+                             const RowSource& attributes, const LocalFrame& frame, const CrsInfo& crs,
+                             bool spatialIndex) {
   detail::ensureGdalRegistered();
   detail::QuietErrors quiet;
   CPLErrorReset();
@@ -216,14 +226,17 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
   // batch before.
   constexpr std::size_t kBatch = 4096;
   LayerWrite report;
-  report.features = static_cast<std::int64_t>(geometries.size());
+  const std::size_t count = attributes.rows;
+  report.features = static_cast<std::int64_t>(count);
   using Batch = std::vector<std::unique_ptr<OGRMultiPolygon>>;
   auto prepare = [&](std::size_t from) {
     Batch batch;
-    const std::size_t to = std::min(geometries.size(), from + kBatch);
+    const std::size_t to = std::min(count, from + kBatch);
     batch.reserve(to - from);
+    std::vector<Polygon> parts;
     for (std::size_t i = from; i < to; ++i) {
-      std::vector<Polygon> parts = geometries[i];
+      parts.clear();
+      geometries(i, parts);
       for (Polygon& p : parts) {
         for (Point& q : p.outer) q = frame.toSource(q);
         for (Ring& h : p.holes)
@@ -240,9 +253,9 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
     return batch;
   };
   std::future<Batch> next = std::async(std::launch::async, prepare, 0);
-  for (std::size_t from = 0; from < geometries.size(); from += kBatch) {
+  for (std::size_t from = 0; from < count; from += kBatch) {
     Batch batch = next.get();
-    if (from + kBatch < geometries.size()) next = std::async(std::launch::async, prepare, from + kBatch);
+    if (from + kBatch < count) next = std::async(std::launch::async, prepare, from + kBatch);
     std::vector<Value> row;
     for (std::size_t k = 0; k < batch.size(); ++k) {
       const std::size_t i = from + k;

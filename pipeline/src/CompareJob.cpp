@@ -292,15 +292,21 @@ RowSource withUndesirable(const RowSource& rows, const std::vector<ParcelMetrics
 }
 
 // observed_parcels.csv and generated_parcels.csv (the latter also the
-// attributes of parcels.gpkg, whose geometries go to `geometries`), made
-// row by row as they are written.
+// attributes of parcels.gpkg), made row by row as they are written.
 RowSource observedRowsOf(const CompareResult& r) {
   return withUndesirable(analysis::parcelRows(r.observed->layer.parcels, r.observed->analysis),
                          r.observed->analysis.metrics);
 }
 
-RowSource generatedRowsOf(const CompareResult& r, std::vector<std::vector<Polygon>>* geometries = nullptr) {
-  return withUndesirable(pipeline::generatedParcelRows(r.generated, geometries), r.generated.metrics);
+RowSource generatedRowsOf(const CompareResult& r, std::vector<int>* parcelOfRow = nullptr) {
+  return withUndesirable(pipeline::generatedParcelRows(r.generated, parcelOfRow), r.generated.metrics);
+}
+
+// The geometry of each row of generatedRowsOf, from its parcelOfRow.
+io::PolygonSource generatedShapes(const CompareResult& r, const std::vector<int>& parcelOfRow) {
+  return [&r, &parcelOfRow](std::size_t row, std::vector<Polygon>& parts) {
+    parts.push_back(r.generated.parcels[static_cast<std::size_t>(parcelOfRow[row])]);
+  };
 }
 
 Json summaryJson(const analysis::SetSummary& s) {
@@ -343,9 +349,10 @@ std::vector<std::pair<std::string, Table>> comparisonTables(const CompareResult&
 
 void exportParcels(const CompareResult& r, const std::string& path, const std::vector<std::string>& inputs) {
   io::StagedFile file(path, inputs);
-  std::vector<std::vector<Polygon>> geometries;
-  const RowSource table = generatedRowsOf(r, &geometries);
-  io::writePolygonLayer(file.path(), "parcels", geometries, table, r.observed->layer.frame, r.observed->layer.crs);
+  std::vector<int> order;
+  const RowSource table = generatedRowsOf(r, &order);
+  io::writePolygonLayer(file.path(), "parcels", generatedShapes(r, order), table, r.observed->layer.frame,
+                        r.observed->layer.crs);
   file.commit();
 }
 
@@ -389,12 +396,12 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
     return io::writePolygonLayer(blocksGpkg, "blocks", outlines, blocks, r.observed->layer.frame, r.observed->layer.crs,
                                  spatialIndex);
   });
-  std::vector<std::vector<Polygon>> geometries;
-  const RowSource generatedTable = generatedRowsOf(r, &geometries);
+  std::vector<int> order;
+  const RowSource generatedTable = generatedRowsOf(r, &order);
   const std::string parcelsGpkg = out.stage(parcelsFile);
   std::future<io::LayerWrite> parcelWriting = std::async(std::launch::async, [&] {
-    return io::writePolygonLayer(parcelsGpkg, "parcels", geometries, generatedTable, r.observed->layer.frame,
-                                 r.observed->layer.crs, spatialIndex);
+    return io::writePolygonLayer(parcelsGpkg, "parcels", generatedShapes(r, order), generatedTable,
+                                 r.observed->layer.frame, r.observed->layer.crs, spatialIndex);
   });
   io::writeCsv(blocksCsv, blocks);
   io::writeCsv(out.stage("generated_parcels.csv"), generatedTable);

@@ -380,7 +380,7 @@ std::vector<int> GeneratedParcels::assignedOf(const std::vector<int>& list) cons
   return out;
 }
 
-RowSource generatedParcelRows(const GeneratedParcels& g, std::vector<std::vector<Polygon>>* geometries) {
+RowSource generatedParcelRows(const GeneratedParcels& g, std::vector<int>* parcelOfRow) {
   RowSource table;
   table.columns = {{"parcel_id", Column::Type::Integer, ""},
                    {"parcel_key", Column::Type::String, ""},
@@ -401,7 +401,7 @@ RowSource generatedParcelRows(const GeneratedParcels& g, std::vector<std::vector
     int& index = inBlock[g.blockKeys[b]];
     for (int i : g.blocks[b].parcels) {
       places->push_back({i, static_cast<int>(b), index++});
-      if (geometries) geometries->push_back({g.parcels[i]});
+      if (parcelOfRow) parcelOfRow->push_back(i);
     }
   }
   table.rows = places->size();
@@ -417,7 +417,12 @@ RowSource generatedParcelRows(const GeneratedParcels& g, std::vector<std::vector
 }
 
 Table generatedParcelTable(const GeneratedParcels& g, std::vector<std::vector<Polygon>>* geometries) {
-  return generatedParcelRows(g, geometries).table();
+  std::vector<int> order;
+  Table table = generatedParcelRows(g, &order).table();
+  if (geometries) {
+    for (int i : order) geometries->push_back({g.parcels[static_cast<std::size_t>(i)]});
+  }
+  return table;
 }
 
 namespace {

@@ -57,6 +57,12 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
 LayerWrite writePolygonLayer(const std::string& path, const std::string& layerName,
                              const std::vector<std::vector<Polygon>>& geometries, const RowSource& attributes,
                              const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex = true);
+/// Feature i's polygons into `parts`, which comes empty; called from another thread.
+using PolygonSource = std::function<void(std::size_t i, std::vector<Polygon>& parts)>;
+/// The same with geometries too made feature by feature (attributes.rows features).
+LayerWrite writePolygonLayer(const std::string& path, const std::string& layerName, const PolygonSource& geometries,
+                             const RowSource& attributes, const LocalFrame& frame, const CrsInfo& crs,
+                             bool spatialIndex = true);
 
 /// Writes a GeoPackage with a point layer `nodes` (one point per row of
 /// `nodeAttributes`) and a line layer `edges` (one line string per row of

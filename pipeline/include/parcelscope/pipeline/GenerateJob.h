@@ -216,8 +216,9 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
 /// "<block_key>-<index>") and, when
 /// `geometries` is given, each row's geometry.
 Table generatedParcelTable(const GeneratedParcels& g, std::vector<std::vector<Polygon>>* geometries = nullptr);
-/// The same rows, made when read; `g` must outlive it.
-RowSource generatedParcelRows(const GeneratedParcels& g, std::vector<std::vector<Polygon>>* geometries = nullptr);
+/// The same rows, made when read; `g` must outlive it. `parcelOfRow` receives
+/// each row's parcel (an index of g.parcels), in row order.
+RowSource generatedParcelRows(const GeneratedParcels& g, std::vector<int>* parcelOfRow = nullptr);
 
 /// Runs `generate` and writes DIR/parcels.gpkg (layer `parcels`, input CRS, field
 /// block_id and the metrics), DIR/parcels.csv and DIR/run.json, all at once when
