@@ -478,6 +478,7 @@ int compareCommand(const std::vector<std::string>& args) {
   if (auto v = a.value("vector")) request.vectorFormat = *v;
   if (auto v = a.value("parcels-format")) request.parcelsFormat = *v;
   if (const auto shard = a.value("shard")) {
+    if (mpiSize() > 1) throw usageError("--shard runs one shard in one process; under mpirun, leave it out");
     const auto [index, count] = pipeline::parseShard(*shard);
     if (request.style == "all") throw usageError("--shard: runs one style (not --style all)");
     return reportOutcome(pipeline::runShard(request, index, count, *a.value("out"), terminalProgress(a.has("quiet"))),

@@ -31,7 +31,9 @@ constexpr std::size_t kChunk = std::size_t(1) << 30;  // bytes per message (MPI 
 
 MpiSession::MpiSession(int& argc, char**& argv) {
   if (!launched()) return;
-  MPI_Init(&argc, &argv);
+  // Worker threads run beside MPI; only the main thread calls it.
+  int provided = 0;
+  MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
   started = true;
 }
 
@@ -72,6 +74,9 @@ pipeline::ShardReading rankReading() {
     MPI_Allreduce(local, all, 4, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
     sample.extent = {all[0], all[1], -all[2], -all[3]};
     const int size = mpiSize(), rank = mpiRank();
+    if (sample.centresX.size() > static_cast<std::size_t>(std::numeric_limits<int>::max())) {
+      abortRanks("more than 2^31 features in one rank's strip: use more ranks");
+    }
     const int mine = static_cast<int>(sample.centresX.size());
     std::vector<int> counts(static_cast<std::size_t>(size)), offsets(static_cast<std::size_t>(size));
     MPI_Gather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);

@@ -43,6 +43,7 @@ struct Feature {
   std::vector<double> values;  // ReadOptions::numericFields
   Key key = 0;                 // Parcel::featureKey
   bool owned = true;           // counted in the report (its shard's, see ShardRead)
+  double minX = 0;             // its envelope's, input CRS
   bool inWindow = true;        // cleaned and returned
 };
 
@@ -146,30 +147,42 @@ Cleaned cleanFeature(const Feature& f, const LocalFrame& frame) {
 
 // Narrows the reading of a shard's layer to features whose envelope may meet
 // `window` where the format indexes envelopes: a GeoPackage's R-tree, through
-// an SQL attribute filter (its boxes are rounded outwards, so none is missed).
-// GDAL's spatial filter is not used: it tests the geometry itself against the
-// rectangle, and drops an invalid feature that crosses its edge (GEOS finds no
-// intersection). Other formats are read whole; the reader tests envelopes.
+// an SQL attribute filter (its boxes are rounded outwards, so none is missed),
+// with every feature the R-tree lacks (null or empty geometries, a stale
+// index). GDAL's spatial filter is not used: it tests the geometry itself
+// against the rectangle, and drops an invalid feature that crosses its edge
+// (GEOS finds no intersection). Other formats are read whole; the reader tests
+// envelopes.
 void restrictToWindow(GDALDataset& ds, OGRLayer& layer, const std::string& where, const Box& window) {
   if (!EQUAL(ds.GetDriverName(), "GPKG") || !*layer.GetFIDColumn() || !*layer.GetGeometryColumn()) return;
   const std::string rtree = std::string("rtree_") + layer.GetName() + "_" + layer.GetGeometryColumn();
-  auto quoted = [](const std::string& name) {
-    std::string q = "\"";
-    for (char c : name) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-    return q + "\"";
+  auto quoted = [](const std::string& text, char quote) {
+    std::string q(1, quote);
+    for (char c : text) q += c == quote ? std::string(2, c) : std::string(1, c);
+    return q + quote;
   };
   {
-    const std::string probe = "SELECT name FROM sqlite_master WHERE type = 'table' AND name = '" + rtree + "'";
+    const std::string probe = "SELECT name FROM sqlite_master WHERE type = 'table' AND name = " + quoted(rtree, '\'');
     OGRLayer* found = ds.ExecuteSQL(probe.c_str(), nullptr, nullptr);
     const bool indexed = found && found->GetFeatureCount() > 0;
     if (found) ds.ReleaseResultSet(found);
-    if (!indexed || rtree.find('\'') != std::string::npos) return;
+    if (!indexed) return;
   }
-  char box[256];
-  std::snprintf(box, sizeof box, "maxx >= %.17g AND minx <= %.17g AND maxy >= %.17g AND miny <= %.17g", window.minX,
-                window.maxX, window.minY, window.maxY);
-  const std::string filter = (where.empty() ? "" : "(" + where + ") AND ") + quoted(layer.GetFIDColumn()) +
-                             " IN (SELECT id FROM " + quoted(rtree) + " WHERE " + box + ")";
+  std::string box;
+  auto bound = [&](const char* column, const char* op, double value) {
+    if (!std::isfinite(value)) return;
+    char clause[96];
+    std::snprintf(clause, sizeof clause, "%s%s %s %.17g", box.empty() ? "" : " AND ", column, op, value);
+    box += clause;
+  };
+  bound("maxx", ">=", window.minX);
+  bound("minx", "<=", window.maxX);
+  bound("maxy", ">=", window.minY);
+  bound("miny", "<=", window.maxY);
+  if (box.empty()) return;  // the whole layer
+  const std::string fid = quoted(layer.GetFIDColumn(), '"'), table = quoted(rtree, '"');
+  const std::string filter = (where.empty() ? "" : "(" + where + ") AND ") + "(" + fid + " IN (SELECT id FROM " +
+                             table + " WHERE " + box + ") OR " + fid + " NOT IN (SELECT id FROM " + table + "))";
   CPLErrorReset();
   if (layer.SetAttributeFilter(filter.c_str()) != OGRERR_NONE) {
     throw inputError(ds.GetDescription() + std::string(": the R-tree of layer ") + layer.GetName() +
@@ -365,7 +378,7 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
     const bool inWindow = !shard || (e.MinX <= shard->window.maxX && e.MaxX >= shard->window.minX &&
                                      e.MinY <= shard->window.maxY && e.MaxY >= shard->window.minY);
     byHash.emplace(hash, features.size());
-    features.push_back({raw.fid, std::move(raw.geometry), 1, std::move(raw.values), key, owned, inWindow});
+    features.push_back({raw.fid, std::move(raw.geometry), 1, std::move(raw.values), key, owned, e.MinX, inWindow});
   };
   auto rawOf = [&](OGRFeature& feature) {
     RawFeature raw;
@@ -381,34 +394,32 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
   };
   CPLErrorReset();
   layer->ResetReading();
-  // A spatial filter may return features in any order (an R-tree's): they are
-  // taken in the order of their ids, as a whole read takes them.
-  std::vector<RawFeature> window;
+  // Features are taken in the order of their ids (stable: read order where
+  // ids repeat): a spatial filter returns them in any order (an R-tree's), and
+  // so may a filtered SQL read or a GeoJSON file's own ids; a shard then takes
+  // them as a whole read does.
+  std::vector<RawFeature> read;
   for (auto& feature : *layer) {
     throwIfReadFailed();
     ++featuresRead;
     if (featuresRead % 2000 == 0 && total > 0) {
       reportProgress(progress, 0.6 * static_cast<double>(featuresRead) / static_cast<double>(total), "reading");
     }
-    if (filtered) {
-      window.push_back(rawOf(*feature));
-    } else {
-      take(rawOf(*feature));
-    }
+    read.push_back(rawOf(*feature));
   }
   throwIfReadFailed();
-  if (filtered) {
-    std::stable_sort(window.begin(), window.end(),
-                     [](const RawFeature& a, const RawFeature& b) { return a.fid < b.fid; });
-    for (std::size_t i = 1; i < window.size(); ++i) {
-      if (window[i].fid == window[i - 1].fid) {
-        throw inputError(path + ": layer " + result.layerName + " gives two features the id " +
-                         std::to_string(window[i].fid) + ", so it cannot be read in shards");
-      }
-    }
-    for (RawFeature& raw : window) take(std::move(raw));
-    window.clear();
+  if (!std::is_sorted(read.begin(), read.end(),
+                      [](const RawFeature& a, const RawFeature& b) { return a.fid < b.fid; })) {
+    std::stable_sort(read.begin(), read.end(), [](const RawFeature& a, const RawFeature& b) { return a.fid < b.fid; });
   }
+  for (std::size_t i = 1; shard && i < read.size(); ++i) {
+    if (read[i].fid == read[i - 1].fid) {
+      throw inputError(path + ": layer " + result.layerName + " gives two features the id " +
+                       std::to_string(read[i].fid) + ", so it cannot be read in shards");
+    }
+  }
+  for (RawFeature& raw : read) take(std::move(raw));
+  read = std::vector<RawFeature>();
   const std::string featuresText =
       std::to_string(report.features) + " features read" + (options.where.empty() ? "" : " with --where");
   if (!shard && features.empty() && report.nonFiniteSkipped > 0) {
@@ -489,6 +500,7 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
       }
       report.parcels += static_cast<std::int64_t>(c.parcels.size());
     }
+    if (shard) result.sourceMinX.insert(result.sourceMinX.end(), c.parcels.size(), features[k].minX);
     for (Parcel& p : c.parcels) {
       p.featureKey = features[k].key;
       if (!p.shape.holes.empty() && features[k].owned) ++report.withHoles;

@@ -112,13 +112,19 @@ std::vector<std::string> inputFiles(const std::string& path) {
     std::string name = fs::path(path).filename().string();
     if (name.empty()) name = fs::path(path).parent_path().filename().string();
     if (name.size() > 4 && name.substr(name.size() - 4) == ".gdb") return {};  // a File Geodatabase is one dataset
-    for (const auto& entry : fs::directory_iterator(path, ec)) {
-      if (entry.is_regular_file(ec) && isVectorFile(entry.path())) files.push_back(entry.path().string());
+    fs::directory_iterator entries(path, ec), end;
+    for (; !ec && entries != end; entries.increment(ec)) {
+      std::error_code typeError;
+      if (entries->is_regular_file(typeError) && isVectorFile(entries->path())) {
+        files.push_back(entries->path().string());
+      }
     }
+    if (ec) throw inputError(path + ": the folder cannot be listed (" + ec.message() + ")");
     std::sort(files.begin(), files.end());
     return files;
   }
-  const std::string ext = fs::path(path).extension().string();
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   if (!fs::is_regular_file(path, ec) || (ext != ".txt" && ext != ".lst")) return {};
   std::ifstream list(path);
   std::string line;

@@ -20,7 +20,7 @@ namespace parcelscope::pipeline {
 
 namespace {
 
-constexpr double kFar = 1e12;  // the reader skips coordinates beyond it: a window this wide holds everything
+constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr int kMaxReads = 64;
 
 // The strip boundaries: strip k is [cut(k), cut(k + 1)).
@@ -58,16 +58,15 @@ Box unite(const Box& a, const Box& b) {
   return {std::min(a.minX, b.minX), std::min(a.minY, b.minY), std::max(a.maxX, b.maxX), std::max(a.maxY, b.maxY)};
 }
 
-// The lowest vertex (smallest x, then y) of the parcels' outer rings, and their box.
+// The parcels' box (local metres) and their anchor: the smallest x of their
+// features' envelopes in the input CRS, the same number in every shard.
 struct Extent {
-  Point lowest{std::numeric_limits<double>::max(), std::numeric_limits<double>::max()};
+  double anchor = std::numeric_limits<double>::infinity();
   Box box{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(), std::numeric_limits<double>::lowest(),
           std::numeric_limits<double>::lowest()};
-  void add(const Polygon& shape) {
-    for (const Point& p : shape.outer) {
-      if (p.x < lowest.x || (p.x == lowest.x && p.y < lowest.y)) lowest = p;
-      box = unite(box, {p.x, p.y, p.x, p.y});
-    }
+  void add(const Polygon& shape, double sourceMinX) {
+    anchor = std::min(anchor, sourceMinX);
+    for (const Point& p : shape.outer) box = unite(box, {p.x, p.y, p.x, p.y});
   }
 };
 
@@ -132,6 +131,11 @@ public:
     std::memcpy(v.data(), bytes_.data() + at_, n * sizeof(T));
     at_ += n * sizeof(T);
     return v;
+  }
+  bool flag() {
+    const auto v = pod<std::uint8_t>();
+    if (v > 1) fail();
+    return v == 1;
   }
   std::string text() {
     const auto n = count(1);
@@ -233,12 +237,12 @@ ShardPart analyseShard(const CompareRequest& request, int index, int count, cons
   shard.tileMaxX = strips.cut(index + 1);
   shard.spatialFilter = reading.spatialFilter;
   shard.exchange = reading.exchange;
-  Box window{index == 0 ? -kFar : shard.tileMinX - halo, -kFar, index == count - 1 ? kFar : shard.tileMaxX + halo,
-             kFar};
+  Box window{index == 0 ? -kInf : shard.tileMinX - halo, -kInf, index == count - 1 ? kInf : shard.tileMaxX + halo,
+             kInf};
   ShardPart part;
   part.index = index;
   part.count = count;
-  if (reading.spatialFilter && index == 0) part.layerFeatures = io::featureCount(request.input);
+  if (index == 0) part.layerFeatures = io::featureCount(request.input);
   for (int read = 1;; ++read) {
     shard.window = window;
     input.shard = shard;
@@ -254,30 +258,28 @@ ShardPart analyseShard(const CompareRequest& request, int index, int count, cons
     // the window grows for those of this shard cut by its edge.
     std::vector<char> keepBlock(a.blocks.size(), 0), keepParcel(layer.parcels.size(), 0);
     bool cut = false;
-    Box grow{kFar, kFar, -kFar, -kFar};
-    const double slack = 1e-6 * std::max(strips.extent.width() / count, 1e-9);
+    Box grow{kInf, kInf, -kInf, -kInf};
     auto judge = [&](const Extent& e) {
       const Box box = sourceBox(layer.frame, e.box.expanded(margin));
-      const double anchor = layer.frame.toSource(e.lowest).x;
-      if (inside(box, window)) return strips.holds(index, anchor);
-      // Cut. Its lowest vertex lies at or left of the one seen: left of this
-      // strip, a shard on the left owns it. Not cut on the left (windows span
-      // every y), the vertex seen is its lowest: it tells the owner.
-      if (anchor < shard.tileMinX - slack) return false;
-      if (box.minX >= window.minX && !strips.holds(index, anchor)) return false;
+      if (inside(box, window)) return strips.holds(index, e.anchor);
+      // Cut. Its true anchor is at most the one seen: left of this strip, a
+      // shard on the left owns it. Not cut on the left (windows span every y),
+      // the anchor seen is the true one: it names the owner.
+      if (e.anchor < shard.tileMinX) return false;
+      if (box.minX >= window.minX && !strips.holds(index, e.anchor)) return false;
       cut = true;
       grow = unite(grow, box);
       return false;
     };
     for (std::size_t b = 0; b < a.blocks.size(); ++b) {
       Extent e;
-      for (int i : a.blocks[b].parcels) e.add(layer.parcels[i].shape);
+      for (int i : a.blocks[b].parcels) e.add(layer.parcels[i].shape, layer.sourceMinX[i]);
       keepBlock[b] = judge(e);
     }
     for (std::size_t i = 0; i < layer.parcels.size(); ++i) {
       if (a.blockOf[i] >= 0) continue;
       Extent e;
-      e.add(layer.parcels[i].shape);
+      e.add(layer.parcels[i].shape, layer.sourceMinX[i]);
       keepParcel[i] = judge(e);
     }
     if (cut) {
@@ -340,11 +342,13 @@ ObservedData mergeShards(std::vector<ShardPart> parts) {
   }
   if (static_cast<int>(parts.size()) != count) {
     std::string missing;
-    for (int i = 0, k = 0; i < count; ++i) {
+    for (int i = 0, k = 0, listed = 0; i < count; ++i) {
       if (k < static_cast<int>(parts.size()) && parts[k].index == i) {
         ++k;
-      } else {
+      } else if (++listed <= 20) {
         missing += (missing.empty() ? "" : ", ") + std::to_string(i);
+      } else if (listed == 21) {
+        missing += ", ...";
       }
     }
     throw inputError("merge: " + std::to_string(parts.size()) + " of " + std::to_string(count) +
@@ -383,18 +387,26 @@ ObservedData mergeShards(std::vector<ShardPart> parts) {
   layer.frame = io::LocalFrame::fromState(parts.front().frame);
   layer.crs = parts.front().crs;
   for (const ShardPart& p : parts) addReport(layer.report, p.report);
-  // Features no spatial filter returns have no geometry (or no usable envelope).
-  if (const std::int64_t all = parts.front().layerFeatures; all > layer.report.features) {
-    layer.report.nullOrEmpty += all - layer.report.features;
-    layer.report.features = all;
+  // Every feature of the layer is some shard's, once.
+  if (const std::int64_t all = parts.front().layerFeatures; all >= 0 && all != layer.report.features) {
+    throw inputError("merge: the shards counted " + std::to_string(layer.report.features) + " features of the " +
+                     std::to_string(all) + " of " + layer.path + " (was the file changed between the shards?)");
   }
   if (layer.report.parcels != static_cast<std::int64_t>(refs.size())) {
     throw inputError("merge: the shards read " + std::to_string(layer.report.parcels) + " parcels but hold " +
                      std::to_string(refs.size()) + " in their blocks and right-of-way");
   }
+  if (refs.size() >= static_cast<std::size_t>(std::numeric_limits<int>::max())) {
+    throw inputError("merge: more than 2^31 parcels in one run");
+  }
   std::vector<std::vector<int>> global(parts.size());
   for (std::size_t s = 0; s < parts.size(); ++s) global[s].resize(parts[s].parcels.size());
   const bool fields = std::any_of(parts.begin(), parts.end(), [](const ShardPart& p) { return !p.fields.empty(); });
+  for (const ShardPart& p : parts) {
+    if (fields && p.fields.size() != p.parcels.size()) {
+      throw inputError("merge: shard " + std::to_string(p.index) + " carries no field values where others do");
+    }
+  }
   layer.parcels.reserve(refs.size());
   a.metrics.reserve(refs.size());
   a.rightOfWay.reserve(refs.size());
@@ -467,8 +479,8 @@ std::string encodeShard(const ShardPart& p) {
   w.pods(p.frame);
   w.text(p.crs.wkt);
   w.text(p.crs.name);
-  w.pod(p.crs.assumedLonLat);
-  w.pod(p.crs.overridden);
+  w.pod(static_cast<std::uint8_t>(p.crs.assumedLonLat));
+  w.pod(static_cast<std::uint8_t>(p.crs.overridden));
   w.pod(p.report);
   w.pod(static_cast<std::uint64_t>(p.parcels.size()));
   for (const Parcel& parcel : p.parcels) {
@@ -476,7 +488,7 @@ std::string encodeShard(const ShardPart& p) {
     w.pod(parcel.sourceFid);
     w.pod(parcel.part);
     w.pod(parcel.stackCount);
-    w.pod(parcel.repaired);
+    w.pod(static_cast<std::uint8_t>(parcel.repaired));
     w.pod(parcel.featureKey);
   }
   w.pod(static_cast<std::uint64_t>(p.fields.size()));
@@ -511,23 +523,24 @@ ShardPart decodeShard(std::string_view bytes, const std::string& what) {
   p.frame = r.pods<double>();
   p.crs.wkt = r.text();
   p.crs.name = r.text();
-  p.crs.assumedLonLat = r.pod<bool>();
-  p.crs.overridden = r.pod<bool>();
+  p.crs.assumedLonLat = r.flag();
+  p.crs.overridden = r.flag();
   p.report = r.pod<io::CleaningReport>();
-  p.parcels.resize(r.count(1));
+  constexpr std::size_t kMinParcelBytes = 3 * sizeof(std::uint64_t) + sizeof(std::int64_t) + 2 * sizeof(int) + 1;
+  p.parcels.resize(r.count(kMinParcelBytes));
   for (Parcel& parcel : p.parcels) {
     parcel.shape = r.polygon();
     parcel.sourceFid = r.pod<std::int64_t>();
     parcel.part = r.pod<int>();
     parcel.stackCount = r.pod<int>();
-    parcel.repaired = r.pod<bool>();
+    parcel.repaired = r.flag();
     parcel.featureKey = r.pod<Key>();
   }
   p.fields.resize(r.count(sizeof(std::uint64_t)));
   for (auto& f : p.fields) f = r.pods<double>();
   p.metrics = r.pods<analysis::ParcelMetrics>();
   p.rightOfWay = r.pods<analysis::RightOfWay>();
-  p.blocks.resize(r.count(1));
+  p.blocks.resize(r.count(3 * sizeof(std::uint64_t)));
   for (Block& b : p.blocks) {
     b.parts.resize(r.count(sizeof(std::uint64_t)));
     for (Polygon& part : b.parts) part = r.polygon();
@@ -541,14 +554,29 @@ ShardPart decodeShard(std::string_view bytes, const std::string& what) {
   p.reads = r.pod<int>();
   p.parcelsRead = r.pod<std::int64_t>();
   p.seconds = r.pod<double>();
-  if (!r.done() || p.count < 1 || p.index < 0 || p.index >= p.count || p.metrics.size() != p.parcels.size() ||
-      p.rightOfWay.size() != p.parcels.size() || p.statistics.size() != p.blocks.size() ||
-      (!p.fields.empty() && p.fields.size() != p.parcels.size())) {
+  constexpr int kMaxShards = 1 << 20;
+  if (!r.done() || p.count < 1 || p.count > kMaxShards || p.index < 0 || p.index >= p.count ||
+      p.metrics.size() != p.parcels.size() || p.rightOfWay.size() != p.parcels.size() ||
+      p.statistics.size() != p.blocks.size() || (!p.fields.empty() && p.fields.size() != p.parcels.size()) ||
+      (p.frame.size() != 4 && p.frame.size() != 6)) {
     r.fail();
   }
+  for (const auto& f : p.fields) {
+    if (f.size() != p.fields.front().size()) r.fail();
+  }
+  // Each lot in exactly one block, each right-of-way parcel in none.
+  std::vector<char> inBlock(p.parcels.size(), 0);
   for (const Block& b : p.blocks) {
+    if (b.parcels.empty()) r.fail();
     for (int i : b.parcels) {
-      if (i < 0 || static_cast<std::size_t>(i) >= p.parcels.size()) r.fail();
+      if (i < 0 || static_cast<std::size_t>(i) >= p.parcels.size() || inBlock[static_cast<std::size_t>(i)]) r.fail();
+      inBlock[static_cast<std::size_t>(i)] = 1;
+    }
+  }
+  for (std::size_t i = 0; i < p.parcels.size(); ++i) {
+    const auto role = static_cast<std::uint8_t>(p.rightOfWay[i]);
+    if (role > static_cast<std::uint8_t>(analysis::RightOfWay::NetworkShape) || (role == 0) != (inBlock[i] == 1)) {
+      r.fail();
     }
   }
   return p;

@@ -189,8 +189,11 @@ std::string writeLongBlockLayer(const fs::path& dir) {
   out << "{\"type\":\"FeatureCollection\",\"crs\":{\"type\":\"name\",\"properties\":{\"name\":"
          "\"urn:ogc:def:crs:EPSG::32631\"}},\"features\":[";
   bool first = true;
+  // Ids counting down: the features' ids are not in the file's order.
+  int id = 1000;
   auto lot = [&](double x, double y, double w, double h) {
-    out << (first ? "" : ",") << "{\"type\":\"Feature\",\"properties\":{},\"geometry\":{\"type\":\"Polygon\","
+    out << (first ? "" : ",") << "{\"type\":\"Feature\",\"id\":" << id--
+        << ",\"properties\":{},\"geometry\":{\"type\":\"Polygon\","
         << "\"coordinates\":[[[" << x << "," << y << "],[" << x + w << "," << y << "],[" << x + w << "," << y + h
         << "],[" << x << "," << y + h << "],[" << x << "," << y << "]]]}}";
     first = false;
@@ -210,6 +213,9 @@ std::string writeLongBlockLayer(const fs::path& dir) {
   out << ",{\"type\":\"Feature\",\"properties\":{},\"geometry\":{\"type\":\"MultiPolygon\",\"coordinates\":[[[[" << x0
       << "," << y0 - 200 << "],[" << x0 + 700 << "," << y0 - 150 << "],[" << x0 + 700 << "," << y0 - 200 << "],[" << x0
       << "," << y0 - 150 << "],[" << x0 << "," << y0 - 200 << "]]]]}}";
+  // A feature without geometry, and one far beyond any city (skipped as absurd).
+  out << ",{\"type\":\"Feature\",\"id\":" << id-- << ",\"properties\":{},\"geometry\":null}";
+  lot(x0 + 300, 5e12, 20, 20);
   out << "]}";
   return file.string();
 }
@@ -228,6 +234,8 @@ TEST(Shards, ABlockCrossingEveryStripIsReadWholeByOneShard) {
     const ObservedData one = loadObserved(request.input, request.parameters);
     ASSERT_EQ(one.analysis.blocks.size(), 26u);
     ASSERT_EQ(one.layer.report.invalidRepaired, 1);
+    ASSERT_EQ(one.layer.report.nullOrEmpty, 1);
+    ASSERT_EQ(one.layer.report.nonFiniteSkipped, 1);
     for (int count : {2, 3, 4}) {
       SCOPED_TRACE("shards: " + std::to_string(count));
       std::vector<ShardPart> parts = analyseFiltered(request, count);
@@ -249,6 +257,12 @@ TEST(Shards, APartSurvivesEncodingAndBrokenBytesAreNamed) {
   EXPECT_EQ(encodeShard(back), bytes);
   parts[1] = back;
   expectSameObserved(loadObserved(request.input, request.parameters), mergeShards(std::move(parts)));
+  // A part that breaks its own rules (a lot in no block) is refused, not merged.
+  ShardPart broken = back;
+  ASSERT_FALSE(broken.blocks.empty());
+  broken.blocks.pop_back();
+  broken.statistics.pop_back();
+  EXPECT_THROW(decodeShard(encodeShard(broken), "broken.bin"), Error);
   try {
     decodeShard(bytes.substr(0, bytes.size() / 2), "half.bin");
     FAIL() << "a truncated part was decoded";

@@ -100,6 +100,9 @@ struct ParcelLayer {
   Timings timings;  ///< "read" and "clean"
   /// Per parcel, the values of ReadOptions::numericFields in that order.
   std::vector<std::vector<double>> fields;
+  /// A shard's read only: per parcel, its feature's envelope's smallest x in
+  /// the input CRS (what places a block in a strip, exactly, in every shard).
+  std::vector<double> sourceMinX;
 };
 
 /// The names of the vector layers of `path`, in order. Throws Error(Input) as

@@ -5,7 +5,7 @@
 // The layer's extent is cut into `count` vertical strips. Shard i reads the
 // features whose envelope meets its strip widened by a halo, and analyses them
 // as one process would. A block (or a right-of-way parcel) is shard i's when
-// its lowest vertex (smallest x, then y) lies in strip i; it is kept only once
+// the smallest x of its features' envelopes lies in strip i; it is kept only once
 // it is whole: its box, grown by the contact distances, lies inside the window
 // read, so every parcel that touches it, and so its grouping, right-of-way
 // test, outline and metrics, are the single process's. A block of the strip
@@ -39,9 +39,8 @@ struct ShardPart {
   std::vector<Block> blocks;  ///< `parcels` index this part's parcels
   std::vector<analysis::BlockStatistics> statistics;
   std::vector<std::pair<std::string, double>> readTimings, analysisTimings;
-  /// Shard 0 read through its window: the layer's features as GDAL counts
-  /// them, so that those no window returns (null or empty geometries, absent
-  /// from a GeoPackage's R-tree) are counted too. -1 otherwise.
+  /// Shard 0: the layer's features as GDAL counts them (the merge checks that
+  /// the shards counted each once). -1 in the other shards.
   std::int64_t layerFeatures = -1;
   int reads = 0;                 ///< windows read (1 when no block crossed the first one's edge)
   std::int64_t parcelsRead = 0;  ///< parcels cleaned over the reads
