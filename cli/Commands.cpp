@@ -507,8 +507,13 @@ int compareOnRanks(const pipeline::CompareRequest& request, const std::string& o
   std::vector<std::string> parts;
   try {
     const ProgressFn progress = rank == 0 ? terminalProgress(a.has("quiet")) : ProgressFn{};
-    parts = gatherParts(pipeline::encodeShard(
-        pipeline::analyseShard(request, rank, size, rankReading(), scaledProgress(progress, 0.0, 0.5))));
+    std::string mine;
+    {  // the part itself is gone before the parts travel
+      const pipeline::ShardPart part =
+          pipeline::analyseShard(request, rank, size, rankReading(), scaledProgress(progress, 0.0, 0.5));
+      mine = pipeline::encodeShard(part);
+    }
+    parts = gatherParts(std::move(mine));
   } catch (const std::exception& e) {
     abortRanks(who + ": " + e.what() + "; every rank stopped, nothing was written");
   }

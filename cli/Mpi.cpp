@@ -116,7 +116,7 @@ pipeline::ShardReading rankReading() {
   return reading;
 }
 
-std::vector<std::string> gatherParts(const std::string& mine) {
+std::vector<std::string> gatherParts(std::string mine) {
   const int size = mpiSize(), rank = mpiRank();
   auto transfer = [](char* data, std::size_t n, int peer, bool send) {
     for (std::size_t at = 0; at < n; at += kChunk) {
@@ -135,7 +135,7 @@ std::vector<std::string> gatherParts(const std::string& mine) {
     transfer(const_cast<char*>(mine.data()), mine.size(), 0, true);
     return parts;
   }
-  parts.push_back(mine);
+  parts.push_back(std::move(mine));
   for (int r = 1; r < size; ++r) {
     unsigned long long n = 0;
     MPI_Recv(&n, 1, MPI_UNSIGNED_LONG_LONG, r, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
@@ -160,7 +160,7 @@ MpiSession::~MpiSession() = default;
 int mpiRank() { return 0; }
 int mpiSize() { return 1; }
 pipeline::ShardReading rankReading() { return {}; }
-std::vector<std::string> gatherParts(const std::string& mine) { return {mine}; }
+std::vector<std::string> gatherParts(std::string mine) { return {std::move(mine)}; }
 void abortRanks(const std::string& message) {
   std::fprintf(stderr, "%s\n", message.c_str());
   std::exit(1);

@@ -28,7 +28,7 @@ int mpiSize();
 pipeline::ShardReading rankReading();
 
 /// Every rank's encoded part, on rank 0 (empty elsewhere), in rank order.
-std::vector<std::string> gatherParts(const std::string& mine);
+std::vector<std::string> gatherParts(std::string mine);
 
 /// Stops every rank at once after printing `message` (a rank's failure).
 [[noreturn]] void abortRanks(const std::string& message);
