@@ -624,6 +624,9 @@ JobOutcome runShard(const CompareRequest& request, int index, int count, const s
                             .set("shard", index)
                             .set("shards", count)
                             .set("input_as_given", request.input.path)
+                            .set("metric", request.metric)
+                            .set("vector_format", request.vectorFormat)
+                            .set("parcels_format", request.parcelsFormat)
                             .set("blocks", static_cast<std::int64_t>(part.blocks.size()))
                             .set("parcels", static_cast<std::int64_t>(part.parcels.size()))
                             .set("parcels_read", part.parcelsRead)
@@ -670,6 +673,12 @@ std::pair<CompareRequest, PreparedObserved> readShards(const std::vector<std::st
   if (const Json* given = record.find("input_as_given"); given && given->isString()) {
     std::error_code ec;
     if (fs::equivalent(given->string(), request.input.path, ec) && !ec) request.input.path = given->string();
+  }
+  // What the session file does not hold: the outputs' forms.
+  for (auto [key, field] : {std::pair<const char*, std::string*>{"metric", &request.metric},
+                            {"vector_format", &request.vectorFormat},
+                            {"parcels_format", &request.parcelsFormat}}) {
+    if (const Json* v = record.find(key); v && v->isString()) *field = v->string();
   }
   const int ranks = parts.front().count;
   return {std::move(request), prepareMerged(std::move(parts), ranks)};

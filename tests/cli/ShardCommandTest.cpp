@@ -56,7 +56,22 @@ const std::string kOptions = " --style obb --seed 3 --figures 0 --quiet";
 TEST(ShardCommand, ThreeShardsMergedWriteWhatOneProcessWrites) {
   const fs::path dir = scratch("merge");
   ASSERT_EQ(0, runCli("compare '" + kSample + "'" + kOptions + " --out '" + (dir / "one").string() + "'").code);
-  std::string shards;
+  // The outputs' forms travel with the shards.
+  const std::string forms = " --parcels-format geojson --metric area";
+  ASSERT_EQ(
+      0, runCli("compare '" + kSample + "'" + kOptions + forms + " --out '" + (dir / "one-forms").string() + "'").code);
+  std::string shards, shardsWithForms;
+  for (int i = 0; i < 2; ++i) {
+    const fs::path out = dir / ("forms" + std::to_string(i));
+    ASSERT_EQ(0, runCli("compare '" + kSample + "'" + kOptions + forms + " --shard " + std::to_string(i) +
+                        "/2 --out '" + out.string() + "'")
+                     .code);
+    shardsWithForms += " '" + out.string() + "'";
+  }
+  ASSERT_EQ(0, runCli("merge" + shardsWithForms + " --quiet --out '" + (dir / "merged-forms").string() + "'").code);
+  EXPECT_TRUE(fs::exists(dir / "merged-forms" / "parcels.geojson"));
+  EXPECT_EQ(slurp((dir / "one-forms" / "parcels.geojson").string()),
+            slurp((dir / "merged-forms" / "parcels.geojson").string()));
   for (int i = 0; i < 3; ++i) {
     const fs::path out = dir / ("shard" + std::to_string(i));
     const CliRun r = runCli("compare '" + kSample + "'" + kOptions + " --shard " + std::to_string(i) + "/3 --out '" +
