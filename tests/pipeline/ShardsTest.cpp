@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <stdexcept>
 #include <thread>
 
 #include "SampleRequest.h"
@@ -94,12 +95,20 @@ public:
     all_.centresX.insert(all_.centresX.end(), sample.centresX.begin(), sample.centresX.end());
     all_.centresY.insert(all_.centresY.end(), sample.centresY.begin(), sample.centresY.end());
     if (++arrived_ == count_) done_.notify_all();
-    done_.wait(lock, [&] { return arrived_ == count_; });
+    done_.wait(lock, [&] { return arrived_ == count_ || failed_; });
+    if (arrived_ != count_) throw std::runtime_error("another shard failed before the exchange");
     sample = all_;
+  }
+  // A shard that failed: the others stop waiting for it.
+  void fail() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    failed_ = true;
+    done_.notify_all();
   }
 
 private:
   int count_, arrived_ = 0;
+  bool failed_ = false;
   std::mutex mutex_;
   std::condition_variable done_;
   io::FrameSample all_;
@@ -119,6 +128,7 @@ std::vector<ShardPart> analyseFiltered(const CompareRequest& request, int count)
         parts[i] = analyseShard(request, i, count, reading);
       } catch (const std::exception& e) {
         errors[i] = e.what();
+        exchange.fail();
       }
     });
   }
