@@ -165,6 +165,11 @@ std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, 
     auto dissolved = dissolveCoverage(polygons, {snap});
     if (!dissolved || dissolved->empty()) continue;
     const bool single = dissolved->size() == 1;
+    // One ring that is clearly simple (a conservative test) is a valid outline
+    // with nothing to close: GEOS need not be asked.
+    if (single && dissolved->front().holes.empty() && isClearlySimple(dissolved->front().outer)) {
+      return std::move(*dissolved);
+    }
     std::vector<const Polygon*> parts;
     for (const Polygon& p : *dissolved) parts.push_back(&p);
     Geom outline = single ? toGeos(dissolved->front()) : toGeos(parts);
