@@ -191,6 +191,10 @@ int dispatch(const std::vector<std::string>& args) {
     std::printf("parcelscope %s\n", pipeline::version().c_str());
     return 0;
   }
+  // Under mpirun every rank runs the command line: only compare splits its work.
+  if (mpiSize() > 1 && args[0] != "compare") {
+    throw usageError("'" + args[0] + "' runs in one process; under mpirun only 'compare' runs in ranks");
+  }
   if (args[0] == "metrics") return metricsCommand(rest);
   if (args[0] == "stats") return statsCommand(rest);
   if (args[0] == "blocks") return blocksCommand(rest);
