@@ -477,8 +477,21 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
     features = std::move(kept);
   }
   std::vector<Cleaned> cleaned(features.size());
+  // Largest geometries first, so that one street network stored as a parcel
+  // (tens of thousands of vertices to repair) does not finish last alone.
+  std::vector<std::size_t> bySize(features.size());
+  std::vector<std::size_t> sizes(features.size());
+  for (std::size_t k = 0; k < features.size(); ++k) {
+    bySize[k] = k;
+    sizes[k] = features[k].geometry->WkbSize();
+  }
+  std::stable_sort(bySize.begin(), bySize.end(), [&](std::size_t x, std::size_t y) { return sizes[x] > sizes[y]; });
   parallelFor(
-      features.size(), [&](std::size_t k) { cleaned[k] = cleanFeature(features[k], result.frame); },
+      features.size(),
+      [&](std::size_t i) {
+        const std::size_t k = bySize[i];
+        cleaned[k] = cleanFeature(features[k], result.frame);
+      },
       [&](std::size_t done) {
         reportProgress(progress, 0.6 + 0.4 * static_cast<double>(done) / static_cast<double>(features.size()),
                        "cleaning");
