@@ -190,6 +190,23 @@ void restrictToWindow(GDALDataset& ds, OGRLayer& layer, const std::string& where
   }
 }
 
+// The layer `name` of `ds` (empty: the first). Throws Error(Input) naming `path`.
+OGRLayer& namedLayer(GDALDataset& ds, const std::string& path, const std::string& name) {
+  OGRLayer* layer = name.empty() ? ds.GetLayer(0) : ds.GetLayerByName(name.c_str());
+  if (!layer) throw inputError(path + ": no layer named '" + name + "'");
+  return *layer;
+}
+
+// Sets `options.where` (if any) on `layer`. Throws Error(Input) naming the file and the filter.
+void applyWhere(OGRLayer& layer, const ReadOptions& options) {
+  if (options.where.empty()) return;
+  CPLErrorReset();
+  if (layer.SetAttributeFilter(options.where.c_str()) != OGRERR_NONE) {
+    throw inputError(options.path + ": --where \"" + options.where + "\" is not a valid filter on layer " +
+                     layer.GetName() + " (" + lastGdalMessage() + ")");
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> layerNames(const std::string& path) {
@@ -201,10 +218,8 @@ std::vector<std::string> layerNames(const std::string& path) {
 
 std::vector<FieldInfo> layerFields(const std::string& path, const std::string& layerName) {
   const GDALDatasetUniquePtr ds = openVector(path, layerName);
-  OGRLayer* layer = layerName.empty() ? ds->GetLayer(0) : ds->GetLayerByName(layerName.c_str());
-  if (!layer) throw inputError(path + ": no layer named '" + layerName + "'");
   std::vector<FieldInfo> fields;
-  OGRFeatureDefn* defn = layer->GetLayerDefn();
+  OGRFeatureDefn* defn = namedLayer(*ds, path, layerName).GetLayerDefn();
   for (int i = 0; i < defn->GetFieldCount(); ++i) {
     const OGRFieldType type = defn->GetFieldDefn(i)->GetType();
     fields.push_back(
@@ -217,8 +232,7 @@ std::vector<std::string> inputFiles(const std::string& path) { return detail::in
 
 Box layerExtent(const ReadOptions& options) {
   const GDALDatasetUniquePtr ds = openVector(options.path, options.layer);
-  OGRLayer* layer = options.layer.empty() ? ds->GetLayer(0) : ds->GetLayerByName(options.layer.c_str());
-  if (!layer) throw inputError(options.path + ": no layer named '" + options.layer + "'");
+  OGRLayer* layer = &namedLayer(*ds, options.path, options.layer);
   OGREnvelope e;
   QuietErrors quiet;
   if (layer->GetExtent(&e, TRUE) != OGRERR_NONE || !std::isfinite(e.MinX) || !std::isfinite(e.MaxX) ||
@@ -230,14 +244,10 @@ Box layerExtent(const ReadOptions& options) {
 
 std::int64_t featureCount(const ReadOptions& options) {
   const GDALDatasetUniquePtr ds = openVector(options.path, options.layer);
-  OGRLayer* layer = options.layer.empty() ? ds->GetLayer(0) : ds->GetLayerByName(options.layer.c_str());
-  if (!layer) throw inputError(options.path + ": no layer named '" + options.layer + "'");
+  OGRLayer& layer = namedLayer(*ds, options.path, options.layer);
   QuietErrors quiet;
-  if (!options.where.empty() && layer->SetAttributeFilter(options.where.c_str()) != OGRERR_NONE) {
-    throw inputError(options.path + ": --where \"" + options.where + "\" is not a valid filter on layer " +
-                     layer->GetName() + " (" + lastGdalMessage() + ")");
-  }
-  return layer->GetFeatureCount(TRUE);
+  applyWhere(layer, options);
+  return layer.GetFeatureCount(TRUE);
 }
 
 ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) {
@@ -266,13 +276,7 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
   result.layerName = layer->GetName();
   CleaningReport& report = result.report;
 
-  if (!options.where.empty()) {
-    CPLErrorReset();
-    if (layer->SetAttributeFilter(options.where.c_str()) != OGRERR_NONE) {
-      throw inputError(path + ": --where \"" + options.where + "\" is not a valid filter on layer " + result.layerName +
-                       " (" + lastGdalMessage() + ")");
-    }
-  }
+  applyWhere(*layer, options);
 
   // CRS: --crs replaces whatever the file declares.
   OGRSpatialReference overrideSrs;

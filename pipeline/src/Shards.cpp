@@ -582,19 +582,22 @@ ShardPart decodeShard(std::string_view bytes, const std::string& what) {
   return p;
 }
 
+namespace {
+// What run.json and shard.json say of a shard.
+Json shardRecord(const ShardPart& p) {
+  return Json::object()
+      .set("shard", p.index)
+      .set("blocks", static_cast<std::int64_t>(p.blocks.size()))
+      .set("parcels", static_cast<std::int64_t>(p.parcels.size()))
+      .set("parcels_read", p.parcelsRead)
+      .set("windows_read", p.reads)
+      .set("seconds", p.seconds);
+}
+}  // namespace
+
 PreparedObserved prepareMerged(std::vector<ShardPart> parts, int ranks) {
   Json shards = Json::array();
-  std::vector<Json> entries(parts.size());
-  for (const ShardPart& p : parts) {
-    std::int64_t blocks = static_cast<std::int64_t>(p.blocks.size());
-    shards.push(Json::object()
-                    .set("shard", p.index)
-                    .set("blocks", blocks)
-                    .set("parcels", static_cast<std::int64_t>(p.parcels.size()))
-                    .set("parcels_read", p.parcelsRead)
-                    .set("windows_read", p.reads)
-                    .set("seconds", p.seconds));
-  }
+  for (const ShardPart& p : parts) shards.push(shardRecord(p));
   PreparedObserved prepared;
   prepared.data = std::make_shared<const ObservedData>(mergeShards(std::move(parts)));
   prepared.ranks = ranks;
@@ -617,21 +620,15 @@ JobOutcome runShard(const CompareRequest& request, int index, int count, const s
     CompareRequest absolute = request;
     absolute.input.path = std::filesystem::absolute(request.input.path).lexically_normal().string();
     io::writeJson(out.stage("session.json"), sessionJson(absolute));
-    const Json record = Json::object()
+    const Json record = shardRecord(part)
+                            .set("shards", count)
                             .set("tool", "parcelscope")
                             .set("version", version())
                             .set("command", "compare --shard")
-                            .set("shard", index)
-                            .set("shards", count)
                             .set("input_as_given", request.input.path)
                             .set("metric", request.metric)
                             .set("vector_format", request.vectorFormat)
                             .set("parcels_format", request.parcelsFormat)
-                            .set("blocks", static_cast<std::int64_t>(part.blocks.size()))
-                            .set("parcels", static_cast<std::int64_t>(part.parcels.size()))
-                            .set("parcels_read", part.parcelsRead)
-                            .set("windows_read", part.reads)
-                            .set("seconds", part.seconds)
                             .set("outputs", Json::array().push("shard.bin").push("session.json").push("shard.json"));
     io::writeJson(out.stage("shard.json"), record);
     out.commit();
