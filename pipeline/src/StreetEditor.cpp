@@ -7,6 +7,7 @@
 #include <numeric>
 #include <set>
 #include <sstream>
+#include <unordered_set>
 #include <utility>
 
 #include "CompareStages.h"
@@ -360,14 +361,31 @@ std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<c
   // two passes each key to one of them).
   std::vector<bool> regenerated(n, false);
   for (std::size_t k : todo) regenerated[k] = true;
-  std::set<Key> kept;
+  // The keys taken: those of the blocks kept and of the anchored parcels
+  // (sorted), then those inherited here.
+  std::vector<Key> kept;
   for (std::size_t k = 0; k < n; ++k) {
-    if (!regenerated[k]) kept.insert(s->entryKeys[k].begin(), s->entryKeys[k].end());
-    kept.insert(anchoredKeys[k].begin(), anchoredKeys[k].end());
+    if (!regenerated[k]) kept.insert(kept.end(), s->entryKeys[k].begin(), s->entryKeys[k].end());
+    kept.insert(kept.end(), anchoredKeys[k].begin(), anchoredKeys[k].end());
   }
+  std::sort(kept.begin(), kept.end());
+  std::unordered_set<Key> inheritedKeys;
+  auto take = [&](Key key) {
+    return !std::binary_search(kept.begin(), kept.end(), key) && inheritedKeys.insert(key).second;
+  };
+  // Each regenerated block's parcels matched to its counterpart's (blocks in parallel).
+  std::vector<generation::ParcelMatches> matches(todo.size());
+  parallelFor(todo.size(), [&](std::size_t t) {
+    const std::size_t k = todo[t];
+    if (counterpart[k] < 0) return;
+    const std::size_t p = static_cast<std::size_t>(counterpart[k]);
+    matches[t] = generation::matchParcels(previous->inputs.entries[p].shape, previous->outcomes[p]->subdivision.parcels,
+                                          s->inputs.entries[k].shape, s->outcomes[k]->subdivision.parcels);
+  });
   std::int64_t parcelsAfter = 0, matched = 0;
   std::set<std::size_t> involved;  // entries before whose parcels were replaced
-  for (std::size_t k : todo) {
+  for (std::size_t t = 0; t < todo.size(); ++t) {
+    const std::size_t k = todo[t];
     const BlockInputs::Entry& e = s->inputs.entries[k];
     const std::vector<Polygon>& now = s->outcomes[k]->subdivision.parcels;
     std::vector<Key>& out = s->entryKeys[k];
@@ -380,12 +398,11 @@ std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<c
     if (counterpart[k] < 0) continue;
     const std::size_t p = static_cast<std::size_t>(counterpart[k]);
     involved.insert(p);
-    const std::vector<Polygon>& then = previous->outcomes[p]->subdivision.parcels;
-    const generation::ParcelMatches m = generation::matchParcels(previous->inputs.entries[p].shape, then, e.shape, now);
+    const generation::ParcelMatches& m = matches[t];
     for (std::size_t i = anchoredKeys[k].size(); i < now.size(); ++i) {
       if (m.before[i] < 0) continue;
       const Key inherited = previous->entryKeys[p][static_cast<std::size_t>(m.before[i])];
-      if (!kept.insert(inherited).second) continue;
+      if (!take(inherited)) continue;
       out[i] = inherited;
       ++matched;
     }
@@ -419,11 +436,15 @@ std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<c
     }
   }
   // Labels and locks follow their parcels' keys; a parcel gone takes them with it.
-  const std::set<Key> present(s->parcelKeys.begin(), s->parcelKeys.end());
-  auto& labels = attributes.labels;
-  for (auto it = labels.begin(); it != labels.end();) it = present.count(it->first) ? std::next(it) : labels.erase(it);
-  auto& locked = attributes.locked;
-  for (auto it = locked.begin(); it != locked.end();) it = present.count(*it) ? std::next(it) : locked.erase(it);
+  if (!attributes.labels.empty() || !attributes.locked.empty()) {
+    std::vector<Key> present = s->parcelKeys;
+    std::sort(present.begin(), present.end());
+    auto isPresent = [&](Key key) { return std::binary_search(present.begin(), present.end(), key); };
+    auto& labels = attributes.labels;
+    for (auto it = labels.begin(); it != labels.end();) it = isPresent(it->first) ? std::next(it) : labels.erase(it);
+    auto& locked = attributes.locked;
+    for (auto it = locked.begin(); it != locked.end();) it = isPresent(*it) ? std::next(it) : locked.erase(it);
+  }
   s->attributes = std::move(attributes);
   return s;
 }
