@@ -13,10 +13,16 @@
 #include "parcelscope/viz/Scenes.h"
 #include "viz/ImageCheck.h"
 
+#include <vtkActor.h>
+#include <vtkActorCollection.h>
+#include <vtkCellArray.h>
 #include <vtkDataArray.h>
+#include <vtkIdList.h>
 #include <vtkImageData.h>
+#include <vtkMapper.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
+#include <vtkPolyData.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
 #include <vtkRendererCollection.h>
@@ -194,6 +200,60 @@ TEST(MapLayer, OutlinesFollowTheScaleDrawn) {
   EXPECT_EQ(layer.outlinedShapes(), 0u);
   layer.setMetresPerPixel(0.5);
   EXPECT_EQ(layer.outlinedShapes(), 1u);
+}
+
+// The street layer's two polydata (kerbs, centre lines), from the actors it
+// adds to a renderer: every kerb ring closed (its first point again), every
+// centre line open, lines of fewer than 2 points and rings of fewer than 3
+// left out.
+TEST(StreetLayer, DrawsEachKerbRingClosedAndEachCentreLineOpen) {
+  Polygon yard = rect(0, 0, 100, 60);
+  yard.holes.push_back({{40, 20}, {40, 40}, {60, 40}, {60, 20}});
+  const Polygon block = rect(120, 0, 180, 60);
+  const Polygon sliver{{{0, 0}, {1, 1}}, {}};
+  const std::vector<std::vector<Point>> lines = {{{-10, 70}, {50, 70}, {190, 70}}, {{110, -5}}, {{110, 0}, {110, 60}}};
+  StreetLayer layer;
+  layer.setStreets(lines, {yard, block, sliver});
+  EXPECT_EQ(layer.lines(), 3u);
+  vtkNew<vtkRenderer> renderer;
+  layer.addTo(renderer);
+  vtkActorCollection* actors = renderer->GetActors();
+  ASSERT_EQ(actors->GetNumberOfItems(), 2);
+  actors->InitTraversal();
+  auto* kerbs = vtkPolyData::SafeDownCast(actors->GetNextActor()->GetMapper()->GetInput());
+  auto* centre = vtkPolyData::SafeDownCast(actors->GetNextActor()->GetMapper()->GetInput());
+  ASSERT_TRUE(kerbs && centre);
+  // Kerbs: the yard's outer ring and hole, the block's ring; no sliver.
+  ASSERT_EQ(kerbs->GetNumberOfLines(), 3);
+  EXPECT_EQ(kerbs->GetNumberOfPoints(), 12);
+  EXPECT_EQ(kerbs->GetNumberOfPolys(), 0);
+  vtkNew<vtkIdList> cell;
+  const std::vector<const Ring*> rings = {&yard.outer, &yard.holes[0], &block.outer};
+  for (vtkIdType c = 0; c < 3; ++c) {
+    kerbs->GetLines()->GetCellAtId(c, cell);
+    const Ring& ring = *rings[static_cast<std::size_t>(c)];
+    ASSERT_EQ(cell->GetNumberOfIds(), static_cast<vtkIdType>(ring.size() + 1));
+    EXPECT_EQ(cell->GetId(0), cell->GetId(cell->GetNumberOfIds() - 1));
+    for (std::size_t v = 0; v < ring.size(); ++v) {
+      double xyz[3];
+      kerbs->GetPoint(cell->GetId(static_cast<vtkIdType>(v)), xyz);
+      EXPECT_EQ(xyz[0], ring[v].x);
+      EXPECT_EQ(xyz[1], ring[v].y);
+    }
+  }
+  // Centre lines: the two of 2 points or more, open, in order.
+  ASSERT_EQ(centre->GetNumberOfLines(), 2);
+  EXPECT_EQ(centre->GetNumberOfPoints(), 5);
+  centre->GetLines()->GetCellAtId(1, cell);
+  ASSERT_EQ(cell->GetNumberOfIds(), 2);
+  double end[3];
+  centre->GetPoint(cell->GetId(1), end);
+  EXPECT_EQ(end[0], 110);
+  EXPECT_EQ(end[1], 60);
+  // Empty: nothing drawn.
+  layer.setStreets({}, {});
+  EXPECT_EQ(kerbs->GetNumberOfLines(), 0);
+  EXPECT_EQ(centre->GetNumberOfLines(), 0);
 }
 
 // The layer drawn off screen, as RGB bytes. One window for every drawing (and

@@ -481,6 +481,54 @@ void buildPanel(const MapPanel& panel, PanelGeometry& g, std::vector<vtkIdType>*
   g.fill->GetPointData()->SetScalars(pointValues);
 }
 
+// The rings of `shapes` as closed lines (buildPanel's rings, without its
+// triangulated fill): outlines only, such as kerbs or a selection.
+void buildRings(const std::vector<const Polygon*>& shapes, vtkPolyData* out) {
+  vtkIdType pointCount = 0;
+  for (const Polygon* shape : shapes) {
+    if (shape->outer.size() < 3) continue;
+    pointCount += static_cast<vtkIdType>(shape->outer.size());
+    for (const Ring& hole : shape->holes) pointCount += static_cast<vtkIdType>(hole.size());
+  }
+  vtkNew<vtkDoubleArray> coordinates;
+  coordinates->SetNumberOfComponents(3);
+  coordinates->SetNumberOfTuples(pointCount);
+  double* xyz = coordinates->GetPointer(0);
+  vtkNew<vtkIdTypeArray> offsets, ids;
+  std::vector<vtkIdType> lineOffsets{0}, lineIds;
+  lineIds.reserve(static_cast<std::size_t>(pointCount) + shapes.size());
+  vtkIdType first = 0;
+  auto addRing = [&](const Ring& ring) {
+    for (const Point& p : ring) {
+      *xyz++ = p.x;
+      *xyz++ = p.y;
+      *xyz++ = 0.0;
+    }
+    const auto size = static_cast<vtkIdType>(ring.size());
+    for (vtkIdType v = 0; v < size; ++v) lineIds.push_back(first + v);
+    lineIds.push_back(first);
+    lineOffsets.push_back(static_cast<vtkIdType>(lineIds.size()));
+    first += size;
+  };
+  for (const Polygon* shape : shapes) {
+    if (shape->outer.size() < 3) continue;  // as buildPanel: nothing to draw
+    addRing(shape->outer);
+    for (const Ring& hole : shape->holes) addRing(hole);
+  }
+  offsets->SetNumberOfValues(static_cast<vtkIdType>(lineOffsets.size()));
+  std::memcpy(offsets->GetPointer(0), lineOffsets.data(), lineOffsets.size() * sizeof(vtkIdType));
+  ids->SetNumberOfValues(static_cast<vtkIdType>(lineIds.size()));
+  if (!lineIds.empty()) std::memcpy(ids->GetPointer(0), lineIds.data(), lineIds.size() * sizeof(vtkIdType));
+  vtkNew<vtkCellArray> lines;
+  lines->SetData(offsets, ids);
+  vtkNew<vtkPoints> points;
+  points->SetData(coordinates);
+  vtkNew<vtkPolyData> rings;
+  rings->SetPoints(points);
+  rings->SetLines(lines);
+  out->ShallowCopy(rings);
+}
+
 // A round length (1, 2 or 5 times a power of ten) of at most `limit` metres.
 double roundLength(double limit) {
   const double p = std::pow(10.0, std::floor(std::log10(limit)));
@@ -1121,14 +1169,7 @@ OutlineLayer::OutlineLayer() : impl_(std::make_unique<Impl>()) {
 
 OutlineLayer::~OutlineLayer() = default;
 
-void OutlineLayer::setShapes(const std::vector<const Polygon*>& shapes) {
-  MapPanel panel;
-  panel.shapes = shapes;
-  panel.values.assign(shapes.size(), 0.0);
-  PanelGeometry fresh;
-  buildPanel(panel, fresh);
-  impl_->rings->ShallowCopy(fresh.rings);
-}
+void OutlineLayer::setShapes(const std::vector<const Polygon*>& shapes) { buildRings(shapes, impl_->rings); }
 
 void OutlineLayer::addTo(vtkRenderer* renderer) { renderer->AddActor(impl_->actor); }
 
@@ -1156,24 +1197,40 @@ StreetLayer::StreetLayer() : impl_(std::make_unique<Impl>()) {
 StreetLayer::~StreetLayer() = default;
 
 void StreetLayer::setStreets(const std::vector<std::vector<Point>>& centreLines, const std::vector<Polygon>& surface) {
-  vtkNew<vtkPoints> points;
-  vtkNew<vtkCellArray> cells;
+  // Filled in bulk: a city's centre lines are redrawn on every edit.
+  std::size_t pointCount = 0;
+  for (const auto& line : centreLines) pointCount += line.size() < 2 ? 0 : line.size();
+  vtkNew<vtkDoubleArray> coordinates;
+  coordinates->SetNumberOfComponents(3);
+  coordinates->SetNumberOfTuples(static_cast<vtkIdType>(pointCount));
+  double* xyz = coordinates->GetPointer(0);
+  vtkNew<vtkIdTypeArray> offsets, ids;
+  offsets->InsertNextValue(0);
+  ids->SetNumberOfValues(static_cast<vtkIdType>(pointCount));
+  vtkIdType next = 0;
   for (const auto& line : centreLines) {
     if (line.size() < 2) continue;
-    cells->InsertNextCell(static_cast<vtkIdType>(line.size()));
-    for (const Point& p : line) cells->InsertCellPoint(points->InsertNextPoint(p.x, p.y, 0));
+    for (const Point& p : line) {
+      *xyz++ = p.x;
+      *xyz++ = p.y;
+      *xyz++ = 0.0;
+      ids->SetValue(next, next);
+      ++next;
+    }
+    offsets->InsertNextValue(next);
   }
+  vtkNew<vtkCellArray> cells;
+  cells->SetData(offsets, ids);
+  vtkNew<vtkPoints> points;
+  points->SetData(coordinates);
   vtkNew<vtkPolyData> centre;
   centre->SetPoints(points);
   centre->SetLines(cells);
   impl_->centre->ShallowCopy(centre);
   impl_->lines = centreLines.size();
-  MapPanel panel;
-  for (const Polygon& p : surface) panel.shapes.push_back(&p);
-  panel.values.assign(panel.shapes.size(), 0.0);
-  PanelGeometry fresh;
-  buildPanel(panel, fresh);
-  impl_->kerbs->ShallowCopy(fresh.rings);
+  std::vector<const Polygon*> kerbs;
+  for (const Polygon& p : surface) kerbs.push_back(&p);
+  buildRings(kerbs, impl_->kerbs);
 }
 
 void StreetLayer::addTo(vtkRenderer* renderer) {
