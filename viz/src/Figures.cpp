@@ -369,6 +369,21 @@ std::vector<vtkIdType> triangulate(const Polygon& shape, vtkPolygon* earCut, vtk
   return cells;
 }
 
+// Room for the points of the shapes drawn (outer ring of 3 vertices or more):
+// x, y and 0 for each vertex of their rings.
+vtkSmartPointer<vtkDoubleArray> pointRoom(const std::vector<const Polygon*>& shapes) {
+  vtkIdType count = 0;
+  for (const Polygon* shape : shapes) {
+    if (shape->outer.size() < 3) continue;
+    count += static_cast<vtkIdType>(shape->outer.size());
+    for (const Ring& hole : shape->holes) count += static_cast<vtkIdType>(hole.size());
+  }
+  auto coordinates = vtkSmartPointer<vtkDoubleArray>::New();
+  coordinates->SetNumberOfComponents(3);
+  coordinates->SetNumberOfTuples(count);
+  return coordinates;
+}
+
 // Triangles filling every shape (holes left open), each shape's points
 // carrying its value (a point value, not a cell value per triangle: a cell
 // value costs VTK a colour texture rebuilt and read per pixel), and the rings
@@ -382,14 +397,8 @@ std::vector<vtkIdType> triangulate(const Polygon& shape, vtkPolygon* earCut, vtk
 // points.
 void buildPanel(const MapPanel& panel, PanelGeometry& g, std::vector<vtkIdType>* pointsPerShape = nullptr,
                 TriangleCache* cache = nullptr, double minOutlined = 0) {
-  vtkIdType pointCount = 0;
-  for (const Polygon* shape : panel.shapes) {
-    pointCount += static_cast<vtkIdType>(shape->outer.size());
-    for (const Ring& hole : shape->holes) pointCount += static_cast<vtkIdType>(hole.size());
-  }
-  vtkNew<vtkDoubleArray> coordinates;
-  coordinates->SetNumberOfComponents(3);
-  coordinates->SetNumberOfTuples(pointCount);
+  const vtkSmartPointer<vtkDoubleArray> coordinates = pointRoom(panel.shapes);
+  const vtkIdType pointCount = coordinates->GetNumberOfTuples();
   double* xyz = coordinates->GetPointer(0);
   std::vector<vtkIdType> lineOffsets{0}, lineIds, triangleIds;
   std::vector<double> values;
@@ -484,15 +493,8 @@ void buildPanel(const MapPanel& panel, PanelGeometry& g, std::vector<vtkIdType>*
 // The rings of `shapes` as closed lines (buildPanel's rings, without its
 // triangulated fill): outlines only, such as kerbs or a selection.
 void buildRings(const std::vector<const Polygon*>& shapes, vtkPolyData* out) {
-  vtkIdType pointCount = 0;
-  for (const Polygon* shape : shapes) {
-    if (shape->outer.size() < 3) continue;
-    pointCount += static_cast<vtkIdType>(shape->outer.size());
-    for (const Ring& hole : shape->holes) pointCount += static_cast<vtkIdType>(hole.size());
-  }
-  vtkNew<vtkDoubleArray> coordinates;
-  coordinates->SetNumberOfComponents(3);
-  coordinates->SetNumberOfTuples(pointCount);
+  const vtkSmartPointer<vtkDoubleArray> coordinates = pointRoom(shapes);
+  const vtkIdType pointCount = coordinates->GetNumberOfTuples();
   double* xyz = coordinates->GetPointer(0);
   vtkNew<vtkIdTypeArray> offsets, ids;
   std::vector<vtkIdType> lineOffsets{0}, lineIds;
