@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -583,7 +584,20 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
     all.push_back(e.line);
     apart |= e.noNode;
   }
-  const geos::LineFaces faces = geos::polygonizeLines(apart ? geos::nodeLines(all, kGrid) : all);
+  // The faces of the lines; the last call's when its lines were the same.
+  std::optional<geos::LineFaces> polygonized;
+  const auto sameBits = [](const std::vector<Polyline>& a, const std::vector<Polyline>& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (a[i].size() != b[i].size() ||
+          (!a[i].empty() && std::memcmp(a[i].data(), b[i].data(), a[i].size() * sizeof(Point)) != 0))
+        return false;
+    }
+    return true;
+  };
+  const bool sameLines = cache && cache->lineFaces && cache->linesApart == apart && sameBits(cache->lines, all);
+  if (!sameLines) polygonized = geos::polygonizeLines(apart ? geos::nodeLines(all, kGrid) : all);
+  const geos::LineFaces& faces = sameLines ? *cache->lineFaces : *polygonized;
   out.faces = static_cast<std::int64_t>(faces.faces.size());
   reportProgress(progress, 0.2, "faces");
 
@@ -705,6 +719,11 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
       if (computed[f]) {
         cache->faces[faceSignature[f]] = {faces.faces[f], perFace[f].blocks, perFace[f].tooLarge, perFace[f].tooSmall};
       }
+    }
+    if (!sameLines) {  // last: `faces` refers to them until here
+      cache->lines = std::move(all);
+      cache->linesApart = apart;
+      cache->lineFaces = std::move(polygonized);
     }
   }
   for (FaceBlocks& f : perFace) {

@@ -355,7 +355,7 @@ TEST(RoadGraph, CurvedEdgesAreFlattenedAndTheirBlocksFollowTheCurve) {
 
 // The cache gives the blocks a call without it gives, for a graph an edit
 // changed (a node moved, a width changed), and overlays again only the faces
-// the edit reached.
+// the edit reached; a width polygonises no line again.
 TEST(RoadGraph, CachedBlocksAreTheBlocksOfACallWithoutTheCache) {
   RoadGraph g = buildRoadGraph(grid(5, 100));
   StreetBlockCache cache;
@@ -390,8 +390,12 @@ TEST(RoadGraph, CachedBlocksAreTheBlocksOfACallWithoutTheCache) {
   const std::size_t added = cache.faces.size() - facesCached;
   EXPECT_GE(added, 4u);   // the four faces around the node
   EXPECT_LE(added, 12u);  // and the faces whose nearby edges changed, not all 36
+  // A width moves no line: the faces are those polygonised for the move.
+  ASSERT_TRUE(cache.lineFaces.has_value());
+  const Polygon* facesBefore = cache.lineFaces->faces.data();
   g.edges[3].width = 16;
   EXPECT_TRUE(same(streetBlocks(g, {}, {}, &cache), streetBlocks(g)));
+  EXPECT_EQ(cache.lineFaces->faces.data(), facesBefore);
 }
 
 TEST(RoadGraph, FacesAboveTheLimitAreDropped) {

@@ -158,6 +158,11 @@ struct StreetBlockCache {
   };
   std::unordered_map<Key, Face> faces;
   std::unordered_map<Key, std::vector<Polygon>> surfaces;
+  /// The lines the last call polygonised (kept apart or not) and its faces:
+  /// an edit that moves no line (a width) polygonises nothing again.
+  std::vector<Polyline> lines;
+  bool linesApart = false;
+  std::optional<geos::LineFaces> lineFaces;
 };
 
 /// The blocks of `graph` (every edge width must be known: see
