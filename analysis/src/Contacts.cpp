@@ -408,6 +408,8 @@ std::vector<double> lengthAlong(const std::vector<const Polygon*>& polygons, con
   std::vector<double> out(polygons.size(), 0.0);
   std::vector<NearEdge> edges, candidates;
   std::vector<std::pair<double, double>> intervals;
+  EdgeIndex candidateIndex;
+  std::vector<std::size_t> found;
   for (std::size_t k = 0; k < near.size();) {
     const std::size_t i = near[k].first;
     candidates.clear();
@@ -419,13 +421,23 @@ std::vector<double> lengthAlong(const std::vector<const Polygon*>& polygons, con
                std::max(reach.maxY, f.hi[1])};
     }
     edgesNear(*polygons[i], grow, reach, edges);
+    // Many edges on both sides (a large parcel along a long ring): the
+    // candidates meeting each edge's box come from an index, in the same order.
+    const bool indexed = edges.size() > EdgeIndex::kScanUpTo && candidates.size() > EdgeIndex::kScanUpTo;
+    if (indexed) candidateIndex.build(candidates);
     double total = 0;
     for (const NearEdge& e : edges) {
       intervals.clear();
-      for (const NearEdge& f : candidates) {
-        if (!(e.lo[0] <= f.hi[0] && f.lo[0] <= e.hi[0] && e.lo[1] <= f.hi[1] && f.lo[1] <= e.hi[1])) continue;
+      auto measure = [&](const NearEdge& f) {
+        if (!(e.lo[0] <= f.hi[0] && f.lo[0] <= e.hi[0] && e.lo[1] <= f.hi[1] && f.lo[1] <= e.hi[1])) return;
         double lo = 0, hi = 0;
         if (coveredInterval(e, f, tolerance, lo, hi)) intervals.emplace_back(lo, hi);
+      };
+      if (indexed) {
+        candidateIndex.meeting(candidates, {e.lo[0], e.lo[1], e.hi[0], e.hi[1]}, found);
+        for (std::size_t j : found) measure(candidates[j]);
+      } else {
+        for (const NearEdge& f : candidates) measure(f);
       }
       if (!intervals.empty()) total += unionLength(intervals);
     }

@@ -353,6 +353,55 @@ Ring convexHull(const std::vector<Point>& points) {
   return hull;
 }
 
+namespace {
+
+// The vertex of a large hull farthest along a direction, found from the
+// hull's edge angles: a convex polygon's vertex is extreme for the directions
+// between its two edges' outward normals. Used from kFastFrom vertices (below
+// that, testing every vertex costs less).
+class HullExtremes {
+public:
+  static constexpr std::size_t kFastFrom = 256;
+
+  // The edges' directions of the hull (relative coordinates dxs, dys), turned
+  // into one increasing sequence of angles; false unless the hull turns left
+  // at every vertex (counter-clockwise, strictly convex).
+  bool build(const std::vector<double>& dxs, const std::vector<double>& dys) {
+    const std::size_t m = dxs.size();
+    angles_.resize(m);
+    double previous = 0;
+    for (std::size_t j = 0; j < m; ++j) {
+      const std::size_t k = (j + 1) % m;
+      const double a = std::atan2(dys[k] - dys[j], dxs[k] - dxs[j]);
+      if (j == 0) {
+        angles_[0] = previous = a;
+        continue;
+      }
+      double turn = a - std::remainder(previous, 2 * M_PI);
+      while (turn <= 0) turn += 2 * M_PI;
+      while (turn > 2 * M_PI) turn -= 2 * M_PI;
+      if (!(turn < M_PI)) return false;
+      angles_[j] = previous = previous + turn;
+    }
+    return angles_[m - 1] - angles_[0] < 2 * M_PI;
+  }
+
+  // The index of the vertex farthest along (x, y): the first whose outgoing
+  // edge turns past the direction's left normal.
+  std::size_t farthest(double x, double y) const {
+    double psi = std::atan2(y, x) + 0.5 * M_PI;
+    while (psi < angles_[0]) psi += 2 * M_PI;
+    while (psi >= angles_[0] + 2 * M_PI) psi -= 2 * M_PI;
+    const auto it = std::lower_bound(angles_.begin(), angles_.end(), psi);
+    return it == angles_.end() ? 0 : static_cast<std::size_t>(it - angles_.begin());
+  }
+
+private:
+  std::vector<double> angles_;
+};
+
+}  // namespace
+
 OrientedBox smallestBoxAlongEdges(const Ring& hull, const Ring& edges) {
   OrientedBox best;
   if (hull.empty()) return best;
@@ -368,6 +417,11 @@ OrientedBox smallestBoxAlongEdges(const Ring& hull, const Ring& edges) {
     dys[j] = hull[j].y - o.y;
   }
   double bestArea = std::numeric_limits<double>::max();
+  // A large hull: each extreme taken among the vertex its angle gives and two
+  // neighbours each side (the same projections, so the same extremes, as
+  // testing every vertex), in time logarithmic in the hull's size.
+  thread_local HullExtremes extremes;
+  const bool fast = m >= HullExtremes::kFastFrom && extremes.build(dxs, dys);
   for (std::size_t i = 0, n = edges.size(); i < n; ++i) {
     const Point& a = edges[i];
     const Point& b = edges[(i + 1) % n];
@@ -380,35 +434,48 @@ OrientedBox smallestBoxAlongEdges(const Ring& hull, const Ring& edges) {
     double minE1 = std::numeric_limits<double>::max(), maxE1 = std::numeric_limits<double>::lowest();
     double minN1 = minE1, maxN1 = maxE1;
     std::size_t j = 0;
+    if (fast) {
+      const auto around = [&](std::size_t centre, auto&& take) {
+        for (std::size_t k = centre + m - 2; k <= centre + m + 2; ++k) take(k % m);
+      };
+      around(extremes.farthest(e.x, e.y), [&](std::size_t k) { maxE1 = std::max(maxE1, dxs[k] * e.x + dys[k] * e.y); });
+      around(extremes.farthest(-e.x, -e.y),
+             [&](std::size_t k) { minE1 = std::min(minE1, dxs[k] * e.x + dys[k] * e.y); });
+      around(extremes.farthest(-e.y, e.x),
+             [&](std::size_t k) { maxN1 = std::max(maxN1, -dxs[k] * e.y + dys[k] * e.x); });
+      around(extremes.farthest(e.y, -e.x),
+             [&](std::size_t k) { minN1 = std::min(minN1, -dxs[k] * e.y + dys[k] * e.x); });
+    } else {
 #if defined(__SSE2__)
-    const __m128d ex = _mm_set1_pd(e.x), ey = _mm_set1_pd(e.y), sign = _mm_set1_pd(-0.0);
-    __m128d minE = _mm_set1_pd(minE1), maxE = _mm_set1_pd(maxE1), minN = minE, maxN = maxE;
-    for (; j + 2 <= m; j += 2) {
-      const __m128d dx = _mm_loadu_pd(&dxs[j]), dy = _mm_loadu_pd(&dys[j]);
-      const __m128d pe = _mm_add_pd(_mm_mul_pd(dx, ex), _mm_mul_pd(dy, ey));
-      const __m128d pn = _mm_add_pd(_mm_mul_pd(_mm_xor_pd(dx, sign), ey), _mm_mul_pd(dy, ex));
-      minE = _mm_min_pd(pe, minE);
-      maxE = _mm_max_pd(pe, maxE);
-      minN = _mm_min_pd(pn, minN);
-      maxN = _mm_max_pd(pn, maxN);
-    }
-    double lo[2], hi[2], loN[2], hiN[2];
-    _mm_storeu_pd(lo, minE);
-    _mm_storeu_pd(hi, maxE);
-    _mm_storeu_pd(loN, minN);
-    _mm_storeu_pd(hiN, maxN);
-    minE1 = std::min(lo[0], lo[1]);
-    maxE1 = std::max(hi[0], hi[1]);
-    minN1 = std::min(loN[0], loN[1]);
-    maxN1 = std::max(hiN[0], hiN[1]);
+      const __m128d ex = _mm_set1_pd(e.x), ey = _mm_set1_pd(e.y), sign = _mm_set1_pd(-0.0);
+      __m128d minE = _mm_set1_pd(minE1), maxE = _mm_set1_pd(maxE1), minN = minE, maxN = maxE;
+      for (; j + 2 <= m; j += 2) {
+        const __m128d dx = _mm_loadu_pd(&dxs[j]), dy = _mm_loadu_pd(&dys[j]);
+        const __m128d pe = _mm_add_pd(_mm_mul_pd(dx, ex), _mm_mul_pd(dy, ey));
+        const __m128d pn = _mm_add_pd(_mm_mul_pd(_mm_xor_pd(dx, sign), ey), _mm_mul_pd(dy, ex));
+        minE = _mm_min_pd(pe, minE);
+        maxE = _mm_max_pd(pe, maxE);
+        minN = _mm_min_pd(pn, minN);
+        maxN = _mm_max_pd(pn, maxN);
+      }
+      double lo[2], hi[2], loN[2], hiN[2];
+      _mm_storeu_pd(lo, minE);
+      _mm_storeu_pd(hi, maxE);
+      _mm_storeu_pd(loN, minN);
+      _mm_storeu_pd(hiN, maxN);
+      minE1 = std::min(lo[0], lo[1]);
+      maxE1 = std::max(hi[0], hi[1]);
+      minN1 = std::min(loN[0], loN[1]);
+      maxN1 = std::max(hiN[0], hiN[1]);
 #endif
-    for (; j < m; ++j) {
-      const double pe = dxs[j] * e.x + dys[j] * e.y;
-      const double pn = -dxs[j] * e.y + dys[j] * e.x;
-      minE1 = std::min(minE1, pe);
-      maxE1 = std::max(maxE1, pe);
-      minN1 = std::min(minN1, pn);
-      maxN1 = std::max(maxN1, pn);
+      for (; j < m; ++j) {
+        const double pe = dxs[j] * e.x + dys[j] * e.y;
+        const double pn = -dxs[j] * e.y + dys[j] * e.x;
+        minE1 = std::min(minE1, pe);
+        maxE1 = std::max(maxE1, pe);
+        minN1 = std::min(minN1, pn);
+        maxN1 = std::max(maxN1, pn);
+      }
     }
     const double w = maxE1 - minE1, h = maxN1 - minN1;
     if (w * h < bestArea * (1 - 1e-9)) {

@@ -185,6 +185,53 @@ TEST(LengthAlong, EqualsTheEdgeByEdgeDefinitionOnRandomLotsAndOutlines) {
   EXPECT_GT(inside, 500) << "lots inside should not";
 }
 
+// Lots of many vertices along outlines of many vertices (a street-network
+// parcel, a curved block): each lot edge takes its candidates from an index
+// of the outline's edges; the lengths are still those of the definition.
+TEST(LengthAlong, LotsOfManyVerticesAlongLongOutlinesEqualTheDefinition) {
+  auto rng64 = test::seededRandom(20261127, "LengthAlongLarge");
+  std::mt19937 rng(static_cast<std::uint32_t>(rng64()));
+  std::uniform_real_distribution<double> off(-0.08, 0.08);
+  std::uniform_int_distribution<int> steps(30, 120);
+  // A side from `from` to `to` walked in `n` jittered steps (its end left out).
+  auto walk = [&](Ring& ring, Point from, Point to, int n) {
+    for (int k = 0; k < n; ++k) {
+      const double t = static_cast<double>(k) / n;
+      ring.push_back({from.x + t * (to.x - from.x) + off(rng), from.y + t * (to.y - from.y) + off(rng)});
+    }
+  };
+  int fronting = 0;
+  for (int round = 0; round < 12; ++round) {
+    // Three lots side by side, 40 m x 60 m, each side walked in many steps.
+    std::vector<Polygon> lots(3);
+    for (int i = 0; i < 3; ++i) {
+      const double x = 40.0 * i;
+      Ring& r = lots[static_cast<std::size_t>(i)].outer;
+      walk(r, {x, 0}, {x + 40, 0}, steps(rng));
+      walk(r, {x + 40, 0}, {x + 40, 60}, steps(rng));
+      walk(r, {x + 40, 60}, {x, 60}, steps(rng));
+      walk(r, {x, 60}, {x, 0}, steps(rng));
+    }
+    Ring outline;
+    walk(outline, {0, 0}, {120, 0}, 3 * steps(rng));
+    walk(outline, {120, 0}, {120, 60}, steps(rng));
+    walk(outline, {120, 60}, {0, 60}, 3 * steps(rng));
+    walk(outline, {0, 60}, {0, 0}, steps(rng));
+    std::vector<const Polygon*> all;
+    for (const Polygon& p : lots) all.push_back(&p);
+    for (const double tolerance : {0.05, 0.3, 1.0}) {
+      const std::vector<double> got = analysis::detail::lengthAlong(all, {outline}, tolerance);
+      const std::vector<double> expected = lengthAlongEveryPair(all, {outline}, tolerance);
+      ASSERT_EQ(got.size(), expected.size());
+      for (std::size_t i = 0; i < got.size(); ++i) {
+        ASSERT_EQ(got[i], expected[i]) << "round " << round << ", lot " << i << ", tolerance " << tolerance;
+        fronting += got[i] > 50.0;
+      }
+    }
+  }
+  EXPECT_GT(fronting, 50) << "every lot fronts the outline on two sides or more";
+}
+
 // Neighbours are counted from contacts measured only until one edge pair
 // covers the threshold: the decision must be the one the whole length gives.
 TEST(Contacts, StoppingAtEnoughDecidesAsTheWholeLength) {

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 
 #include "TestUtil.h"
@@ -63,6 +64,74 @@ TEST(Geometry, MinimumAreaBoxIsNoLargerThanAxisAlignedBoxOnRandomPolygons) {
       const double across = -(p.x - box.center.x) * box.u.y + (p.y - box.center.y) * box.u.x;
       EXPECT_LE(std::fabs(along), 0.5 * box.length + 1e-9);
       EXPECT_LE(std::fabs(across), 0.5 * box.width + 1e-9);
+    }
+  }
+}
+
+// smallestBoxAlongEdges by testing every hull vertex for every edge (the
+// method used below HullExtremes::kFastFrom hull vertices), for comparison.
+OrientedBox boxByEveryVertex(const Ring& hull, const Ring& edges) {
+  OrientedBox best;
+  best.center = hull[0];
+  const Point o = hull[0];
+  double bestArea = std::numeric_limits<double>::max();
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    const Point& a = edges[i];
+    const Point& b = edges[(i + 1) % edges.size()];
+    const double l = norm(b.x - a.x, b.y - a.y);
+    if (l == 0) continue;
+    const Point e{(b.x - a.x) / l, (b.y - a.y) / l};
+    double minE = std::numeric_limits<double>::max(), maxE = std::numeric_limits<double>::lowest();
+    double minN = minE, maxN = maxE;
+    for (const Point& h : hull) {
+      const double dx = h.x - o.x, dy = h.y - o.y;
+      const double pe = dx * e.x + dy * e.y, pn = -dx * e.y + dy * e.x;
+      minE = std::min(minE, pe);
+      maxE = std::max(maxE, pe);
+      minN = std::min(minN, pn);
+      maxN = std::max(maxN, pn);
+    }
+    const double w = maxE - minE, h = maxN - minN;
+    if (w * h < bestArea * (1 - 1e-9)) {
+      bestArea = w * h;
+      const double ce = 0.5 * (minE + maxE), cn = 0.5 * (minN + maxN);
+      best.center = {o.x + ce * e.x - cn * e.y, o.y + ce * e.y + cn * e.x};
+      best.u = w >= h ? e : Point{-e.y, e.x};
+      best.length = std::max(w, h);
+      best.width = std::min(w, h);
+    }
+  }
+  return best;
+}
+
+// Large hulls (ellipses of 600 to 20,000 vertices, jittered, turned, far from
+// the origin) take their extremes from the edge angles: the boxes are those of
+// testing every vertex, to the bit, for the hull's own edges and for the edges
+// of a ring around it.
+TEST(Geometry, SmallestBoxOfALargeHullIsThatOfTestingEveryVertex) {
+  std::mt19937 rng(11);
+  std::printf("seed 11\n");
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int k = 0; k < 40; ++k) {
+    const int n = k < 36 ? 600 + 60 * k : 20000;
+    const double a = 50 + 400 * u(rng), b = a * (0.3 + 0.7 * u(rng)), turn = 6.3 * u(rng);
+    const double x0 = 1e5 * u(rng), y0 = -1e5 * u(rng);
+    Ring ring;
+    for (int i = 0; i < n; ++i) {
+      const double t = 2 * M_PI * i / n, r = 1 + 1e-7 * u(rng);
+      const double x = a * r * std::cos(t), y = b * r * std::sin(t);
+      ring.push_back({x0 + x * std::cos(turn) - y * std::sin(turn), y0 + x * std::sin(turn) + y * std::cos(turn)});
+    }
+    const Ring hull = convexHull(ring);
+    ASSERT_GE(hull.size(), 256u) << "case " << k;
+    for (const Ring* edges : std::vector<const Ring*>{&hull, &ring}) {
+      const OrientedBox fast = smallestBoxAlongEdges(hull, *edges), every = boxByEveryVertex(hull, *edges);
+      EXPECT_EQ(fast.length, every.length) << "case " << k;
+      EXPECT_EQ(fast.width, every.width) << "case " << k;
+      EXPECT_EQ(fast.center.x, every.center.x) << "case " << k;
+      EXPECT_EQ(fast.center.y, every.center.y) << "case " << k;
+      EXPECT_EQ(fast.u.x, every.u.x) << "case " << k;
+      EXPECT_EQ(fast.u.y, every.u.y) << "case " << k;
     }
   }
 }
