@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <set>
 
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Json.h"
@@ -82,18 +83,50 @@ std::optional<std::string> inputWithin(const std::vector<std::string>& inputs, c
   return std::nullopt;
 }
 
-// A ParcelScope run: a run.json whose "tool" is "parcelscope".
-bool holdsARun(const fs::path& folder) {
-  std::error_code ec;
-  const fs::path record = folder / "run.json";
-  if (!fs::is_regular_file(record, ec)) return false;
-  try {
-    const Json run = readJson(record.string());
-    const Json* tool = run.find("tool");
-    return tool && tool->isString() && tool->string() == "parcelscope";
-  } catch (const Error&) {
-    return false;
+// A ParcelScope run's record in `folder`: its run.json (or a shard's
+// shard.json) whose "tool" is "parcelscope".
+std::optional<std::pair<std::string, Json>> runRecord(const fs::path& folder) {
+  for (const char* name : {"run.json", "shard.json"}) {
+    std::error_code ec;
+    const fs::path record = folder / name;
+    if (!fs::is_regular_file(record, ec)) continue;
+    try {
+      Json run = readJson(record.string());
+      const Json* tool = run.find("tool");
+      if (tool && tool->isString() && tool->string() == "parcelscope") return std::make_pair(std::string(name), run);
+    } catch (const Error&) {
+    }
   }
+  return std::nullopt;
+}
+
+// The first file or folder in `folder` (a previous run) that its record does
+// not list among its outputs: something of the user's, which replacing the
+// folder would delete (the staging folders, and lost+found at a mount point,
+// are not). Empty when there is none (or the record lists no
+// outputs, as runs before the list did).
+std::string foreignEntry(const fs::path& folder, bool inside, const std::string& recordName, const Json& record) {
+  const Json* outputs = record.find("outputs");
+  if (!outputs || !outputs->isArray()) return "";
+  std::set<std::string> files{recordName}, folders;
+  for (const Json& output : outputs->elements()) {
+    if (!output.isString()) continue;
+    const fs::path p = fs::path(output.string()).lexically_normal();
+    files.insert(p.generic_string());
+    for (fs::path up = p.parent_path(); !up.empty(); up = up.parent_path()) folders.insert(up.generic_string());
+  }
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(folder, ec); !ec && it != fs::recursive_directory_iterator();
+       it.increment(ec)) {
+    const std::string relative = fs::relative(it->path(), folder, ec).generic_string();
+    if (relative.rfind(kInside, 0) == 0 || (inside && relative == "lost+found")) {
+      it.disable_recursion_pending();
+      continue;
+    }
+    const bool listed = it->is_directory(ec) ? folders.count(relative) > 0 : files.count(relative) > 0;
+    if (!listed) return relative;
+  }
+  return "";
 }
 
 // Whether `dir` (existing, absolute, canonical) is the root of a mount: renames
@@ -290,10 +323,16 @@ void OutputDirectory::checkTarget() const {
   }
   const auto entries = runEntries(d, inside_, ec);
   if (ec) throw ioError(target_ + ": cannot read --out (" + ec.message() + ")");
-  if (!entries.empty() && !holdsARun(d)) {
+  if (entries.empty()) return;
+  const auto record = runRecord(d);
+  if (!record) {
     throw usageError(target_ +
                      ": --out holds files that are not a ParcelScope run (no run.json written by parcelscope); "
                      "a run replaces its folder whole, so name a new or empty folder");
+  }
+  if (const std::string foreign = foreignEntry(d, inside_, record->first, record->second); !foreign.empty()) {
+    throw usageError(target_ + ": --out holds " + foreign + ", which is not an output of the run there (" +
+                     record->first + "); a run replaces its folder whole, so move it or name another folder");
   }
 }
 

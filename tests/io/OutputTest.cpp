@@ -340,6 +340,43 @@ TEST(OutputDirectory, AFolderOfUnknownFilesIsRefusedAndLeftAsItWas) {
   }
 }
 
+// Bug: a folder holding a previous run and the user's own files (notes beside
+// the outputs, a file put in its figures folder) was replaced whole, deleting
+// them. A run's record lists its outputs: anything else there is refused and
+// kept. A shard's folder (shard.json) is a run too: an array job can be run
+// again into it.
+TEST(OutputDirectory, FilesBesideAPreviousRunsOutputsAreRefusedAndKept) {
+  const RunFiles listed = {{"run.json", R"({"tool": "parcelscope", "outputs": ["parcels.csv", "figures/map.png"]})"},
+                           {"parcels.csv", "parcel_id\n1\n"},
+                           {"figures/map.png", "png"}};
+  for (const char* mine : {"notes.txt", "figures/mine.txt", "data/x.csv"}) {
+    TempDir dir;
+    const std::string target = dir.file("out");
+    commitRun(target, listed);
+    fs::create_directories(fs::path(target + "/" + mine).parent_path());
+    std::ofstream(target + "/" + mine) << "mine";
+    const auto before = snapshot(target);
+    try {
+      OutputDirectory out(target, {});
+      ADD_FAILURE() << mine << " beside a previous run was accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), Error::Kind::Usage) << e.what();
+      const std::string named = fs::path(mine).begin()->string() == "data" ? "data" : mine;
+      EXPECT_NE(std::string(e.what()).find(named), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(snapshot(target), before);
+  }
+  TempDir dir;  // the run's own files only: replaced
+  commitRun(dir.file("out"), listed);
+  commitRun(dir.file("out"), kSecond);
+  EXPECT_EQ(snapshot(dir.file("out")), snapshotOf(kSecond));
+  const RunFiles shard = {{"shard.json", R"({"tool": "parcelscope", "outputs": ["shard.bin", "shard.json"]})"},
+                          {"shard.bin", "bytes"}};
+  commitRun(dir.file("shard"), shard);
+  commitRun(dir.file("shard"), shard);
+  EXPECT_EQ(snapshot(dir.file("shard")), snapshotOf(shard));
+}
+
 // Bug: an --out holding an input (e.g. `generate s/blocks.gpkg --out s`) was
 // accepted; replacing it whole would delete the input.
 TEST(OutputDirectory, AnOutContainingAnInputIsRefused) {
