@@ -424,6 +424,16 @@ TEST(RenderHistogram, OverlaidSeriesInTheirColoursWithTextInTheSvg) {
     EXPECT_NE(svg.str().find(text), std::string::npos) << text;
   }
   EXPECT_THROW(renderHistogram("x", "x", "y", {0, 1, 2}, {{"bad", {1}, {}}}, out), Error);
+  // Texts holding XML's special characters (an input named "R&D <b>.geojson")
+  // are escaped: the title and the chart's text keep the file well formed.
+  renderHistogram("Parcel area, R&D <b>.geojson", "area", "parcels (count)", {0, 100, 200},
+                  {{"observed", {5, 10}, {0.84, 0.15, 0.16}}}, out);
+  std::stringstream escaped;
+  escaped << std::ifstream(out.vector).rdbuf();
+  EXPECT_EQ(escaped.str().find("R&D"), std::string::npos);
+  EXPECT_EQ(escaped.str().find("<b>"), std::string::npos);
+  EXPECT_NE(escaped.str().find("<title>Parcel area, R&amp;D &lt;b&gt;.geojson</title>"), std::string::npos);
+  EXPECT_NE(escaped.str().find(">Parcel area, R&amp;D &lt;b&gt;.geojson</text>"), std::string::npos);
 }
 
 // The band of the title (the top `share` of the image): no ink in the columns
