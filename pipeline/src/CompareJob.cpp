@@ -454,7 +454,7 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
                  .set("seed", static_cast<std::int64_t>(r.generated.seed))
                  .set("vtk", figures ? Json(renderer->version) : Json())
                  .set("parameters_given", given)
-                 .set("session", sessionJson(request));
+                 .set("session", sessionJson(withAbsolutePaths(request)));  // read from its own folder
   addObservedRecord(run, *r.observed);
   if (prepared) run.set("ranks", prepared->ranks).set("shards", prepared->shards);
   if (r.observed->streets) {

@@ -388,6 +388,14 @@ CompareSession::Update CompareSession::completeContext(const ProgressFn& progres
   return u;
 }
 
+CompareRequest withAbsolutePaths(CompareRequest request) {
+  request.input.path = std::filesystem::absolute(request.input.path).lexically_normal().string();
+  if (request.streets) {
+    request.streets->path = std::filesystem::absolute(request.streets->path).lexically_normal().string();
+  }
+  return request;
+}
+
 Json sessionJson(const CompareRequest& request) {
   Json parameters = Json::object();
   for (const auto& name : request.explicitParameters) {

@@ -617,9 +617,7 @@ JobOutcome runShard(const CompareRequest& request, int index, int count, const s
       file.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
       if (!file.flush()) throw ioError(outDir + "/shard.bin: cannot be written");
     }
-    CompareRequest absolute = request;
-    absolute.input.path = std::filesystem::absolute(request.input.path).lexically_normal().string();
-    io::writeJson(out.stage("session.json"), sessionJson(absolute));
+    io::writeJson(out.stage("session.json"), sessionJson(withAbsolutePaths(request)));
     const Json record = shardRecord(part)
                             .set("shards", count)
                             .set("tool", "parcelscope")

@@ -472,6 +472,24 @@ TEST(CompareCommand, SessionFileRerunsWithItsOverrides) {
   EXPECT_FALSE(test::sameGeometries(withOverride, written(c)));
 }
 
+// Bug: a run given a relative INPUT recorded it as given, and `compare
+// --session OUT/run.json` looked for it beside run.json. The record holds the
+// input's absolute path: the rerun works from any folder.
+TEST(CompareCommand, ARunGivenARelativeInputRerunsFromItsRecordAnywhere) {
+  TempDir dir;
+  fs::copy_file(kSample, dir.file("town.geojson"));
+  const std::string a = dir.file("a"), b = dir.file("b");
+  CliRun r = test::runShell("cd '" + dir.path().string() + "' && '" + PARCELSCOPE_CLI +
+                            "' compare town.geojson --figures 0 --out a --quiet");
+  ASSERT_EQ(r.code, 0) << r.output;
+  CPLJSONDocument run;
+  ASSERT_TRUE(run.Load(a + "/run.json"));
+  EXPECT_EQ(run.GetRoot().GetString("session/input/path"), dir.file("town.geojson"));
+  r = runCli("compare --session '" + a + "/run.json' --figures 0 --out '" + b + "' --quiet");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(test::slurp(a + "/generated_parcels.csv"), test::slurp(b + "/generated_parcels.csv"));
+}
+
 // calibrate: its session file through compare gives the calibrated measures,
 // and its figures (per-block fit map, histograms before and after) are drawn.
 TEST(CalibrateCommand, SessionReproducesTheCalibratedCityAndFiguresAreDrawn) {

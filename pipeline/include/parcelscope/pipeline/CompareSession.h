@@ -80,6 +80,11 @@ private:
 /// read by block id from a version 1 file is written back by block_id).
 Json sessionJson(const CompareRequest& request);
 
+/// `request` with its input's and streets' paths made absolute (a record
+/// written in another folder than the one they were given from: a run's
+/// run.json, a shard's session.json).
+CompareRequest withAbsolutePaths(CompareRequest request);
+
 /// Reads a session file (or the "session" member of a compare run.json), of
 /// version 2 (overrides by block_key) or 1 (overrides by block_id, which
 /// follow the order of the input's features: see BlockOverridesById).
