@@ -101,8 +101,10 @@ io::StreetReadOptions streetOptions(const Args& a, const std::string& path, cons
         if (eq != std::string::npos) w = std::stod(item.substr(eq + 1), &used);
       } catch (const std::exception&) {
       }
-      if (eq == std::string::npos || eq == 0 || used != item.size() - eq - 1 || !std::isfinite(w) || w < 0) {
-        throw usageError("--class-widths: '" + item + "' is not CLASS=METRES (a width of 0 or more)");
+      if (eq == std::string::npos || eq == 0 || used != item.size() - eq - 1 || !std::isfinite(w) || w < 0 ||
+          w > io::kMaxStreetWidth) {
+        throw usageError("--class-widths: '" + item + "' is not CLASS=METRES (a width of 0 to " +
+                         std::to_string(static_cast<int>(io::kMaxStreetWidth)) + " m)");
       }
       o.classWidths[item.substr(0, eq)] = w;
       at = comma + 1;

@@ -138,9 +138,10 @@ StreetLayer readStreets(const StreetReadOptions& options, const LocalFrame* fram
         while (end && (*end == ' ' || *end == '\t')) ++end;
         if (!end || *end != '\0') w = -1;
       }
-      if ((numeric || !std::isnan(w)) && (!std::isfinite(w) || w < 0)) {
+      if ((numeric || !std::isnan(w)) && (!std::isfinite(w) || w < 0 || w * widthUnit > kMaxStreetWidth)) {
         throw inputError(path + ": feature " + std::to_string(a.fid) + " has width '" + text + "' in field '" +
-                         options.widthField + "' (a width is a number of 0 or more)");
+                         options.widthField + "' (a width is a number of 0 or more, at most " +
+                         std::to_string(static_cast<int>(kMaxStreetWidth)) + " m)");
       }
       if (!std::isnan(w)) a.width = w * widthUnit;
     }

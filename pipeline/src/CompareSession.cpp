@@ -485,8 +485,9 @@ CompareRequest readSession(const std::string& path) {
     if (const Json* widths = st->find("class_widths"); widths && !widths->isNull()) {
       if (!widths->isObject()) throw bad("member streets.class_widths is not an object");
       for (const auto& [value, width] : widths->members()) {
-        if (!width.isNumber() || !(width.number() >= 0)) {
-          throw bad("member streets.class_widths." + value + " is not a width of 0 or more");
+        if (!width.isNumber() || !(width.number() >= 0) || width.number() > io::kMaxStreetWidth) {
+          throw bad("member streets.class_widths." + value + " is not a width of 0 to " +
+                    std::to_string(static_cast<int>(io::kMaxStreetWidth)) + " m");
         }
         o.classWidths[value] = width.number();
       }

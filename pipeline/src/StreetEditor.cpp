@@ -17,6 +17,7 @@
 #include "parcelscope/generation/ParcelMatching.h"
 #include "parcelscope/generation/Styles.h"
 #include "parcelscope/io/OutputDirectory.h"
+#include "parcelscope/io/StreetReader.h"
 #include "parcelscope/io/Writers.h"
 #include "parcelscope/pipeline/BlockSource.h"
 
@@ -91,6 +92,17 @@ std::size_t indexOf(const std::vector<Item>& items, Key key, const char* what) {
   }
   throw usageError(std::string("the network has no ") + what + " " + keyText(key));
 }
+// How far from the network's centre (the local frame's origin) an edit may
+// take a node or a street's point: 1,000 km.
+constexpr double kReach = 1e6;
+
+void requireWithinReach(const Point& p, const char* what) {
+  if (!(std::fabs(p.x) <= kReach && std::fabs(p.y) <= kReach)) {
+    throw usageError(std::string(what) + " beyond 1,000 km of the network's centre (a place that is not finite, " +
+                     "or a scale or move far too large)");
+  }
+}
+
 std::size_t indexOf(const std::vector<analysis::RoadNode>& nodes, Key key) { return indexOf(nodes, key, "node"); }
 std::size_t indexOf(const std::vector<analysis::RoadEdge>& edges, Key key) { return indexOf(edges, key, "edge"); }
 
@@ -552,8 +564,9 @@ EditReport StreetEditor::apply(const StreetEdit& edit) {
       }
       case StreetEdit::Op::SetWidth: {
         const std::size_t e = indexOf(g.edges, edit.edge);
-        if (!std::isfinite(edit.width) || edit.width <= 0) {
-          throw usageError("edge " + keyText(edit.edge) + ": a width must be a positive number of metres");
+        if (!std::isfinite(edit.width) || edit.width <= 0 || edit.width > io::kMaxStreetWidth) {
+          throw usageError("edge " + keyText(edit.edge) + ": a width must be a positive number of metres, at most " +
+                           std::to_string(static_cast<int>(io::kMaxStreetWidth)));
         }
         if (g.edges[e].boundary)
           throw usageError("edge " + keyText(edit.edge) + " is the study area's edge, not a street");
@@ -561,6 +574,9 @@ EditReport StreetEditor::apply(const StreetEdit& edit) {
         break;
       }
       case StreetEdit::Op::SetCurve:
+        if (edit.controls) {
+          for (const Point& c : *edit.controls) requireWithinReach(c, "a control point lies");
+        }
         analysis::setCurve(g, indexOf(g.edges, edit.edge), edit.controls);
         break;
       case StreetEdit::Op::TransformNodes: {
@@ -607,8 +623,9 @@ EditReport StreetEditor::apply(const StreetEdit& edit) {
       }
       case StreetEdit::Op::AddStreet: {
         auto end = [&](Key node, const Point& p) { return node ? g.nodes[indexOf(g.nodes, node)].at : p; };
-        if (!std::isfinite(edit.width) || edit.width <= 0) {
-          throw usageError("add_street: a width must be a positive number of metres");
+        if (!std::isfinite(edit.width) || edit.width <= 0 || edit.width > io::kMaxStreetWidth) {
+          throw usageError("add_street: a width must be a positive number of metres, at most " +
+                           std::to_string(static_cast<int>(io::kMaxStreetWidth)));
         }
         const Point a = end(edit.node, edit.from), b = end(edit.node2, edit.to);
         if (a.x == b.x && a.y == b.y) throw usageError("add_street: the street's ends are one point");
@@ -627,6 +644,12 @@ EditReport StreetEditor::apply(const StreetEdit& edit) {
       case StreetEdit::Op::SetLabel:
       case StreetEdit::Op::SetLock:
         break;
+    }
+    // Every node and street still at a finite place within reach (a scale of
+    // 1e12 gave coordinates of NaN).
+    for (const analysis::RoadNode& n : g.nodes) requireWithinReach(n.at, "the edit moves a node");
+    for (const analysis::RoadEdge& e : g.edges) {
+      for (const Point& p : e.line) requireWithinReach(p, "the edit moves a street");
     }
     const auto blocksStarted = std::chrono::steady_clock::now();
     if (cache_.faces.size() > 8 * std::max<std::size_t>(1, edited->blocks.blocks.size())) cache_ = {};

@@ -220,6 +220,12 @@ TEST(BlocksCommand, WidthsInATextFieldAndInFeetAreRead) {
   EXPECT_EQ(b.code, 1) << b.output;
   EXPECT_NE(b.output.find("has width 'wide' in field 'W'"), std::string::npos) << b.output;
   EXPECT_NE(b.output.find("bad.geojson: feature 1"), std::string::npos) << b.output;
+  // Bug: a width of 1e300 emptied the street surface and every block, exit 0.
+  const std::string huge = dir.write("huge.geojson", layer({"40", "40", "1e300", "40"}));
+  const CliRun h = run("blocks '" + huge + "' --width-field W --quiet --out '" + dir.file("h") + "'");
+  EXPECT_EQ(h.code, 1) << h.output;
+  EXPECT_NE(h.output.find("huge.geojson: feature 2 has width '1e300'"), std::string::npos) << h.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("h")));
 }
 
 TEST(BlocksCommand, BadStreetInputsAreOneLineErrors) {

@@ -579,6 +579,31 @@ TEST(StreetEditor, ABadEditNamesWhatIsWrongAndChangesNothing) {
   e.edge = editor.network().graph.edges.front().key;
   e.width = -2;
   EXPECT_THROW(editor.apply(e), Error);
+  // Bug: these gave NaN coordinates or emptied every block, written with exit 0.
+  e.width = 1e300;  // wider than any street
+  EXPECT_THROW(editor.apply(e), Error);
+  StreetEdit scale;  // nodes sent beyond reach
+  scale.op = StreetEdit::Op::TransformNodes;
+  scale.nodes = {editor.network().graph.nodes.front().key};
+  scale.scale = 1e12;
+  scale.centre = {-1, -1};
+  EXPECT_THROW(editor.apply(scale), Error);
+  StreetEdit curve;  // control points beyond reach
+  curve.op = StreetEdit::Op::SetCurve;
+  curve.edge = e.edge;
+  curve.controls = std::array<Point, 2>{Point{1e10, 1e10}, Point{-1e10, -1e10}};
+  EXPECT_THROW(editor.apply(curve), Error);
+  StreetEdit far;  // a node moved to where no coordinate is finite
+  far.op = StreetEdit::Op::MoveNode;
+  far.node = editor.network().graph.nodes.front().key;
+  far.to = {NAN, 0};
+  try {
+    editor.apply(far);
+    ADD_FAILURE() << "a node moved to NaN was accepted";
+  } catch (const Error& error) {
+    EXPECT_EQ(error.kind(), Error::Kind::Usage);
+    EXPECT_NE(std::string(error.what()).find("moves a node"), std::string::npos) << error.what();
+  }
   EXPECT_TRUE(sameState(snapshot(editor), before));
   EXPECT_EQ(editor.undoSize(), 0u);
 }

@@ -16,6 +16,10 @@
 
 namespace parcelscope::io {
 
+/// The widest street width taken (metres): a width field, a class width or an
+/// edit above it is an error (a street 1e300 m wide emptied every block).
+constexpr double kMaxStreetWidth = 1000.0;
+
 struct StreetReadOptions {
   std::string path;
   std::string layer;        ///< layer name; empty = the first layer
