@@ -223,6 +223,24 @@ static std::string fmt(double v) {
   return s.str();
 }
 
+// Lon/lat a local frame cannot hold: parcels within half a degree of a pole
+// (longitudes wrap there, and a parcel written back came out empty) or spread
+// over more than 180 degrees of longitude (across the antimeridian, a block
+// was written round the globe; or continents apart, with areas 46 % off).
+void requireOneLocalArea(const std::string& path, const Envelope& env, double degreesPerUnit) {
+  const double west = env.minX * degreesPerUnit, east = env.maxX * degreesPerUnit;
+  const double south = env.minY * degreesPerUnit, north = env.maxY * degreesPerUnit;
+  const std::string reproject = "; reproject the layer to a projected CRS of its area first (ogr2ogr -t_srs EPSG:N)";
+  if (north > 89.5 || south < -89.5) {
+    throw inputError(path + ": parcels reach latitude " + fmt(north > 89.5 ? north : south) +
+                     ", within half a degree of a pole, where lon/lat cannot be measured or written" + reproject);
+  }
+  if (east - west > 180) {
+    throw inputError(path + ": parcels span longitudes " + fmt(west) + " to " + fmt(east) +
+                     ", more than 180 degrees (across the antimeridian, or continents apart)" + reproject);
+  }
+}
+
 // Chooses the local frame and records the CRS, or throws when the CRS cannot be used.
 LocalFrame chooseFrame(const std::string& path, const OGRSpatialReference* srs, Envelope& env, CrsInfo& crs) {
   const Point c = env.centre();
@@ -233,6 +251,7 @@ LocalFrame chooseFrame(const std::string& path, const OGRSpatialReference* srs, 
       throw inputError(path + ": the layer declares no CRS and its coordinates (x " + fmt(env.minX) + " to " +
                        fmt(env.maxX) + ", y " + fmt(env.minY) + " to " + fmt(env.maxY) + ") are not degrees" + hint);
     }
+    requireOneLocalArea(path, env, 1.0);
     crs.assumedLonLat = true;
     crs.name = "assumed OGC:CRS84 (no CRS declared)";
     return LocalFrame::geographic(cx, cy);
@@ -251,6 +270,7 @@ LocalFrame chooseFrame(const std::string& path, const OGRSpatialReference* srs, 
                        " to " + fmt(env.maxX) + ", y " + fmt(env.minY) + " to " + fmt(env.maxY) +
                        ") cannot be degrees" + hint);
     }
+    requireOneLocalArea(path, env, degreesPerUnit);
     OGRErr err = OGRERR_NONE;
     const double a = srs->GetSemiMajor(&err);
     const double invf = srs->GetInvFlattening(&err);

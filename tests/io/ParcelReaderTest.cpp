@@ -4,6 +4,8 @@
 #include <gdal_utils.h>
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include <fstream>
 #include <random>
 #include <set>
@@ -284,6 +286,31 @@ TEST(ParcelReader, RefusesMissingUnreadableAndPolygonFreeInput) {
   const auto points =
       dir.write("points.geojson", test::collection(test::feature(R"({"type":"Point","coordinates":[2.35,48.85]})", 1)));
   expectError(options(points, "", "", ""), Error::Kind::Input, {"points.geojson", "no usable polygon"});
+}
+
+// Bug: a parcel around the North Pole was written back empty, a block across
+// the antimeridian round the whole globe, and a parcel a continent away from the
+// others measured 46 % too large, all with exit 0. Lon/lat that one local
+// frame cannot hold is refused, with the way out.
+TEST(ParcelReader, RefusesLonLatNearAPoleOrSpreadOverMoreThanHalfTheGlobe) {
+  TempDir dir;
+  const auto square = [](double x, double y, double d) {
+    std::ostringstream s;
+    s.precision(12);
+    s << R"({"type":"Polygon","coordinates":[[[)" << x << "," << y << "],[" << x + d << "," << y << "],[" << x + d
+      << "," << y + d << "],[" << x << "," << y + d << "],[" << x << "," << y << "]]]}";
+    return s.str();
+  };
+  const auto pole = dir.write("pole.geojson", test::collection(test::feature(square(0, 89.9995, 0.0002), 1)));
+  expectError(options(pole, "", "", ""), Error::Kind::Input, {"pole.geojson", "pole", "reproject"});
+  const auto across = dir.write("across.geojson", test::collection(test::feature(square(179.9998, 0, 0.0001), 1) + "," +
+                                                                   test::feature(square(-179.9999, 0, 0.0001), 2)));
+  expectError(options(across, "", "", ""), Error::Kind::Input, {"across.geojson", "antimeridian", "reproject"});
+  // Parcels near each other in the far north or east are taken.
+  const auto north = dir.write("north.geojson", test::collection(test::feature(square(25, 89.0, 0.0005), 1)));
+  EXPECT_EQ(readParcels(options(north, "", "", "")).parcels.size(), 1u);
+  const auto east = dir.write("east.geojson", test::collection(test::feature(square(179.99, 0, 0.0005), 1)));
+  EXPECT_EQ(readParcels(options(east, "", "", "")).parcels.size(), 1u);
 }
 
 TEST(ParcelReader, RefusesLonLatClaimForCoordinatesThatCannotBeDegrees) {
