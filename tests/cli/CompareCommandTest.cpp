@@ -395,6 +395,12 @@ TEST(CompareCommand, UnknownStyleIsAUsageErrorAndWritesNothing) {
   EXPECT_FALSE(fs::exists(dir.file("x")));
   EXPECT_EQ(runCli("compare " + kSampleArgs + " --bins 1 --out '" + dir.file("x") + "'").code, 2);
   EXPECT_EQ(runCli("compare --help").code, 0);
+  // Bug: 10000 x 10000 figures (each side in its range) took 8.9 GB and 6 minutes.
+  const CliRun huge = runCli("compare " + kSampleArgs + " --figure-width 10000 --figure-height 10000 --out '" +
+                             dir.file("x") + "' --quiet");
+  EXPECT_EQ(huge.code, 2) << huge.output;
+  EXPECT_NE(huge.output.find("16 million pixels"), std::string::npos) << huge.output;
+  EXPECT_FALSE(fs::exists(dir.file("x")));
 }
 
 TEST(CompareCommand, CtrlCLeavesNoOutputAndNoStagingFolder) {
