@@ -511,9 +511,14 @@ CompareRequest readSession(const std::string& path) {
                         std::set<std::string>* names) {
     for (const auto& [name, v] : object.members()) {
       if (!v.isNumber()) throw bad("member " + where + name + " is not a number");
-      const bool known = std::any_of(descriptions.begin(), descriptions.end(),
-                                     [&](const ParameterDescription& d) { return d.name == name; });
-      if (!known) throw bad("member " + where + name + " is not a parameter of compare");
+      const auto d = std::find_if(descriptions.begin(), descriptions.end(),
+                                  [&](const ParameterDescription& x) { return x.name == name; });
+      if (d == descriptions.end()) throw bad("member " + where + name + " is not a parameter of compare");
+      try {
+        checkValue(*d, v.number());  // said here, naming the file, not later as if given on the command line
+      } catch (const Error& e) {
+        throw bad("member " + where + name + ": " + e.what());
+      }
       into[name] = v.number();
       if (names) names->insert(name);
     }

@@ -515,6 +515,14 @@ TEST(SessionFile, BadMembersAreNamed) {
   EXPECT_NE(message(R"({"parcelscope_session": 1, "input": {"path": "x"}, "overrides": [{"style": "obb"}]})")
                 .find("overrides[0].block_key"),
             std::string::npos);
+  // Bug: a value out of range was told later, as if given on the command line.
+  EXPECT_NE(message(R"({"parcelscope_session": 2, "input": {"path": "x"}, "parameters": {"w-max": -3}})")
+                .find("parameters.w-max: --w-max -3 is outside"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"parcelscope_session": 2, "input": {"path": "x"},
+                        "overrides": [{"block_key": "00000000000000aa", "parameters": {"omega": 1e9}}]})")
+                .find("overrides[0].parameters.omega"),
+            std::string::npos);
 }
 
 // Every list of parameter descriptions, by the function that returns it.
