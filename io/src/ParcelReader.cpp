@@ -525,8 +525,23 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
     }
   }
   if (result.parcels.empty() && !shard) {
+    // Why, by reason; parts under 0.001 m2 mostly come from a CRS whose unit is
+    // not the data's (lon/lat read as metres).
+    std::string why;
+    const auto add = [&](std::int64_t n, const char* reason) {
+      if (n > 0) why += (why.empty() ? ": " : ", ") + std::to_string(n) + " " + reason;
+    };
+    add(report.nullOrEmpty, "null or empty");
+    add(report.nonPolygonal, "not polygons");
+    add(report.nonFiniteSkipped, "with coordinates that are not finite");
+    add(report.invalidSkipped, "invalid beyond repair");
+    add(report.degenerateSkipped, "degenerate parts (under 0.001 m2 or under 3 vertices)");
+    const bool tiny = report.degenerateSkipped > 0;
     throw inputError(path + ": layer " + result.layerName + " holds no usable polygon (" +
-                     std::to_string(report.features) + " features, all skipped)");
+                     std::to_string(report.features) + " features, all skipped" + why + ")" +
+                     (tiny ? (options.crsOverride.empty() ? "; is the layer's CRS right? (--crs EPSG:N)"
+                                                          : "; is --crs " + options.crsOverride + " the data's CRS?")
+                           : ""));
   }
   reportProgress(progress, 1.0, "cleaning");
   timings.stop();

@@ -313,6 +313,20 @@ TEST(ParcelReader, RefusesLonLatNearAPoleOrSpreadOverMoreThanHalfTheGlobe) {
   EXPECT_EQ(readParcels(options(east, "", "", "")).parcels.size(), 1u);
 }
 
+// Bug: lon/lat given --crs EPSG:3857 (metres) made every parcel a speck, and
+// the error said only "all skipped". It says why, and asks about the CRS.
+TEST(ParcelReader, AllSkippedSaysWhyAndAsksAboutTheCrsWhenEveryPartIsASpeck) {
+  TempDir dir;
+  const auto path = dir.write(
+      "lonlat.geojson",
+      test::collection(test::feature(
+          R"({"type":"Polygon","coordinates":[[[-71.1,42.37],[-71.0999,42.37],[-71.0999,42.3701],[-71.1,42.3701],[-71.1,42.37]]]})",
+          1)));
+  EXPECT_EQ(readParcels(options(path, "", "", "")).parcels.size(), 1u);
+  expectError(options(path, "", "", "EPSG:3857"), Error::Kind::Input,
+              {"lonlat.geojson", "all skipped: 1 degenerate", "is --crs EPSG:3857 the data's CRS?"});
+}
+
 TEST(ParcelReader, RefusesLonLatClaimForCoordinatesThatCannotBeDegrees) {
   TempDir dir;
   const auto path = dir.write("feet.geojson", feetGeoJson());
