@@ -273,6 +273,11 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
 
   ParcelLayer result;
   result.path = path;
+  // A failure GDAL reports while opening a layer it still opens (a VRT whose
+  // source file is missing): the reason, should no feature come of it.
+  CPLErrorReset();
+  layer->GetLayerDefn();
+  const std::string openFailure = CPLGetLastErrorType() >= CE_Failure ? lastGdalMessage() : "";
   result.layerName = layer->GetName();
   CleaningReport& report = result.report;
 
@@ -436,7 +441,11 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
                      " (" + featuresText + ")");
   }
   if (!shard && features.empty()) {
-    throw inputError(path + ": layer " + result.layerName + " holds no polygon geometry (" + featuresText + ")");
+    // GDAL's reason when reading failed (a VRT whose source file is missing).
+    const std::string gdal = !openFailure.empty()                  ? "; GDAL: " + openFailure
+                             : CPLGetLastErrorType() >= CE_Failure ? "; GDAL: " + lastGdalMessage()
+                                                                   : "";
+    throw inputError(path + ": layer " + result.layerName + " holds no polygon geometry (" + featuresText + ")" + gdal);
   }
 
   if (filtered && !shard->frame && shard->exchange) {

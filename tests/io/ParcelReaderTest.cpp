@@ -327,6 +327,14 @@ TEST(ParcelReader, AllSkippedSaysWhyAndAsksAboutTheCrsWhenEveryPartIsASpeck) {
               {"lonlat.geojson", "all skipped: 1 degenerate", "is --crs EPSG:3857 the data's CRS?"});
 }
 
+// Bug: a VRT whose source file is missing said only "no polygon geometry".
+TEST(ParcelReader, AVrtWhoseSourceIsMissingSaysSo) {
+  TempDir dir;
+  const auto vrt = dir.write("missing.vrt", R"(<OGRVRTDataSource><OGRVRTLayer name="x">
+      <SrcDataSource>nonexistent.geojson</SrcDataSource></OGRVRTLayer></OGRVRTDataSource>)");
+  expectError(options(vrt, "", "", ""), Error::Kind::Input, {"missing.vrt", "nonexistent.geojson"});
+}
+
 TEST(ParcelReader, RefusesLonLatClaimForCoordinatesThatCannotBeDegrees) {
   TempDir dir;
   const auto path = dir.write("feet.geojson", feetGeoJson());
