@@ -326,6 +326,7 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
   // Features by the hash of their WKB; the bytes are compared again (exported
   // anew) only when hashes meet, so no copy of every geometry is kept.
   std::unordered_multimap<std::size_t, std::size_t> byHash;
+  std::unordered_map<Key, std::int64_t> fieldKeyOwner;  // key field value -> first feature id
   std::string wkb, earlier;
   auto exportWkb = [](const OGRGeometry& g, std::string& out) {
     out.resize(static_cast<std::size_t>(g.WkbSize()));
@@ -374,6 +375,15 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
       // The stack's key is the least of its features' keys, whatever their order.
       original->key = std::min(original->key, key);
       return;
+    }
+    if (raw.fieldKey) {
+      // Another geometry with the same key field value: keys would collide.
+      const auto [seen, fresh] = fieldKeyOwner.emplace(*raw.fieldKey, raw.fid);
+      if (!fresh) {
+        throw inputError(path + ": features " + std::to_string(seen->second) + " and " + std::to_string(raw.fid) +
+                         " have the same value in --key-field " + options.keyField +
+                         " (a key names one parcel; give a field of unique values, or no --key-field)");
+      }
     }
     if (!coordinatesFinite(*g) || !std::isfinite(e.MinX) || !std::isfinite(e.MinY) || !std::isfinite(e.MaxX) ||
         !std::isfinite(e.MaxY) || std::fabs(e.MinX) > 1e12 || std::fabs(e.MaxX) > 1e12 || std::fabs(e.MinY) > 1e12 ||

@@ -399,6 +399,25 @@ TEST(ParcelReaderKeys, KeysComeFromGeometriesOrFromTheKeyField) {
   o.keyField = "block_key";
   EXPECT_EQ(readParcels(o).parcels[0].featureKey, Key{255});
 
+  // Bug: two geometries with one key field value were taken, their parcels
+  // then sharing a key. Copies of one geometry (a condominium stack) may share it.
+  const auto twice = dir.write(
+      "twice.geojson", R"({"type":"FeatureCollection","features":[)"
+                       R"({"type":"Feature","properties":{"pid":"7"},"geometry":)" +
+                           square(0) + R"(},{"type":"Feature","properties":{"pid":"7"},"geometry":)" + square(0) +
+                           R"(},{"type":"Feature","properties":{"pid":"7"},"geometry":)" + square(20) + "}]}");
+  o.path = twice;
+  o.keyField = "pid";
+  try {
+    readParcels(o);
+    FAIL() << "one key field value on two geometries is an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), Error::Kind::Input);
+    EXPECT_NE(std::string(e.what()).find("twice.geojson: features 0 and 2 have the same value in --key-field pid"),
+              std::string::npos)
+        << e.what();
+  }
+
   o.path = path;
   o.keyField = "nothing";
   try {
