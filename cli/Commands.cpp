@@ -190,6 +190,11 @@ int dispatch(const std::vector<std::string>& args) {
   }
   const std::vector<std::string> rest(args.begin() + 1, args.end());
   if (args[0] == "version" || args[0] == "--version") {
+    if (rest.size() == 1 && (rest[0] == "--help" || rest[0] == "-h")) {
+      std::puts("parcelscope version: prints the version of ParcelScope (no arguments)");
+      return 0;
+    }
+    if (!rest.empty()) throw usageError("version takes no arguments ('" + rest.front() + "' given)");
     std::printf("parcelscope %s\n", pipeline::version().c_str());
     return 0;
   }

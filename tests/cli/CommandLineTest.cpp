@@ -97,6 +97,12 @@ TEST(StatsCommand, UsageErrorsExitTwo) {
   EXPECT_NE(r.output.find("--k"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir.file("x")));
   EXPECT_EQ(run("stats --help").code, 0);
+  // Bug: `version extra` printed the version and exited 0.
+  EXPECT_EQ(run("version").code, 0);
+  EXPECT_EQ(run("version --help").code, 0);
+  const CliRun v = run("version extra");
+  EXPECT_EQ(v.code, 2);
+  EXPECT_NE(v.output.find("'extra'"), std::string::npos) << v.output;
 }
 
 // The first line of the output (the error; a usage error adds a second line

@@ -515,6 +515,8 @@ TEST(SessionFile, BadMembersAreNamed) {
   EXPECT_NE(message(R"({"parcelscope_session": 1, "input": {"path": "x"}, "overrides": [{"style": "obb"}]})")
                 .find("overrides[0].block_key"),
             std::string::npos);
+  // Bug: a session of a later version (99) was read as if it were this one's.
+  EXPECT_NE(message(R"({"parcelscope_session": 99, "input": {"path": "x"}})").find("version 99"), std::string::npos);
   // Bug: a value out of range was told later, as if given on the command line.
   EXPECT_NE(message(R"({"parcelscope_session": 2, "input": {"path": "x"}, "parameters": {"w-max": -3}})")
                 .find("parameters.w-max: --w-max -3 is outside"),
