@@ -165,12 +165,15 @@ private:
 
   // The pieces of the split, or nothing when a piece is too small (see kMinPieceShare).
   static std::vector<Polygon> piecesOf(const Polygon& lot, double lotArea, const SplitLine& line) {
-    std::vector<Polygon> pieces = detail::splitLot(lot, lotArea, line);
-    for (const Polygon& q : pieces) {
-      const double share = area(q) / lotArea;
-      if (share < kMinPieceShare || share > 1 - kMinPieceShare) return {};
-    }
-    return pieces;
+    const auto shared = [&](const std::vector<Polygon>& pieces) {
+      for (const Polygon& q : pieces) {
+        const double share = area(q) / lotArea;
+        if (share < kMinPieceShare || share > 1 - kMinPieceShare) return false;
+      }
+      return true;
+    };
+    std::vector<Polygon> pieces = detail::splitLot(lot, lotArea, line, true, shared);
+    return shared(pieces) ? pieces : std::vector<Polygon>{};
   }
 
   const Polygon& block_;
