@@ -113,6 +113,7 @@ void requireBlocks(const CompareRequest& request, const pipeline::ObservedData& 
 }
 
 void checkRequest(const CompareRequest& request) {
+  if (request.style != "all") requireStyle(request.style);  // before the input is read
   for (const auto& d : compareParameters()) {
     const auto it = request.parameters.find(d.name);
     if (it != request.parameters.end()) checkValue(d, it->second);

@@ -64,6 +64,8 @@ const std::vector<StreetWidths>& streetWidthsOf(BlockInputs& inputs) {
   return inputs.widths;
 }
 
+void requireStyle(const std::string& style) { checkStyle(style, true); }
+
 std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInputs& inputs,
                                   std::int64_t* clampedBounds) {
   checkStyle(request.style, true);

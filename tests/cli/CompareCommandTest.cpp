@@ -395,6 +395,12 @@ TEST(CompareCommand, UnknownStyleIsAUsageErrorAndWritesNothing) {
   EXPECT_FALSE(fs::exists(dir.file("x")));
   EXPECT_EQ(runCli("compare " + kSampleArgs + " --bins 1 --out '" + dir.file("x") + "'").code, 2);
   EXPECT_EQ(runCli("compare --help").code, 0);
+  // Told before the input is read (it was after reading it): an input that
+  // does not exist is not reached.
+  const CliRun early =
+      runCli("compare '" + dir.file("absent.geojson") + "' --style voronoi --out '" + dir.file("x") + "' --quiet");
+  EXPECT_EQ(early.code, 2) << early.output;
+  EXPECT_NE(early.output.find("voronoi is not available"), std::string::npos) << early.output;
   // Bug: 10000 x 10000 figures (each side in its range) took 8.9 GB and 6 minutes.
   const CliRun huge = runCli("compare " + kSampleArgs + " --figure-width 10000 --figure-height 10000 --out '" +
                              dir.file("x") + "' --quiet");

@@ -155,6 +155,10 @@ struct BlockPlan {
   bool operator!=(const BlockPlan& other) const { return !(*this == other); }
 };
 
+/// Throws Error(Usage) naming the styles when `style` is not one (auto
+/// included): said before any input is read.
+void requireStyle(const std::string& style);
+
 /// The plan of every entry of `inputs` under `request`: auto resolved, per-block
 /// bounds clamped into range (counted in `clampedBounds`), the user's explicit
 /// values and the block overrides applied. Throws Error(Usage) on an unknown
