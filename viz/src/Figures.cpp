@@ -49,7 +49,6 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <limits>
 #include <unordered_map>
@@ -197,56 +196,6 @@ vtkSmartPointer<vtkRenderWindow> offscreenWindow(const FigureOutput& out) {
 // after the scene was drawn (and laid out) once, and returns whether it changed
 // it, which is then drawn again; `beforeVector` may change the scene between
 // the PNG and the vector copy.
-// GL2PS writes the texts of an SVG (its <title>, each <text>) as they are:
-// an input named "R&D.geojson" in a chart's title made the file unreadable
-// as XML. Their characters are escaped here, in place.
-void escapeSvgTexts(const std::string& path) {
-  std::string svg;
-  {
-    std::ifstream in(path, std::ios::binary);
-    svg.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
-  std::string out;
-  out.reserve(svg.size());
-  std::size_t at = 0;
-  while (at < svg.size()) {
-    std::size_t open = std::string::npos;
-    const char* closing = nullptr;
-    for (const char* tag : {"<title", "<text"}) {
-      const std::size_t found = svg.find(tag, at);
-      if (found < open) {
-        open = found;
-        closing = std::string(tag) == "<title" ? "</title>" : "</text>";
-      }
-    }
-    const std::size_t start = open == std::string::npos ? std::string::npos : svg.find('>', open);
-    const std::size_t end = start == std::string::npos ? std::string::npos : svg.find(closing, start);
-    if (end == std::string::npos) break;
-    out.append(svg, at, start + 1 - at);
-    for (std::size_t i = start + 1; i < end; ++i) {
-      switch (svg[i]) {
-        case '&':
-          out += "&amp;";
-          break;
-        case '<':
-          out += "&lt;";
-          break;
-        case '>':
-          out += "&gt;";
-          break;
-        default:
-          out += svg[i];
-      }
-    }
-    at = end;
-  }
-  out.append(svg, at, std::string::npos);
-  std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  file << out;
-  file.close();
-  if (!file) throw ioError(path + ": cannot write vector figure");
-}
-
 void writeFigure(vtkRenderWindow* window, const FigureOutput& out, const std::string& title,
                  const std::function<bool()>& adjust = {}, const std::function<void()>& beforeVector = {}) {
   window->Render();
@@ -288,7 +237,7 @@ void writeFigure(vtkRenderWindow* window, const FigureOutput& out, const std::st
   exporter->Write();
   if (!std::filesystem::exists(path)) throw ioError(out.vector + ": cannot write vector figure");
   if (path.extension() == ".pdf") detail::compressPdfStreams(out.vector);
-  if (path.extension() == ".svg") escapeSvgTexts(out.vector);
+  if (path.extension() == ".svg") detail::escapeSvgTexts(out.vector);
 }
 
 vtkSmartPointer<vtkLookupTable> lookupTable(const ColourScale& scale) {

@@ -1,5 +1,6 @@
 #pragma once
-// PDF files written by others (VTK's GL2PS export) made smaller in place.
+// Vector files written by others (VTK's GL2PS export) mended in place: PDFs made
+// smaller, SVGs made well-formed XML.
 #include <string>
 
 namespace parcelscope::viz::detail {
@@ -11,5 +12,14 @@ namespace parcelscope::viz::detail {
 /// streams compressed. Throws Error(IO) when the file cannot be read, parsed
 /// or written (it is then left as it was).
 int compressPdfStreams(const std::string& path);
+
+/// Appends `text` to `out` as XML character data (&, < and > escaped).
+void appendXmlText(std::string& out, const std::string& text);
+
+/// Escapes, in place, the characters of the SVG at `path`'s texts (its
+/// <title> and each <text>): GL2PS writes them as they are, and an input named
+/// "R&D.geojson" in a chart's title made the file unreadable as XML. Throws
+/// Error(IO) when the file cannot be written.
+void escapeSvgTexts(const std::string& path);
 
 }  // namespace parcelscope::viz::detail

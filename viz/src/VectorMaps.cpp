@@ -95,22 +95,9 @@ public:
               : anchor == Anchor::Middle ? "middle"
                                          : "end")
           << '"' << (bold ? " font-weight=\"bold\"" : "") << '>';
-    for (char c : utf8) {
-      switch (c) {
-        case '&':
-          body_ << "&amp;";
-          break;
-        case '<':
-          body_ << "&lt;";
-          break;
-        case '>':
-          body_ << "&gt;";
-          break;
-        default:
-          body_ << c;
-      }
-    }
-    body_ << "</text>\n";
+    std::string escaped;
+    detail::appendXmlText(escaped, utf8);
+    body_ << escaped << "</text>\n";
   }
   void save(const std::string& path) override { writeFile(path, body_.str() + "</svg>\n"); }
 
@@ -386,6 +373,52 @@ std::string deflate(const std::string& raw, const std::string& path) {
   return packed;
 }
 }  // namespace
+
+void appendXmlText(std::string& out, const std::string& text) {
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      default:
+        out += c;
+    }
+  }
+}
+
+void escapeSvgTexts(const std::string& path) {
+  std::string svg;
+  {
+    std::ifstream in(path, std::ios::binary);
+    svg.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  std::string out;
+  out.reserve(svg.size());
+  std::size_t at = 0;
+  while (at < svg.size()) {
+    // The next <title> or <text>, its content from the end of its opening tag.
+    const std::size_t title = svg.find("<title", at), text = svg.find("<text", at);
+    const std::size_t open = std::min(title, text);
+    const char* closing = open == title ? "</title>" : "</text>";
+    const std::size_t start = open == std::string::npos ? std::string::npos : svg.find('>', open);
+    const std::size_t end = start == std::string::npos ? std::string::npos : svg.find(closing, start);
+    if (end == std::string::npos) break;
+    out.append(svg, at, start + 1 - at);
+    appendXmlText(out, svg.substr(start + 1, end - start - 1));
+    at = end;
+  }
+  out.append(svg, at, std::string::npos);
+  std::ofstream file(path, std::ios::binary | std::ios::trunc);
+  file << out;
+  file.close();
+  if (!file) throw ioError(path + ": cannot write vector figure");
+}
 
 int compressPdfStreams(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
