@@ -4,8 +4,10 @@
 #include <cmath>
 #include <iterator>
 #include <map>
+#include <optional>
 
 #include "Exact.h"
+#include "parcelscope/core/GeosOps.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
@@ -238,12 +240,59 @@ bool isStrictlySimple(const Ring& ring) {
   return p.size() >= 3 && p.is_simple();
 }
 
+namespace {
+// Whether no two rings of the polygon share a point (exact predicates on the
+// doubles): edges in the order of their boxes' least x, each tested against
+// the edges of other rings whose boxes meet its own. Null when that takes
+// more than `budget` box tests (many long edges side by side).
+std::optional<bool> ringsApart(const Polygon& polygon, std::uint64_t budget) {
+  struct Edge {
+    double minX, maxX, minY, maxY;
+    std::size_t ring;
+    Point a, b;
+  };
+  std::vector<Edge> edges;
+  for (std::size_t k = 0; k <= polygon.holes.size(); ++k) {
+    const Ring& r = k == 0 ? polygon.outer : polygon.holes[k - 1];
+    for (std::size_t i = 0, n = r.size(); i < n; ++i) {
+      const Point& a = r[i];
+      const Point& b = r[(i + 1) % n];
+      edges.push_back({std::min(a.x, b.x), std::max(a.x, b.x), std::min(a.y, b.y), std::max(a.y, b.y), k, a, b});
+    }
+  }
+  std::sort(edges.begin(), edges.end(), [](const Edge& e, const Edge& f) { return e.minX < f.minX; });
+  using Epick = CGAL::Exact_predicates_inexact_constructions_kernel;
+  std::uint64_t tests = 0;
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    const Edge& e = edges[i];
+    for (std::size_t j = i + 1; j < edges.size() && edges[j].minX <= e.maxX; ++j) {
+      if (++tests > budget) return std::nullopt;
+      const Edge& f = edges[j];
+      if (f.ring == e.ring || f.minY > e.maxY || f.maxY < e.minY) continue;
+      if (CGAL::do_intersect(Epick::Segment_2({e.a.x, e.a.y}, {e.b.x, e.b.y}),
+                             Epick::Segment_2({f.a.x, f.a.y}, {f.b.x, f.b.y}))) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+}  // namespace
+
 bool isValidForSplit(const Polygon& polygon) {
   if (polygon.outer.size() < 3) return false;
   // A strictly simple ring is valid (toExact orients it). This test is far
   // cheaper than the Boolean-operations validation, which still judges
   // everything else (touching rings, holes).
   if (polygon.holes.empty() && isStrictlySimple(polygon.outer)) return true;
+  // With holes: GEOS's validity (simple rings, holes inside the outer ring,
+  // none inside another, no crossing) of rings that share no point is CGAL's
+  // too, and far cheaper on many holes (CGAL's validation took half a minute
+  // on a block of 1,600 holes). Rings that touch, or too many edges side by
+  // side to tell, go to CGAL.
+  if (!polygon.holes.empty() && geos::isValid(polygon) && ringsApart(polygon, 50000000).value_or(false)) {
+    return true;
+  }
   return isValidExact(toExact(polygon));
 }
 

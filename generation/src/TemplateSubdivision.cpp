@@ -652,7 +652,8 @@ public:
 
 private:
   static constexpr int kMaxDepth = 6;
-  static constexpr double kMinShare = 0.02;  // of the region, the least piece of a split without template
+  static constexpr double kMinShare = 0.02;     // of the region, the least piece of a split without template
+  static constexpr std::size_t kMaxLines = 64;  // lines tried to split a region no template fits
 
   bool fit(const Polygon& region, Ring ring) {
     std::vector<Corner> corners = detail::cornersOf(ring, kCornerTurn, kMaxCorners, kShortSide);
@@ -833,7 +834,10 @@ private:
       return;
     }
     const double whole = area(region);
-    for (const detail::SplitLine& line : lines) {
+    // The first kMaxLines only: each is an exact cut of the whole region (a
+    // block of 1,600 holes offered 6,400 lines, none usable, for five minutes).
+    for (std::size_t k = 0; k < lines.size() && k < kMaxLines; ++k) {
+      const detail::SplitLine& line = lines[k];
       std::vector<Polygon> pieces = cutAlong(region, whole, line);
       if (pieces.size() < 2) continue;
       for (const Polygon& piece : pieces) subdivide(piece, depth + 1);

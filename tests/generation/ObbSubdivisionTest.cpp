@@ -86,6 +86,27 @@ TEST(ObbSubdivision, HolesAreKeptOutOfParcels) {
   EXPECT_TILES(block, s.parcels, "courtyard block");
 }
 
+// A block of 900 small courtyards on a grid (its validity was once checked
+// by CGAL's Boolean operations alone: minutes for such blocks) is subdivided
+// into a tiling that keeps every courtyard out.
+TEST(ObbSubdivision, BlockWithManyHolesIsSubdivided) {
+  Polygon block = rect(0, 0, 1000, 1000);
+  for (int i = 0; i < 30; ++i) {
+    for (int j = 0; j < 30; ++j) {
+      const double x = 20 + 32 * i, y = 20 + 32 * j;
+      block.holes.push_back({{x, y}, {x, y + 6}, {x + 6, y + 6}, {x + 6, y}});
+    }
+  }
+  normalise(block);
+  const Subdivision s = subdivideObb(block, params(2000, 8000, 20, 120), 5);
+  ASSERT_FALSE(s.failed) << s.failure;
+  EXPECT_GT(s.parcels.size(), 60u);
+  std::size_t holes = 0;
+  for (const Polygon& p : s.parcels) holes += p.holes.size();
+  EXPECT_GT(holes, 0u);
+  EXPECT_TILES(block, s.parcels, "block of 900 courtyards");
+}
+
 TEST(ObbSubdivision, SelfIntersectingBlockComesBackWholeAndFlagged) {
   const Polygon bowtie = poly({{0, 0}, {100, 100}, {100, 0}, {0, 100}});
   const Subdivision s = subdivideObb(bowtie, params(100, 500, 5, 30), 1);

@@ -7,8 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
+#include <string>
 
+#include "Exact.h"
 #include "TestUtil.h"
 #include "generation/RandomShapes.h"
 
@@ -321,6 +324,66 @@ TEST(PolygonSplit, HolesOffTheLineGoToThePieceHoldingThem) {
   const SplitPieces e = splitByLine(u, {15, 15}, {-1, 0});
   EXPECT_TRUE(samePieces(s.left, e.left, 1e-9));
   EXPECT_TRUE(samePieces(s.right, e.right, 1e-9));
+}
+
+// The validity check of a block with holes (GEOS's validity and rings that
+// share no point, else CGAL's) agrees with CGAL's own on holes apart, touching
+// the outer ring or each other at a vertex or along an edge, crossing,
+// nested, outside, and on random squares in random shapes.
+TEST(PolygonSplit, ValidityWithHolesAgreesWithTheExactCheck) {
+  const auto square = [](double x, double y, double s) { return Ring{{x, y}, {x, y + s}, {x + s, y + s}, {x + s, y}}; };
+  const auto agrees = [](Polygon p, const std::string& what) {
+    normalise(p);
+    const bool exact = isValidExact(toExact(p));
+    EXPECT_EQ(isValidForSplit(p), exact) << what;
+    return exact;
+  };
+  Polygon apart = rect(0, 0, 100, 100);
+  for (int i = 0; i < 4; ++i) apart.holes.push_back(square(10 + 20 * i, 10, 5));
+  EXPECT_TRUE(agrees(apart, "holes apart"));
+  Polygon touchOuter = rect(0, 0, 100, 100);
+  touchOuter.holes.push_back({{0, 50}, {10, 60}, {10, 40}});
+  agrees(touchOuter, "a hole touching the outer ring at a vertex");
+  Polygon touchEachOther = rect(0, 0, 100, 100);
+  touchEachOther.holes = {square(10, 10, 10), square(20, 20, 10)};
+  agrees(touchEachOther, "holes touching at a vertex");
+  Polygon sharedEdge = rect(0, 0, 100, 100);
+  sharedEdge.holes = {square(10, 10, 10), square(20, 10, 10)};
+  EXPECT_FALSE(agrees(sharedEdge, "holes sharing an edge"));
+  Polygon crossing = rect(0, 0, 100, 100);
+  crossing.holes = {square(90, 40, 20)};
+  EXPECT_FALSE(agrees(crossing, "a hole crossing the outer ring"));
+  Polygon outside = rect(0, 0, 100, 100);
+  outside.holes = {square(200, 40, 20)};
+  EXPECT_FALSE(agrees(outside, "a hole outside"));
+  Polygon nested = rect(0, 0, 100, 100);
+  nested.holes = {square(10, 10, 50), square(20, 20, 10)};
+  EXPECT_FALSE(agrees(nested, "a hole inside another"));
+  Polygon overlapping = rect(0, 0, 100, 100);
+  overlapping.holes = {square(10, 10, 20), square(20, 20, 20)};
+  EXPECT_FALSE(agrees(overlapping, "overlapping holes"));
+
+  std::mt19937_64 rng = test::seededRandom(12, "validity with holes");
+  std::uniform_real_distribution<double> u(0, 1);
+  int valid = 0, invalid = 0;
+  for (int i = 0; i < 300 / test::kSanitizerDivisor; ++i) {
+    Polygon block = test::randomShape(rng, i % 4);
+    if (!normalise(block)) continue;
+    const Box b = bounds(block);
+    const double side = (0.02 + 0.1 * u(rng)) * std::min(b.width(), b.height());
+    // Squares on a coarse grid: some apart, some touching or overlapping, some
+    // across the outer ring or outside it.
+    const int count = 1 + static_cast<int>(u(rng) * 6);
+    for (int k = 0; k < count; ++k) {
+      const double x = b.minX + std::floor(u(rng) * 8) / 8 * b.width();
+      const double y = b.minY + std::floor(u(rng) * 8) / 8 * b.height();
+      block.holes.push_back(square(x, y, side));
+    }
+    (agrees(block, "random shape " + std::to_string(i)) ? valid : invalid)++;
+  }
+  std::printf("%d valid, %d invalid\n", valid, invalid);
+  EXPECT_GT(valid, 20 / test::kSanitizerDivisor);
+  EXPECT_GT(invalid, 20 / test::kSanitizerDivisor);
 }
 
 TEST(PolygonSplit, FastSplitDeclinesWhatOnlyTheExactSplitHandles) {
