@@ -114,6 +114,7 @@ void requireBlocks(const CompareRequest& request, const pipeline::ObservedData& 
 
 void checkRequest(const CompareRequest& request) {
   if (request.style != "all") requireStyle(request.style);  // before the input is read
+  requireGeneratorParameters(request.parameters);
   for (const auto& d : compareParameters()) {
     const auto it = request.parameters.find(d.name);
     if (it != request.parameters.end()) checkValue(d, it->second);
@@ -520,7 +521,9 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
                 static_cast<long long>(r.generated.failedBlocks), r.city.area.ks, r.city.width.ks,
                 r.city.aspectRatio.ks, r.city.area.wasserstein, r.city.width.wasserstein,
                 r.city.observed.undesirableShare, r.city.generated.undesirableShare, secondsSince(started));
-  return {run, summarize(*r.observed) + line};
+  std::string told = summarize(*r.observed) + line;
+  if (r.generated.clampedBounds > 0) told += "\n  " + clampedBoundsNote(r.generated.clampedBounds);
+  return {run, told};
 }
 
 }  // namespace

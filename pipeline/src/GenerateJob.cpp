@@ -66,26 +66,39 @@ const std::vector<StreetWidths>& streetWidthsOf(BlockInputs& inputs) {
 
 void requireStyle(const std::string& style) { checkStyle(style, true); }
 
+std::string clampedBoundsNote(std::int64_t clamped) {
+  return std::to_string(clamped) +
+         " per-block bounds outside their parameter's range (an A_max below 1 m2 from a block of slivers, a "
+         "negative A_min) were moved to the range's end (run.json: per_block_bounds_clamped)";
+}
+
+namespace {
+// The generator parameters of `values` in their ranges and the bound pairs in
+// order. The run's values also hold analysis and comparison parameters; an
+// override holds generator parameters only (strict).
+void checkGeneratorValues(const ParameterValues& values, const std::string& where, bool strict) {
+  static const std::vector<ParameterDescription> descriptions = generationParameterDescriptions();
+  for (const auto& [name, v] : values) {
+    const auto d = std::find_if(descriptions.begin(), descriptions.end(),
+                                [&](const ParameterDescription& x) { return x.name == name; });
+    if (d == descriptions.end()) {
+      if (!strict) continue;
+      throw usageError(where + ": no generator parameter named '" + name + "'");
+    }
+    checkValue(*d, v);
+  }
+  const ObbParameters p = obbParametersFrom(values);
+  if (p.aMin > p.aMax) throw usageError((where.empty() ? "" : where + ": ") + "--a-min must not exceed --a-max");
+  if (p.wMin > p.wMax) throw usageError((where.empty() ? "" : where + ": ") + "--w-min must not exceed --w-max");
+}
+}  // namespace
+
+void requireGeneratorParameters(const ParameterValues& values) { checkGeneratorValues(values, "", false); }
+
 std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInputs& inputs,
                                   std::int64_t* clampedBounds) {
   checkStyle(request.style, true);
-  const std::vector<ParameterDescription> descriptions = generationParameterDescriptions();
-  // The run's values also hold analysis and comparison parameters; an
-  // override holds generator parameters only (strict).
-  auto check = [&](const ParameterValues& values, const std::string& where, bool strict) {
-    for (const auto& [name, v] : values) {
-      const auto d = std::find_if(descriptions.begin(), descriptions.end(),
-                                  [&](const ParameterDescription& x) { return x.name == name; });
-      if (d == descriptions.end()) {
-        if (!strict) continue;
-        throw usageError(where + ": no generator parameter named '" + name + "'");
-      }
-      checkValue(*d, v);
-    }
-    const ObbParameters p = obbParametersFrom(values);
-    if (p.aMin > p.aMax) throw usageError((where.empty() ? "" : where + ": ") + "--a-min must not exceed --a-max");
-    if (p.wMin > p.wMax) throw usageError((where.empty() ? "" : where + ": ") + "--w-min must not exceed --w-max");
-  };
+  const auto check = checkGeneratorValues;
   check(request.parameters, "", false);
   std::set<std::int64_t> ids;
   std::set<Key> keys;
@@ -339,6 +352,7 @@ Json variantCounts(const std::map<std::string, std::int64_t>& blocksByVariant) {
 
 GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& progress) {
   checkStyle(request.style, true);
+  requireGeneratorParameters(request.parameters);  // before the input is read
   BlockInputs inputs = prepareBlocks(request, scaledProgress(progress, 0.0, request.fromParcels ? 0.4 : 0.2));
   std::int64_t clamped = 0;
   const std::vector<BlockPlan> plans = planBlocks(request, inputs, &clamped);
@@ -496,6 +510,7 @@ JobOutcome writeGenerate(io::OutputDirectory& out, const GenerateRequest& reques
            : "") +
       std::to_string(g.fallbackBlocks) + " blocks fell back to obb, " + std::to_string(g.failedBlocks) +
       " blocks refused";
+  if (g.clampedBounds > 0) summary += "\n  " + clampedBoundsNote(g.clampedBounds);
   for (const auto& f : g.failures) summary += "\n  " + f;
   return {run, summary};
 }

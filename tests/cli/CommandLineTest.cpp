@@ -276,6 +276,40 @@ TEST(GenerateCommand, BadStyleAndConflictingBoundsAreUsageErrors) {
   EXPECT_FALSE(fs::exists(dir.file("x")));
 }
 
+// Bounds out of order are told before the input is read (here, one that does
+// not exist), by generate and by compare.
+TEST(GenerateCommand, ConflictingBoundsAreToldBeforeTheInputIsRead) {
+  TempDir dir;
+  for (const char* command : {"generate", "compare"}) {
+    const CliRun r = run(std::string(command) + " '" + dir.file("missing.geojson") +
+                         "' --a-min 900 --a-max 100 --out '" + dir.file("x") + "' --quiet");
+    EXPECT_EQ(r.code, 2) << command << ": " << r.output;
+    EXPECT_NE(r.output.find("--a-min must not exceed --a-max"), std::string::npos) << command << ": " << r.output;
+  }
+}
+
+// A block layer's bounds outside their parameters' ranges (a negative A_min, an
+// A_max below 1 m2) are moved into them, and the summary says how many.
+TEST(GenerateCommand, BoundsMovedIntoTheirRangesAreTold) {
+  TempDir dir;
+  const std::string blocks = dir.file("blocks.geojson");
+  std::ofstream(blocks) << R"({"type": "FeatureCollection",
+    "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::32631"}},
+    "features": [
+      {"type": "Feature", "properties": {"block_id": 1, "a_min": -50, "a_max": 0.5, "w_min": 2, "w_max": 10},
+       "geometry": {"type": "Polygon", "coordinates": [[[500000, 0], [500040, 0], [500040, 30], [500000, 30], [500000, 0]]]}},
+      {"type": "Feature", "properties": {"block_id": 2, "a_min": 100, "a_max": 400, "w_min": 5, "w_max": 20},
+       "geometry": {"type": "Polygon", "coordinates": [[[500100, 0], [500140, 0], [500140, 30], [500100, 30], [500100, 0]]]}}
+    ]})";
+  const CliRun r = run("generate '" + blocks + "' --out '" + dir.file("g") + "'");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("2 per-block bounds outside their parameter's range"), std::string::npos) << r.output;
+  EXPECT_NE(slurp(dir.file("g") + "/run.json").find("\"per_block_bounds_clamped\": 2"), std::string::npos);
+  const CliRun inRange = run("generate '" + blocks + "' --a-min 10 --a-max 400 --out '" + dir.file("h") + "'");
+  ASSERT_EQ(inRange.code, 0) << inRange.output;
+  EXPECT_EQ(inRange.output.find("per-block bounds outside"), std::string::npos) << inRange.output;
+}
+
 TEST(GenerateCommand, EnumAndBooleanParametersTakeTheirLabelsAndRecordNumbers) {
   TempDir dir;
   const std::string base = "generate '" + kSample + "' --where \"use <> 'ROW'\" --from-parcels --quiet --seed 3" +

@@ -159,6 +159,15 @@ struct BlockPlan {
 /// included): said before any input is read.
 void requireStyle(const std::string& style);
 
+/// Throws Error(Usage) when a generator parameter of `values` is out of its
+/// range or a bound pair is out of order (--a-min above --a-max): said before
+/// any input is read. (Other names in `values` are not checked here.)
+void requireGeneratorParameters(const ParameterValues& values);
+
+/// The summary's line saying that `clamped` per-block bounds were moved into
+/// their parameter's range (planBlocks).
+std::string clampedBoundsNote(std::int64_t clamped);
+
 /// The plan of every entry of `inputs` under `request`: auto resolved, per-block
 /// bounds clamped into range (counted in `clampedBounds`), the user's explicit
 /// values and the block overrides applied. Throws Error(Usage) on an unknown
