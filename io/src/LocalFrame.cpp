@@ -1,6 +1,8 @@
 #include "parcelscope/io/LocalFrame.h"
 
 #include <GeographicLib/TransverseMercator.hpp>
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
@@ -45,6 +47,18 @@ Point LocalFrame::toSource(const Point& p) const {
     return {lon / unit_, lat / unit_};
   }
   return {p.x / unit_ + x0_, p.y / unit_ + y0_};
+}
+
+double LocalFrame::distanceFromCentre(double x, double y) const {
+  if (tm_) {
+    // Haversine: the transverse Mercator is no guide this far (it folds).
+    constexpr double kRadian = M_PI / 180, kEarthRadius = 6371008.8;
+    const double lat = y * unit_ * kRadian, lat0 = lat0_ * kRadian, dLon = (x * unit_ - lon0_) * kRadian;
+    const double h =
+        std::pow(std::sin((lat - lat0) / 2), 2) + std::cos(lat) * std::cos(lat0) * std::pow(std::sin(dLon / 2), 2);
+    return 2 * kEarthRadius * std::asin(std::min(1.0, std::sqrt(h)));
+  }
+  return std::hypot((x - x0_) * unit_, (y - y0_) * unit_);
 }
 
 std::vector<double> LocalFrame::state() const {

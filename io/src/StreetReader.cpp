@@ -215,7 +215,17 @@ StreetLayer readStreets(const StreetReadOptions& options, const LocalFrame* fram
       StreetFeature s = r.attributes;
       s.key = partKey(r.attributes.key, static_cast<int>(p));
       for (int i = 0; i < parts[p]->getNumPoints(); ++i) {
-        s.line.push_back(result.frame.toLocal(parts[p]->getX(i), parts[p]->getY(i)));
+        const double x = parts[p]->getX(i), y = parts[p]->getY(i);
+        // In the parcels' frame: a line this far from them is another place
+        // (a CRS wrong on one side), and the frame's projection folds there.
+        if (const double d = frame ? frame->distanceFromCentre(x, y) : 0; !(d <= kMaxStreetReach)) {
+          throw inputError(path + ": feature " + std::to_string(r.attributes.fid) + " lies " +
+                           std::to_string(static_cast<long long>(std::isfinite(d) ? d / 1000 : -1)) +
+                           " km from the parcels' centre, more than " +
+                           std::to_string(static_cast<long long>(kMaxStreetReach / 1000)) +
+                           " km: the streets are not where the parcels are (is each file's CRS right?)");
+        }
+        s.line.push_back(result.frame.toLocal(x, y));
       }
       if (s.line.size() < 2) continue;
       report.withWidth += !std::isnan(s.width);

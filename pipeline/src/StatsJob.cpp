@@ -93,6 +93,10 @@ std::string summarize(const ObservedData& data) {
     << "  " << a.rightOfWayCount << " right-of-way parcels kept out of blocks\n"
     << "  " << a.blocks.size() << " blocks (" << a.clampedAMin << " with A_min clamped, " << a.clampedWMin
     << " with W_min clamped)";
+  if (data.streets) {
+    s << "\n  " << data.outsideStreetBlocks << " of " << (r.parcels - a.rightOfWayCount)
+      << " parcels lie in no street block (left out of the comparison)";
+  }
   return s.str();
 }
 

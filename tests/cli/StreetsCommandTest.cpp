@@ -256,6 +256,35 @@ TEST(BlocksCommand, BadStreetInputsAreOneLineErrors) {
   }
 }
 
+// Streets read in the parcels' frame: 6,000 km away they are refused, naming
+// the feature (the frame's projection folded such lines onto the parcels);
+// where the parcels are, the summary counts the parcels in no street block.
+TEST(CompareCommand, StreetsAwayFromTheParcelsAreTold) {
+  TempDir dir;
+  const std::string sample = std::string(PARCELSCOPE_SOURCE_DIR) + "/datasets/sample/sample_town.geojson";
+  const auto moved = [](double dLon) {
+    std::vector<Line> lines = network();
+    for (Line& l : lines) {
+      for (Point& p : l.lonLat) p.x += dLon;
+    }
+    return lines;
+  };
+  const std::string flags = " --width-field W --name-field NAME --default-width 10";  // not quiet: the summary
+  const std::string far = dir.write("far.geojson", geojson(moved(73.4), false));
+  const CliRun f =
+      run("compare '" + sample + "' --streets '" + far + "' --figures 0 --quiet --out '" + dir.file("f") + "'");
+  EXPECT_EQ(f.code, 1) << f.output;
+  EXPECT_NE(f.output.find("far.geojson: feature 0 lies "), std::string::npos) << f.output;
+  EXPECT_NE(f.output.find("the streets are not where the parcels are"), std::string::npos) << f.output;
+  EXPECT_FALSE(fs::exists(dir.file("f")));
+  const std::string same = dir.write("same.geojson", geojson(network(), false));
+  const CliRun s =
+      run("compare '" + sample + "' --streets '" + same + "'" + flags + " --figures 0 --out '" + dir.file("s") + "'");
+  ASSERT_EQ(s.code, 0) << s.output;
+  EXPECT_NE(s.output.find(" parcels lie in no street block (left out of the comparison)"), std::string::npos)
+      << s.output;
+}
+
 // `parcelscope edit`: edits in the input's CRS (lon/lat here) by the keys
 // streets.gpkg gives; the parcels written are valid, keyed and labelled, and
 // persistence.csv counts what each edit kept. A bad edit writes nothing.

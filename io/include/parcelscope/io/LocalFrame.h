@@ -41,6 +41,10 @@ public:
   /// this frame does (frames sent between processes).
   std::vector<double> state() const;
   static LocalFrame fromState(const std::vector<double>& state);
+  /// Distance (m) from the frame's centre to input coordinates (x = easting or
+  /// longitude): on the sphere of the mean Earth radius for a geographic frame,
+  /// in the plane for a projected one.
+  double distanceFromCentre(double x, double y) const;
   /// One line for logs and run records, e.g. "transverse Mercator at lon 2.35, lat 48.89".
   std::string describe() const;
 

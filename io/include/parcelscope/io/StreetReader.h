@@ -19,6 +19,9 @@ namespace parcelscope::io {
 /// The widest street width taken (metres): a width field, a class width or an
 /// edit above it is an error (a street 1e300 m wide emptied every block).
 constexpr double kMaxStreetWidth = 1000.0;
+/// Farthest a street point may lie from the parcels' centre (m) when streets
+/// are read in the parcels' frame: farther, the file is refused.
+constexpr double kMaxStreetReach = 1000000.0;
 
 struct StreetReadOptions {
   std::string path;
