@@ -3,15 +3,19 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <unordered_map>
 #include <utility>
 
 #include "parcelscope/core/BoxIndex.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 namespace parcelscope::analysis {
 
@@ -571,6 +575,274 @@ Key doubleKey(double x, Key basis) {
 
 }  // namespace
 
+namespace {
+
+struct PointHash {
+  std::size_t operator()(const Point& p) const {
+    std::uint64_t x = 0, y = 0;
+    std::memcpy(&x, &p.x, sizeof x);
+    std::memcpy(&y, &p.y, sizeof y);
+    return static_cast<std::size_t>(x * 0x9e3779b97f4a7c15ull ^ (y + 0x632be59bd9b4e019ull + (x << 6) + (x >> 2)));
+  }
+};
+struct PointEqual {
+  bool operator()(const Point& a, const Point& b) const { return a.x == b.x && a.y == b.y; }
+};
+bool samePoint(const Point& a, const Point& b) { return a.x == b.x && a.y == b.y; }
+
+using Epick = CGAL::Exact_predicates_inexact_constructions_kernel;
+Epick::Point_2 cgal(const Point& p) { return {p.x, p.y}; }
+
+Box withPoint(Box b, const Point& p) {
+  return {std::min(b.minX, p.x), std::min(b.minY, p.y), std::max(b.maxX, p.x), std::max(b.maxY, p.y)};
+}
+Box withBox(const Box& a, const Box& b) {
+  return {std::min(a.minX, b.minX), std::min(a.minY, b.minY), std::max(a.maxX, b.maxX), std::max(a.maxY, b.maxY)};
+}
+Box lineBox(const Polyline& l) {
+  Box b{l.front().x, l.front().y, l.front().x, l.front().y};
+  for (const Point& p : l) b = withPoint(b, p);
+  return b;
+}
+
+// Whether lines `changed` (indices into `lines`) meet any line, themselves
+// included, anywhere but where two of them legitimately share a point: two
+// consecutive segments of one line at their vertex, or two lines at an end of
+// both (a node); and not there either when the two segments run along each
+// other (exact predicates on the doubles).
+bool linesMeet(const std::vector<Polyline>& lines, const std::vector<std::size_t>& changed,
+               const std::vector<Box>& boxes) {
+  for (std::size_t c : changed) {
+    const Polyline& a = lines[c];
+    for (std::size_t e = 0; e < lines.size(); ++e) {
+      if (!boxes[c].intersects(boxes[e])) continue;
+      // A pair of changed lines is tested once, from the lower index.
+      if (e != c && e < c && std::binary_search(changed.begin(), changed.end(), e)) continue;
+      const Polyline& b = lines[e];
+      for (std::size_t i = 0; i + 1 < a.size(); ++i) {
+        const Box sa = withPoint(Box{a[i].x, a[i].y, a[i].x, a[i].y}, a[i + 1]);
+        if (!sa.intersects(boxes[e])) continue;
+        for (std::size_t j = e == c ? i + 1 : 0; j + 1 < b.size(); ++j) {
+          const Box sb = withPoint(Box{b[j].x, b[j].y, b[j].x, b[j].y}, b[j + 1]);
+          if (!sa.intersects(sb)) continue;
+          // The point the two segments share, if any, and whether they may.
+          const Point* shared = nullptr;
+          const Point *otherA = nullptr, *otherB = nullptr;
+          for (int u = 0; u < 2 && !shared; ++u) {
+            for (int v = 0; v < 2 && !shared; ++v) {
+              if (samePoint(a[i + u], b[j + v])) {
+                shared = &a[i + u];
+                otherA = &a[i + 1 - u];
+                otherB = &b[j + 1 - v];
+                const bool consecutive = e == c && j == i + 1 && u == 1 && v == 0;
+                const bool node =
+                    e != c && (i + u == 0 || i + u + 1 == a.size()) && (j + v == 0 || j + v + 1 == b.size());
+                if (!consecutive && !node) return true;
+              }
+            }
+          }
+          if (shared) {
+            // Along each other: collinear and pointing the same way from the shared point.
+            if (CGAL::orientation(cgal(*shared), cgal(*otherA), cgal(*otherB)) == CGAL::COLLINEAR &&
+                (otherA->x - shared->x) * (otherB->x - shared->x) + (otherA->y - shared->y) * (otherB->y - shared->y) >=
+                    0) {
+              return true;
+            }
+            // The segments' far ends: a segment may still reach the other's far end.
+            if (CGAL::do_intersect(Epick::Segment_2(cgal(a[i]), cgal(a[i + 1])), Epick::Point_2(cgal(*otherB))) ||
+                CGAL::do_intersect(Epick::Segment_2(cgal(b[j]), cgal(b[j + 1])), Epick::Point_2(cgal(*otherA)))) {
+              return true;
+            }
+            continue;
+          }
+          if (CGAL::do_intersect(Epick::Segment_2(cgal(a[i]), cgal(a[i + 1])),
+                                 Epick::Segment_2(cgal(b[j]), cgal(b[j + 1])))) {
+            return true;
+          }
+        }
+      }
+    }
+  }
+  return false;
+}
+
+// The line ends at `node` in counter-clockwise order of their first segments,
+// from the positive x axis (exact predicates); each as 2 x line + (1 at the
+// line's last point). False when two of them leave along the same direction.
+bool endsAround(const std::vector<Polyline>& lines, const std::vector<std::size_t>& at, const Point& node,
+                std::vector<std::size_t>& order) {
+  struct End {
+    std::size_t id;
+    Point towards;
+  };
+  std::vector<End> ends;
+  for (std::size_t id : at) {
+    const Polyline& l = lines[id / 2];
+    ends.push_back({id, id % 2 ? l[l.size() - 2] : l[1]});
+  }
+  const auto upper = [&](const Point& q) { return q.y > node.y || (q.y == node.y && q.x > node.x); };
+  bool tie = false;
+  std::sort(ends.begin(), ends.end(), [&](const End& a, const End& b) {
+    const bool ua = upper(a.towards), ub = upper(b.towards);
+    if (ua != ub) return ua;
+    const CGAL::Orientation o = CGAL::orientation(cgal(node), cgal(a.towards), cgal(b.towards));
+    if (o == CGAL::COLLINEAR) tie = tie || a.id != b.id;
+    return o == CGAL::LEFT_TURN;
+  });
+  order.clear();
+  for (const End& e : ends) order.push_back(e.id);
+  return !tie;
+}
+
+// Same cyclic sequence.
+bool sameCycle(const std::vector<std::size_t>& a, const std::vector<std::size_t>& b) {
+  if (a.size() != b.size()) return false;
+  if (a.empty()) return true;
+  const auto start = std::find(b.begin(), b.end(), a.front());
+  if (start == b.end()) return false;
+  const std::size_t shift = static_cast<std::size_t>(start - b.begin());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i] != b[(i + shift) % b.size()]) return false;
+  }
+  return true;
+}
+
+// The faces of `now` from those of `before` (`faces`, GEOS's polygonisation
+// of `before`, lines not kept apart) when the lines changed only by moving
+// vertices without changing the network's topology: then GEOS's polygoniser
+// builds the same rings, from the same edges in the same order (it follows
+// the edges' order around each node and the order of the lines), with the
+// moved points in place of the old ones, and assigns the same holes to the
+// same shells. Nothing when that cannot be shown here (the caller
+// polygonises): more than a few lines changed, a line's vertex count changed,
+// a vertex moved onto another or a segment of no length, a changed line
+// meeting any line but at its nodes (before or after), the order of the line
+// ends around a node of a changed line not the same, lines of another
+// connected part of the network in the box the changed lines swept (an
+// island or a separate network whose place in the faces could change), or a
+// face ring turning the other way.
+std::optional<geos::LineFaces> movedFaces(const std::vector<Polyline>& before, const std::vector<Polyline>& now,
+                                          const geos::LineFaces& faces) {
+  if (before.size() != now.size()) return std::nullopt;
+  std::vector<std::size_t> changed;
+  for (std::size_t i = 0; i < now.size(); ++i) {
+    if (before[i].size() != now[i].size()) return std::nullopt;
+    if (before[i].size() < 2) return std::nullopt;
+    if (std::memcmp(before[i].data(), now[i].data(), now[i].size() * sizeof(Point)) != 0) {
+      changed.push_back(i);
+      if (changed.size() > 16) return std::nullopt;
+    }
+  }
+  if (changed.empty()) return std::nullopt;
+  // The moves, old point to new; one new point per old point and the other way round.
+  std::unordered_map<Point, Point, PointHash, PointEqual> moved, movedBack;
+  for (std::size_t c : changed) {
+    for (std::size_t k = 0; k < now[c].size(); ++k) {
+      if (k > 0 && (samePoint(now[c][k], now[c][k - 1]) || samePoint(before[c][k], before[c][k - 1]))) {
+        return std::nullopt;
+      }
+      const Point& o = before[c][k];
+      const Point& n = now[c][k];
+      if (samePoint(o, n)) continue;
+      const auto [it, fresh] = moved.emplace(o, n);
+      if (!fresh && !samePoint(it->second, n)) return std::nullopt;
+      const auto [back, freshBack] = movedBack.emplace(n, o);
+      if (!freshBack && !samePoint(back->second, o)) return std::nullopt;
+    }
+  }
+  // An old point moved is no vertex of a line left as it was, nor a point
+  // left in place in a changed line.
+  std::vector<char> isChanged(now.size(), 0);
+  for (std::size_t c : changed) isChanged[c] = 1;
+  for (std::size_t i = 0; i < now.size(); ++i) {
+    for (std::size_t k = 0; k < now[i].size(); ++k) {
+      if (isChanged[i] && !samePoint(before[i][k], now[i][k])) continue;
+      if (moved.count(now[i][k])) return std::nullopt;
+    }
+  }
+  // No changed line meets another but at their nodes, before and after.
+  std::vector<Box> boxesBefore(now.size()), boxesNow(now.size());
+  for (std::size_t i = 0; i < now.size(); ++i) {
+    boxesNow[i] = lineBox(now[i]);
+    boxesBefore[i] = isChanged[i] ? lineBox(before[i]) : boxesNow[i];
+  }
+  if (linesMeet(now, changed, boxesNow) || linesMeet(before, changed, boxesBefore)) return std::nullopt;
+  // The line ends around every node of a changed line, in the same order.
+  std::vector<Point> nodesBefore, nodesNow;
+  for (std::size_t c : changed) {
+    for (const Polyline* l : {&before[c]}) nodesBefore.insert(nodesBefore.end(), {l->front(), l->back()});
+    nodesNow.insert(nodesNow.end(), {now[c].front(), now[c].back()});
+  }
+  for (std::size_t k = 0; k < nodesBefore.size(); ++k) {
+    std::vector<std::size_t> atBefore, atNow;
+    for (std::size_t i = 0; i < now.size(); ++i) {
+      if (samePoint(before[i].front(), nodesBefore[k])) atBefore.push_back(2 * i);
+      if (samePoint(before[i].back(), nodesBefore[k])) atBefore.push_back(2 * i + 1);
+      if (samePoint(now[i].front(), nodesNow[k])) atNow.push_back(2 * i);
+      if (samePoint(now[i].back(), nodesNow[k])) atNow.push_back(2 * i + 1);
+    }
+    if (atBefore != atNow) return std::nullopt;
+    std::vector<std::size_t> orderBefore, orderNow;
+    if (!endsAround(before, atBefore, nodesBefore[k], orderBefore) || !endsAround(now, atNow, nodesNow[k], orderNow) ||
+        !sameCycle(orderBefore, orderNow)) {
+      return std::nullopt;
+    }
+  }
+  // Connected parts (lines joined at shared ends): in the box the changed
+  // lines swept, only lines of their own part.
+  std::vector<std::size_t> parent(now.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  const std::function<std::size_t(std::size_t)> root = [&](std::size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  {
+    std::unordered_map<Point, std::size_t, PointHash, PointEqual> firstAt;
+    for (std::size_t i = 0; i < now.size(); ++i) {
+      for (const Point* end : {&now[i].front(), &now[i].back()}) {
+        const auto [it, fresh] = firstAt.emplace(*end, i);
+        if (!fresh) parent[root(i)] = root(it->second);
+      }
+    }
+  }
+  const std::size_t part = root(changed.front());
+  Box swept = boxesNow[changed.front()];
+  for (std::size_t c : changed) {
+    if (root(c) != part) return std::nullopt;
+    swept = withBox(withBox(swept, boxesNow[c]), boxesBefore[c]);
+  }
+  for (std::size_t i = 0; i < now.size(); ++i) {
+    if (root(i) != part && boxesNow[i].intersects(swept)) return std::nullopt;
+  }
+  // The rings with the moved points; each keeps its turn.
+  geos::LineFaces out = faces;
+  const auto substitute = [&](Ring& ring) {
+    bool touched = false;
+    for (Point& p : ring) {
+      const auto it = moved.find(p);
+      if (it == moved.end()) continue;
+      p = it->second;
+      touched = true;
+    }
+    return touched;
+  };
+  for (Polygon& face : out.faces) {
+    for (std::size_t r = 0; r <= face.holes.size(); ++r) {
+      Ring& ring = r == 0 ? face.outer : face.holes[r - 1];
+      const double was = signedArea(ring);
+      if (!substitute(ring)) continue;
+      const double is = signedArea(ring);
+      if (!(is != 0) || (is > 0) != (was > 0)) return std::nullopt;
+    }
+  }
+  for (auto* lines : {&out.dangles, &out.cutEdges}) {
+    for (Polyline& l : *lines) substitute(l);
+  }
+  return out;
+}
+
+}  // namespace
+
 StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& options, const ProgressFn& progress,
                           StreetBlockCache* cache) {
   for (const RoadEdge& e : graph.edges) {
@@ -596,7 +868,13 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
     return true;
   };
   const bool sameLines = cache && cache->lineFaces && cache->linesApart == apart && sameBits(cache->lines, all);
-  if (!sameLines) polygonized = geos::polygonizeLines(apart ? geos::nodeLines(all, kGrid) : all);
+  // Lines moved without a change of topology (a node dragged): the last
+  // call's faces with the moved points, as GEOS would give them.
+  if (!sameLines && cache && cache->lineFaces && !apart && !cache->linesApart) {
+    polygonized = movedFaces(cache->lines, all, *cache->lineFaces);
+    cache->facesMoved += polygonized.has_value();
+  }
+  if (!sameLines && !polygonized) polygonized = geos::polygonizeLines(apart ? geos::nodeLines(all, kGrid) : all);
   const geos::LineFaces& faces = sameLines ? *cache->lineFaces : *polygonized;
   out.faces = static_cast<std::int64_t>(faces.faces.size());
   reportProgress(progress, 0.2, "faces");

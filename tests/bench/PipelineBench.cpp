@@ -27,6 +27,7 @@
 #include "parcelscope/pipeline/CompareSession.h"
 #include "parcelscope/pipeline/GenerateJob.h"
 #include "parcelscope/pipeline/StatsJob.h"
+#include "parcelscope/pipeline/StreetEditor.h"
 #include "parcelscope/pipeline/StreetsJob.h"
 #include "parcelscope/viz/CompareFigures.h"
 #include "parcelscope/viz/Scenes.h"
@@ -166,6 +167,58 @@ void StreetGraphAndBlocks(benchmark::State& state) {
   state.counters["blocks"] = static_cast<double>(blocks);
 }
 BENCHMARK(StreetGraphAndBlocks)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
+
+// A node of cambridge_ma's street network dragged as the application drags
+// it (observed parcels in the blocks of their streets, as the window edits
+// them): each iteration is one move, 1, 2 or 3 m from where the drag began,
+// applied in place of the move before (undo, then apply). Nodes of degree 3 or
+// more, every 7th. Counters: seconds of the edit's stages (EditReport) per
+// move. Argument: 0 obb, 1 skeleton. Target (issue 26): the whole drag to
+// the view at most 50 ms.
+void StreetEditorMove(benchmark::State& state) {
+  if (!haveData(state)) return;
+  const std::string centreLines = std::string(PARCELSCOPE_SHARED_DATASETS) + "/cambridge_ma/TRANS_Centerlines.geojson";
+  parcelscope::pipeline::CompareRequest request;
+  request.input.path = kCambridge;
+  request.input.where = "ML <> 'ROAD'";
+  request.streets = parcelscope::io::StreetReadOptions{};
+  request.streets->path = centreLines;
+  request.parameters = parcelscope::defaultValues(parcelscope::pipeline::compareParameters());
+  for (const auto& d : parcelscope::pipeline::streetParameters()) request.parameters.emplace(d.name, d.defaultValue);
+  request.style = state.range(0) ? "skeleton" : "obb";
+  auto observed = std::make_shared<const parcelscope::pipeline::ObservedData>(
+      parcelscope::pipeline::loadObservedInStreetBlocks(request.input, &*request.streets, request.parameters, {}));
+  parcelscope::pipeline::StreetEditor editor(request, observed);
+  std::vector<std::pair<parcelscope::Key, parcelscope::Point>> nodes;
+  int seen = 0;
+  for (const auto& n : editor.network().graph.nodes) {
+    if (n.degree >= 3 && seen++ % 7 == 0) nodes.push_back({n.key, n.at});
+  }
+  double blocks = 0, subdivide = 0, match = 0, edit = 0;
+  std::int64_t moves = 0;
+  for (auto _ : state) {
+    const auto& [key, at] = nodes[static_cast<std::size_t>(moves / 3) % nodes.size()];
+    const int step = static_cast<int>(moves % 3) + 1;
+    if (step > 1) editor.undo();
+    parcelscope::pipeline::StreetEdit e;
+    e.op = parcelscope::pipeline::StreetEdit::Op::MoveNode;
+    e.node = key;
+    e.to = {at.x + step, at.y};
+    const parcelscope::pipeline::EditReport r = editor.apply(e);
+    benchmark::DoNotOptimize(editor.snapshot());
+    blocks += r.secondsBlocks;
+    subdivide += r.secondsSubdivide;
+    match += r.secondsMatch;
+    edit += r.seconds;
+    ++moves;
+  }
+  const double n = static_cast<double>(std::max<std::int64_t>(1, moves));
+  state.counters["blocks_ms"] = 1000 * blocks / n;
+  state.counters["subdivide_ms"] = 1000 * subdivide / n;
+  state.counters["match_ms"] = 1000 * match / n;
+  state.counters["rest_ms"] = 1000 * (edit - blocks - subdivide - match) / n;
+}
+BENCHMARK(StreetEditorMove)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
 // Runs `compare` into `out` and adds the seconds of each stage (summary.json)
 // to `seconds`; returns the summary.

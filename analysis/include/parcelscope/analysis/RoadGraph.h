@@ -163,6 +163,9 @@ struct StreetBlockCache {
   std::vector<Polyline> lines;
   bool linesApart = false;
   std::optional<geos::LineFaces> lineFaces;
+  /// Calls whose faces were the last call's with moved points (lines moved
+  /// without a change of topology: a node dragged), not polygonised again.
+  std::int64_t facesMoved = 0;
 };
 
 /// The blocks of `graph` (every edge width must be known: see
