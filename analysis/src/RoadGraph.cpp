@@ -880,18 +880,21 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
   reportProgress(progress, 0.2, "faces");
 
   // Each edge's surface, and an index of their boxes.
-  std::vector<std::vector<Polygon>> surfaces(graph.edges.size());
+  // (The cached ones in place: the cache takes new entries only at the end.)
+  std::vector<std::vector<Polygon>> builtSurfaces(graph.edges.size());
+  std::vector<const std::vector<Polygon>*> surfaces(graph.edges.size());
   std::vector<Key> surfaceKeys(graph.edges.size());
   parallelFor(graph.edges.size(), [&](std::size_t k) {
     const RoadEdge& e = graph.edges[k];
     surfaceKeys[k] = doubleKey(e.width, bitsKey(e.line, static_cast<Key>(options.quadrantSegments)));
     if (cache) {
       if (const auto it = cache->surfaces.find(surfaceKeys[k]); it != cache->surfaces.end()) {
-        surfaces[k] = it->second;
+        surfaces[k] = &it->second;
         return;
       }
     }
-    surfaces[k] = geos::bufferedUnion({&e.line}, {0.5 * e.width}, options.quadrantSegments);
+    builtSurfaces[k] = geos::bufferedUnion({&e.line}, {0.5 * e.width}, options.quadrantSegments);
+    surfaces[k] = &builtSurfaces[k];
   });
   std::vector<BoxEntry> boxes;
   for (std::size_t k = 0; k < graph.edges.size(); ++k) {
@@ -949,7 +952,7 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
         for (int i : geos::linesNear(face, lines, reach)) near.push_back(boxed[static_cast<std::size_t>(i)]);
         std::vector<const Polygon*> cut;
         for (int k : near) {
-          for (const Polygon& p : surfaces[static_cast<std::size_t>(k)]) cut.push_back(&p);
+          for (const Polygon& p : *surfaces[static_cast<std::size_t>(k)]) cut.push_back(&p);
         }
         for (Polygon& part : geos::difference(face, cut, kOverlayGrid)) {
           if (area(part) < options.minArea || 2 * area(part) < options.minWidth * perimeter(part)) {
@@ -992,7 +995,9 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
                        "blocks");
       });
   if (cache) {
-    for (std::size_t k = 0; k < graph.edges.size(); ++k) cache->surfaces.emplace(surfaceKeys[k], surfaces[k]);
+    for (std::size_t k = 0; k < graph.edges.size(); ++k) {
+      if (surfaces[k] == &builtSurfaces[k]) cache->surfaces.try_emplace(surfaceKeys[k], std::move(builtSurfaces[k]));
+    }
     for (std::size_t f = 0; f < perFace.size(); ++f) {
       if (computed[f]) {
         cache->faces[faceSignature[f]] = {faces.faces[f], perFace[f].blocks, perFace[f].tooLarge, perFace[f].tooSmall};

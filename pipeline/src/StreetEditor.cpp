@@ -273,7 +273,8 @@ std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<c
     e.shape = std::move(shape);
     e.blockId = id;
   }
-  if (observed_) s->inputs.source = std::make_shared<const io::ParcelLayer>(observed_->layer);
+  // The observed layer itself, shared (not copied on every edit).
+  if (observed_) s->inputs.source = std::shared_ptr<const io::ParcelLayer>(observed_, &observed_->layer);
   // An override stays with its block's key; a block gone takes its override with it.
   std::set<Key> keys;
   for (const BlockInputs::Entry& e : s->inputs.entries) keys.insert(e.blockKey);
@@ -547,7 +548,15 @@ EditReport StreetEditor::apply(const StreetEdit& edit) {
       overrides[edit.block] = {edit.style, edit.parameters};
     }
   } else {
-    auto edited = std::make_shared<StreetNetwork>(*network);
+    // Everything but the blocks, which are built again below.
+    auto edited = std::make_shared<StreetNetwork>();
+    edited->layer = network->layer;
+    edited->graph = network->graph;
+    edited->widthsGiven = network->widthsGiven;
+    edited->widthsMeasured = network->widthsMeasured;
+    edited->widthsDefault = network->widthsDefault;
+    edited->boundaryLines = network->boundaryLines;
+    edited->timings = network->timings;
     analysis::RoadGraph& g = edited->graph;
     switch (edit.op) {
       case StreetEdit::Op::MoveNode: {
@@ -652,7 +661,7 @@ EditReport StreetEditor::apply(const StreetEdit& edit) {
       for (const Point& p : e.line) requireWithinReach(p, "the edit moves a street");
     }
     const auto blocksStarted = std::chrono::steady_clock::now();
-    if (cache_.faces.size() > 8 * std::max<std::size_t>(1, edited->blocks.blocks.size())) cache_ = {};
+    if (cache_.faces.size() > 8 * std::max<std::size_t>(1, network->blocks.blocks.size())) cache_ = {};
     edited->blocks = analysis::streetBlocks(g, blockOptions(), {}, &cache_);
     report.secondsBlocks = std::chrono::duration<double>(std::chrono::steady_clock::now() - blocksStarted).count();
     network = std::move(edited);
