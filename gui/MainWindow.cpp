@@ -32,6 +32,7 @@
 #include <QSplitter>
 #include <QStandardPaths>
 #include <QStatusBar>
+#include <QSurfaceFormat>
 #include <QTableWidget>
 #include <QTextBrowser>
 #include <QTimer>
@@ -191,6 +192,11 @@ bool sameInput(const io::ReadOptions& a, const io::ReadOptions& b) {
 }
 
 }  // namespace
+
+void MainWindow::prepareApplication() {
+  QSurfaceFormat::setDefaultFormat(QVTKOpenGLStereoWidget::defaultFormat());
+  if (!qEnvironmentVariableIsSet("QT_QPA_UPDATE_IDLE_TIME")) qputenv("QT_QPA_UPDATE_IDLE_TIME", "0");
+}
 
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), worker_(new SessionWorker) {
   setWindowTitle("ParcelScope");

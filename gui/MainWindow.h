@@ -59,6 +59,12 @@ public:
   explicit MainWindow(QWidget* parent = nullptr);
   ~MainWindow() override;
 
+  /// What the application sets before its QApplication exists: VTK's OpenGL
+  /// surface format, and views drawn to the screen as soon as they are
+  /// rendered (QT_QPA_UPDATE_IDLE_TIME 0 unless set: Qt otherwise waits 5 ms
+  /// before each window's update, a tenth of a street drag).
+  static void prepareApplication();
+
   /// Opens `path` (asks for a layer when it holds several and none is given).
   void openFile(const QString& path, const QString& layer = {}, const QString& where = {}, const QString& crs = {});
   /// Opens the bundled sample.

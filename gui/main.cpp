@@ -12,7 +12,7 @@
 #include "MainWindow.h"
 
 int main(int argc, char** argv) {
-  QSurfaceFormat::setDefaultFormat(QVTKOpenGLStereoWidget::defaultFormat());
+  parcelscope::gui::MainWindow::prepareApplication();
   QApplication app(argc, argv);
   QApplication::setApplicationName("parcelscope-gui");
   QCommandLineParser parser;

@@ -144,7 +144,7 @@ private:
 }  // namespace
 
 int main(int argc, char** argv) {
-  QSurfaceFormat::setDefaultFormat(QVTKOpenGLStereoWidget::defaultFormat());
+  MainWindow::prepareApplication();
   QApplication app(argc, argv);
   const std::string input = std::string(PARCELSCOPE_SHARED_DATASETS) + "/cambridge_ma/ASSESSING_ParcelsFY2014.topojson";
   if (!std::filesystem::exists(input)) {

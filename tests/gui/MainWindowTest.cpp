@@ -1298,7 +1298,7 @@ private slots:
 };
 
 int main(int argc, char** argv) {
-  QSurfaceFormat::setDefaultFormat(QVTKOpenGLStereoWidget::defaultFormat());
+  MainWindow::prepareApplication();
   QApplication app(argc, argv);
   // The quit prompt's test closes the window: that must not end the application.
   QApplication::setQuitOnLastWindowClosed(false);
