@@ -9,6 +9,7 @@
 #include <QScrollArea>
 #include <QStatusBar>
 #include <QTextBrowser>
+#include <QThreadPool>
 
 #include <algorithm>
 #include <cmath>
@@ -189,6 +190,10 @@ void MainWindow::drawEditState(const StreetEditState& state) {
     timings.library = static_cast<double>(it->second.nsecsElapsed()) / 1e6;
   }
   timings.editor = 1e3 * state.seconds;
+  // The state shown until now is often the last hold on a whole city's
+  // parcels (a drag's move before): it is let go on a pool thread, after the
+  // new one is drawn, not here before it.
+  auto shownBefore = std::make_shared<std::optional<StreetEditState>>(std::move(editState_));
   editState_ = state;
   const pipeline::StreetEditor::Snapshot& s = *state.snapshot;
   drawProceduralLayer(s.parcels());
@@ -215,6 +220,7 @@ void MainWindow::drawEditState(const StreetEditState& state) {
   timings.handles = lap();
   proceduralView_->render();
   timings.views = lap();
+  QThreadPool::globalInstance()->start([before = std::move(shownBefore)]() mutable { before.reset(); });
   if (const auto it = editStarted_.find(state.serial); it != editStarted_.end()) {
     lastEditLatencyMs_ = static_cast<double>(it->second.nsecsElapsed()) / 1e6;
     editStarted_.erase(editStarted_.begin(), std::next(it));

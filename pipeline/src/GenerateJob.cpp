@@ -96,7 +96,7 @@ void checkGeneratorValues(const ParameterValues& values, const std::string& wher
 void requireGeneratorParameters(const ParameterValues& values) { checkGeneratorValues(values, "", false); }
 
 std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInputs& inputs,
-                                  std::int64_t* clampedBounds) {
+                                  std::int64_t* clampedBounds, const std::vector<char>* skip) {
   checkStyle(request.style, true);
   const auto check = checkGeneratorValues;
   check(request.parameters, "", false);
@@ -141,6 +141,7 @@ std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInp
   };
   std::vector<BlockPlan> plans(inputs.entries.size());
   for (std::size_t k = 0; k < inputs.entries.size(); ++k) {
+    if (skip && k < skip->size() && (*skip)[k]) continue;
     const BlockInputs::Entry& e = inputs.entries[k];
     const BlockOverride* override = nullptr;
     if (const auto byKey = request.overrides.find(e.blockKey); byKey != request.overrides.end()) {

@@ -284,9 +284,7 @@ std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<c
   GenerateRequest r = request_;
   r.overrides = overrides;
   r.overridesById.clear();
-  s->plans = planBlocks(r, s->inputs);
   s->overrides = std::move(overrides);
-
   // Each entry's counterpart before: the same block part (key and part).
   std::map<std::pair<Key, int>, std::size_t> before;
   if (previous) {
@@ -294,6 +292,29 @@ std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<c
       const BlockInputs::Entry& e = previous->inputs.entries[k];
       before.emplace(std::make_pair(e.blockKey, e.part), k);
     }
+  }
+  // A block part as it was (same outline, same override) keeps its plan: a
+  // plan depends on nothing else the editor changes.
+  std::vector<char> planned(s->inputs.entries.size(), 0);
+  std::vector<long> samePart(s->inputs.entries.size(), -1);
+  for (std::size_t k = 0; previous && k < s->inputs.entries.size(); ++k) {
+    const BlockInputs::Entry& e = s->inputs.entries[k];
+    const auto it = before.find({e.blockKey, e.part});
+    if (it == before.end()) continue;
+    const std::size_t p = it->second;
+    const auto now = s->overrides.find(e.blockKey);
+    const auto then = previous->overrides.find(e.blockKey);
+    const bool sameOverride = (now == s->overrides.end()) == (then == previous->overrides.end()) &&
+                              (now == s->overrides.end() || (now->second.style == then->second.style &&
+                                                             now->second.parameters == then->second.parameters));
+    if (sameOverride && sameVertices(e.shape, previous->inputs.entries[p].shape)) {
+      planned[k] = 1;
+      samePart[k] = static_cast<long>(p);
+    }
+  }
+  s->plans = planBlocks(r, s->inputs, nullptr, &planned);
+  for (std::size_t k = 0; k < samePart.size(); ++k) {
+    if (samePart[k] >= 0) s->plans[k] = previous->plans[static_cast<std::size_t>(samePart[k])];
   }
   const std::size_t n = s->inputs.entries.size();
   s->outcomes.resize(n);

@@ -172,8 +172,10 @@ std::string clampedBoundsNote(std::int64_t clamped);
 /// bounds clamped into range (counted in `clampedBounds`), the user's explicit
 /// values and the block overrides applied. Throws Error(Usage) on an unknown
 /// style, a bound pair out of order or an override for a block that does not exist.
+/// Entries `skip` marks (when given) are left unplanned (a default BlockPlan):
+/// the caller has their plans already (and their clamped bounds are not counted).
 std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInputs& inputs,
-                                  std::int64_t* clampedBounds = nullptr);
+                                  std::int64_t* clampedBounds = nullptr, const std::vector<char>* skip = nullptr);
 
 /// One block subdivided and its parcels measured (shape metrics, neighbours
 /// within the block, frontage on the block).
