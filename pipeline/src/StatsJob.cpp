@@ -1,6 +1,10 @@
 #include "parcelscope/pipeline/StatsJob.h"
 
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
 #include <sstream>
+#include <utility>
 
 #include "parcelscope/core/Error.h"
 #include "parcelscope/io/OutputDirectory.h"
@@ -79,6 +83,22 @@ void addObservedRecord(Json& record, const ObservedData& data) {
   record.set("input", input).set("counts", counts).set("seconds", seconds);
 }
 
+namespace {
+// Lon/lat input is measured in one transverse Mercator centred on the layer:
+// its scale grows with the distance x from the central meridian, areas by
+// about (x / R)^2. The largest such error over the parcels, and that x.
+std::pair<double, double> frameAreaError(const io::ParcelLayer& layer) {
+  if (!layer.frame.isGeographic()) return {0, 0};
+  double farthest = 0;
+  for (const Parcel& p : layer.parcels) {
+    const Box b = bounds(p.shape.outer);
+    farthest = std::max({farthest, std::fabs(b.minX), std::fabs(b.maxX)});
+  }
+  const double r = farthest / 6371008.8;
+  return {r * r, farthest};
+}
+}  // namespace
+
 std::string summarize(const ObservedData& data) {
   const io::CleaningReport& r = data.layer.report;
   const ObservedAnalysis& a = data.analysis;
@@ -93,6 +113,11 @@ std::string summarize(const ObservedData& data) {
     << "  " << a.rightOfWayCount << " right-of-way parcels kept out of blocks\n"
     << "  " << a.blocks.size() << " blocks (" << a.clampedAMin << " with A_min clamped, " << a.clampedWMin
     << " with W_min clamped)";
+  if (const auto [error, x] = frameAreaError(data.layer); error > 0.001) {
+    s << "\n  warning: lon/lat measured in one transverse Mercator centred on the layer: areas up to "
+      << std::setprecision(2) << 100 * error << " % too large " << std::setprecision(6) << std::round(x / 1000)
+      << " km from its centre line; reproject so wide a layer to an equal-area CRS, or split it";
+  }
   if (data.streets) {
     s << "\n  " << data.outsideStreetBlocks << " of " << (r.parcels - a.rightOfWayCount)
       << " parcels lie in no street block (left out of the comparison)";

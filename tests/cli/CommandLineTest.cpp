@@ -87,6 +87,28 @@ TEST(StatsCommand, WritesAllOutputsForTheBundledSample) {
   }
 }
 
+// Lon/lat parcels 500 km apart are measured in one transverse Mercator (centred
+// on the median parcel): the summary warns that areas far from its centre line
+// are too large, by how much; a town's parcels get no such warning.
+TEST(StatsCommand, AWideLonLatLayerIsWarnedOfItsAreaError) {
+  TempDir dir;
+  const std::string wide = dir.file("wide.geojson");
+  std::ofstream(wide) << R"({"type": "FeatureCollection", "features": [
+    {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates":
+      [[[2.35, 48.85], [2.3505, 48.85], [2.3505, 48.8505], [2.35, 48.8505], [2.35, 48.85]]]}},
+    {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates":
+      [[[2.3505, 48.8505], [2.351, 48.8505], [2.351, 48.851], [2.3505, 48.851], [2.3505, 48.8505]]]}},
+    {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates":
+      [[[-4.48, 48.39], [-4.4795, 48.39], [-4.4795, 48.3905], [-4.48, 48.3905], [-4.48, 48.39]]]}}]})";
+  const CliRun r = run("stats '" + wide + "' --out '" + dir.file("w") + "'");
+  ASSERT_EQ(r.code, 0) << r.output;
+  // Brest lies about 505 km west of Paris's meridian: areas (505 / 6371)^2 = 0.63 % too large.
+  EXPECT_NE(r.output.find("areas up to 0.63 % too large 506 km from its centre line"), std::string::npos) << r.output;
+  const CliRun town = run("stats '" + kSample + "' --out '" + dir.file("t") + "'");
+  ASSERT_EQ(town.code, 0) << town.output;
+  EXPECT_EQ(town.output.find("transverse Mercator"), std::string::npos) << town.output;
+}
+
 TEST(StatsCommand, UsageErrorsExitTwo) {
   EXPECT_EQ(run("").code, 2);
   EXPECT_EQ(run("frobnicate").code, 2);
