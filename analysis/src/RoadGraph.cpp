@@ -579,9 +579,11 @@ namespace {
 
 struct PointHash {
   std::size_t operator()(const Point& p) const {
+    // -0 and 0 are equal points: one hash.
+    const double px = p.x == 0 ? 0.0 : p.x, py = p.y == 0 ? 0.0 : p.y;
     std::uint64_t x = 0, y = 0;
-    std::memcpy(&x, &p.x, sizeof x);
-    std::memcpy(&y, &p.y, sizeof y);
+    std::memcpy(&x, &px, sizeof x);
+    std::memcpy(&y, &py, sizeof y);
     return static_cast<std::size_t>(x * 0x9e3779b97f4a7c15ull ^ (y + 0x632be59bd9b4e019ull + (x << 6) + (x >> 2)));
   }
 };
@@ -826,15 +828,26 @@ std::optional<geos::LineFaces> movedFaces(const std::vector<Polyline>& before, c
     }
     return touched;
   };
+  // The turn is told by the floating-point area (as `normalise` tells it
+  // when GEOS's rings are collected, from another first vertex): only where
+  // it is far above that sum's rounding, before and after.
+  const auto clearArea = [](const Ring& ring, double a) {
+    const Box b = lineBox(ring);
+    const double size = b.width() + b.height();
+    return std::fabs(a) > 1e-12 * static_cast<double>(ring.size()) * size * size;
+  };
   for (Polygon& face : out.faces) {
     for (std::size_t r = 0; r <= face.holes.size(); ++r) {
       Ring& ring = r == 0 ? face.outer : face.holes[r - 1];
       const double was = signedArea(ring);
+      const bool clearBefore = clearArea(ring, was);
       if (!substitute(ring)) continue;
       const double is = signedArea(ring);
-      if (!(is != 0) || (is > 0) != (was > 0)) return std::nullopt;
+      if (!clearBefore || !clearArea(ring, is) || (is > 0) != (was > 0)) return std::nullopt;
     }
   }
+  // (Dangles and cut edges with the moved points too; GEOS would list the
+  // dangles in the order of their nodes' coordinates: no caller uses them.)
   for (auto* lines : {&out.dangles, &out.cutEdges}) {
     for (Polyline& l : *lines) substitute(l);
   }

@@ -469,6 +469,34 @@ TEST(RoadGraph, FacesOfMovedNodesAreThoseOfAFreshPolygonisation) {
   EXPECT_LT(cache.facesMoved, steps - steps / 10);  // and others polygonised again
 }
 
+// A node moved to within rounding of the line through its neighbours: the
+// face is nearly flat, and whether GEOS's ring is kept (its floating-point
+// area, from GEOS's first vertex) is not what the moved ring's area says; the
+// faces are polygonised again and agree with GEOS. (Found by a review.)
+TEST(RoadGraph, ANearlyFlatFaceIsPolygonisedAgain) {
+  RoadGraph g = buildRoadGraph({street({{0, 0}, {3, 1}}), street({{3, 1}, {1, -5}}), street({{1, -5}, {0, 0}})});
+  StreetBlockCache cache;
+  streetBlocks(g, {}, {}, &cache);
+  ASSERT_EQ(cache.lineFaces->faces.size(), 1u);
+  for (RoadNode& n : g.nodes) {
+    if (n.at.x == 1 && n.at.y == -5) n.at = {1, 0.3333333333333333};
+  }
+  for (RoadEdge& e : g.edges) {
+    for (Point* end : {&e.line.front(), &e.line.back()}) {
+      if (end->x == 1 && end->y == -5) *end = {1, 0.3333333333333333};
+    }
+  }
+  streetBlocks(g, {}, {}, &cache);
+  std::vector<Polyline> all;
+  for (const RoadEdge& e : g.edges) all.push_back(e.line);
+  const geos::LineFaces fresh = geos::polygonizeLines(all);
+  EXPECT_EQ(cache.facesMoved, 0);
+  ASSERT_EQ(cache.lineFaces->faces.size(), fresh.faces.size());
+  for (std::size_t f = 0; f < fresh.faces.size(); ++f) {
+    EXPECT_TRUE(test::sameBits(cache.lineFaces->faces[f], fresh.faces[f]));
+  }
+}
+
 TEST(RoadGraph, FacesAboveTheLimitAreDropped) {
   const RoadGraph g = buildRoadGraph(grid(3, 100));
   StreetBlockOptions options;

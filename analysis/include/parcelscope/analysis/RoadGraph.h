@@ -164,7 +164,9 @@ struct StreetBlockCache {
   bool linesApart = false;
   std::optional<geos::LineFaces> lineFaces;
   /// Calls whose faces were the last call's with moved points (lines moved
-  /// without a change of topology: a node dragged), not polygonised again.
+  /// without a change of topology: a node dragged), not polygonised again:
+  /// the faces GEOS would give, bit for bit (its dangles, unused, may then be
+  /// listed in another order).
   std::int64_t facesMoved = 0;
 };
 
