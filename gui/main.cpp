@@ -1,10 +1,8 @@
 // parcelscope-gui [INPUT] [--layer L] [--where SQL] [--crs EPSG:N] [--session FILE] [--sample]
 //                 [--streets FILE [--width-field F] [--name-field F]]
 //                 [--subdivision-style STYLE] [--screenshot PNG] [--window-size WxH]
-#include <QVTKOpenGLStereoWidget.h>
 #include <QApplication>
 #include <QCommandLineParser>
-#include <QSurfaceFormat>
 #include <QTimer>
 
 #include <cstdio>

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <functional>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -601,11 +600,6 @@ Box withPoint(Box b, const Point& p) {
 Box withBox(const Box& a, const Box& b) {
   return {std::min(a.minX, b.minX), std::min(a.minY, b.minY), std::max(a.maxX, b.maxX), std::max(a.maxY, b.maxY)};
 }
-Box lineBox(const Polyline& l) {
-  Box b{l.front().x, l.front().y, l.front().x, l.front().y};
-  for (const Point& p : l) b = withPoint(b, p);
-  return b;
-}
 
 // Whether lines `changed` (indices into `lines`) meet any line, themselves
 // included, anywhere but where two of them legitimately share a point: two
@@ -765,8 +759,8 @@ std::optional<geos::LineFaces> movedFaces(const std::vector<Polyline>& before, c
   // No changed line meets another but at their nodes, before and after.
   std::vector<Box> boxesBefore(now.size()), boxesNow(now.size());
   for (std::size_t i = 0; i < now.size(); ++i) {
-    boxesNow[i] = lineBox(now[i]);
-    boxesBefore[i] = isChanged[i] ? lineBox(before[i]) : boxesNow[i];
+    boxesNow[i] = bounds(now[i]);
+    boxesBefore[i] = isChanged[i] ? bounds(before[i]) : boxesNow[i];
   }
   if (linesMeet(now, changed, boxesNow) || linesMeet(before, changed, boxesBefore)) return std::nullopt;
   // The line ends around every node of a changed line, in the same order.
@@ -794,7 +788,7 @@ std::optional<geos::LineFaces> movedFaces(const std::vector<Polyline>& before, c
   // lines swept, only lines of their own part.
   std::vector<std::size_t> parent(now.size());
   std::iota(parent.begin(), parent.end(), 0);
-  const std::function<std::size_t(std::size_t)> root = [&](std::size_t i) {
+  const auto root = [&](std::size_t i) {
     while (parent[i] != i) i = parent[i] = parent[parent[i]];
     return i;
   };
@@ -832,7 +826,7 @@ std::optional<geos::LineFaces> movedFaces(const std::vector<Polyline>& before, c
   // when GEOS's rings are collected, from another first vertex): only where
   // it is far above that sum's rounding, before and after.
   const auto clearArea = [](const Ring& ring, double a) {
-    const Box b = lineBox(ring);
+    const Box b = bounds(ring);
     const double size = b.width() + b.height();
     return std::fabs(a) > 1e-12 * static_cast<double>(ring.size()) * size * size;
   };

@@ -13,7 +13,6 @@
 #include <QVTKOpenGLWindow.h>
 #include <QApplication>
 #include <QElapsedTimer>
-#include <QSurfaceFormat>
 #include <QTest>
 #include <QTimer>
 

@@ -25,7 +25,6 @@
 #include <QSignalSpy>
 #include <QSlider>
 #include <QStandardPaths>
-#include <QSurfaceFormat>
 #include <QTableWidget>
 #include <QTemporaryDir>
 #include <QTest>

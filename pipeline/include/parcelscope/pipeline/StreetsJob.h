@@ -24,6 +24,8 @@ namespace parcelscope::pipeline {
 /// max-block-area.
 const std::vector<ParameterDescription>& streetParameters();
 
+// (StreetEditor::apply copies every member but `blocks` one by one: a new
+// member is to be copied there too.)
 struct StreetNetwork {
   io::StreetLayer layer;
   analysis::RoadGraph graph;
