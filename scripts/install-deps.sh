@@ -10,7 +10,7 @@ packages=(
   libopenmpi-dev openmpi-bin
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev
   libgeographiclib-dev
-  libgdal-dev gdal-bin libssl-dev zlib1g-dev
+  libgdal-dev gdal-bin libsqlite3-dev libssl-dev zlib1g-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   libx11-dev xvfb xauth libgl1-mesa-dri
   clang-format

@@ -11,6 +11,7 @@
 #include <future>
 #include <stdexcept>
 
+#include "GpkgRtree.h"
 #include "OgrConvert.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/GeosOps.h"
@@ -220,6 +221,35 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
   OGRLayer* layer = ds->CreateLayer(layerName.c_str(), &srs, wkbMultiPolygon, layerOptions.List());
   if (!layer) throw fail("cannot create layer " + layerName);
   createFields(*layer, attributes.columns, fail);
+  // The R-tree is built in bulk after the features are in (detail::fillRtree):
+  // GDAL makes the empty tree, its triggers and its extension entry now, and
+  // the insert trigger is taken away while the features are written, then
+  // restored as GDAL wrote it. Without that trigger, GDAL's own deferred build
+  // is left in place.
+  std::string rtreeName, insertTrigger;
+  if (!geojson && spatialIndex) {
+    const std::string table = layer->GetName(), column = layer->GetGeometryColumn();
+    if (layer->SyncToDisk() != OGRERR_NONE) throw fail("cannot create layer " + layerName);
+    const std::string trigger = "rtree_" + table + "_" + column + "_insert";
+    auto quoted = [](const std::string& s, char q) {
+      std::string r(1, q);
+      for (char c : s) r += c == q ? std::string(2, q) : std::string(1, c);
+      return r + q;
+    };
+    if (OGRLayer* found = ds->ExecuteSQL(
+            ("SELECT sql FROM sqlite_master WHERE type = 'trigger' AND name = " + quoted(trigger, '\'')).c_str(),
+            nullptr, nullptr)) {
+      if (auto f = std::unique_ptr<OGRFeature>(found->GetNextFeature())) insertTrigger = f->GetFieldAsString(0);
+      ds->ReleaseResultSet(found);
+    }
+    if (!insertTrigger.empty()) {
+      rtreeName = "rtree_" + table + "_" + column;
+      ds->ExecuteSQL(("DROP TRIGGER " + quoted(trigger, '"')).c_str(), nullptr, nullptr);
+      if (CPLGetLastErrorType() == CE_Failure) throw fail("cannot prepare the spatial index");
+    }
+  }
+  std::vector<detail::RtreeEntry> boxes;
+  if (!rtreeName.empty()) boxes.reserve(attributes.rows);
   if (!geojson && ds->StartTransaction() != OGRERR_NONE) throw fail("cannot start transaction");
   // Geometries are taken back to the source CRS, checked and repaired there,
   // and converted in batches on a second thread while this one inserts the
@@ -263,15 +293,20 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
       row.clear();
       attributes.row(i, row);
       setFields(feature, row);
+      OGREnvelope box;
+      const bool indexed = !rtreeName.empty() && !batch[k]->IsEmpty();
+      if (indexed) batch[k]->getEnvelope(&box);
       feature.SetGeometryDirectly(batch[k].release());
       if (layer->CreateFeature(&feature) != OGRERR_NONE) {
         throw fail("cannot write feature " + std::to_string(i));
       }
+      if (indexed) boxes.push_back({feature.GetFID(), box.MinX, box.MaxX, box.MinY, box.MaxY});
     }
   }
   if (!geojson && ds->CommitTransaction() != OGRERR_NONE) throw fail("cannot commit");
   ds.reset();  // flush and close before the caller renames the file
   if (CPLGetLastErrorType() == CE_Failure) throw fail("closing failed");
+  if (!rtreeName.empty()) detail::fillRtree(path, rtreeName, std::move(boxes), insertTrigger);
   return report;
 }
 

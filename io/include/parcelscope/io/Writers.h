@@ -34,8 +34,10 @@ Json readJson(const std::string& path);
 /// attributes of `attributes.rows[i]`. Coordinates are mapped back from local
 /// metres with `frame` and tagged with `crs` (OGC:CRS84 when the CRS was assumed).
 /// A GeoPackage layer gets an R-tree spatial index unless `spatialIndex` is
-/// false: GIS tools draw large layers faster with it, and SQLite takes about
-/// 10 microseconds per feature to build it (3 s for 350,000 parcels).
+/// false: GIS tools draw large layers faster with it. GDAL makes the empty
+/// index, its triggers and its extension entry; the tree is packed from all
+/// features' boxes once they are written (about 1 microsecond per feature,
+/// against 10 for GDAL 3.6 inserting them one by one).
 ///
 /// Validity is that of the file, in the CRS written: a polygon valid in local
 /// metres can be invalid once mapped back (edges straight in metres are not
