@@ -216,11 +216,6 @@ ShardPart analyseShard(const CompareRequest& request, int index, int count, cons
   if (request.streets) {
     throw usageError("blocks from street centre lines (--streets) are not split into shards; run in one process");
   }
-  if (!io::inputFiles(request.input.path).empty()) {
-    throw usageError(request.input.path +
-                     ": an input of several files is not split into shards (its features are numbered in turn); "
-                     "merge them into one GeoPackage first (ogr2ogr), or run in one process");
-  }
   if (count < 1 || index < 0 || index >= count)
     throw usageError("shard " + std::to_string(index) + " of " + std::to_string(count) + " does not exist");
   const auto started = std::chrono::steady_clock::now();
