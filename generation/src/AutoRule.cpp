@@ -140,7 +140,7 @@ const AutoRule& AutoRule::bundled() {
   return rule;
 }
 
-const std::string& AutoRule::predict(const AutoFeatures& x) const {
+std::vector<std::pair<double, std::size_t>> AutoRule::nearest(const AutoFeatures& x, std::size_t k) const {
   std::vector<std::pair<double, std::size_t>> near;
   near.reserve(rows_.size());
   for (std::size_t i = 0; i < rows_.size(); ++i) {
@@ -148,8 +148,15 @@ const std::string& AutoRule::predict(const AutoFeatures& x) const {
     for (std::size_t f = 0; f < kAutoFeatures; ++f) d += std::pow((x[f] - rows_[i].features[f]) / scale_[f], 2);
     near.emplace_back(d, i);
   }
-  const std::size_t k = std::min(neighbours_, near.size());
+  k = std::min(k, near.size());
   std::partial_sort(near.begin(), near.begin() + static_cast<long>(k), near.end());
+  near.resize(k);
+  return near;
+}
+
+const std::string& AutoRule::predict(const AutoFeatures& x) const {
+  const auto near = nearest(x, neighbours_);
+  const std::size_t k = near.size();
   std::map<std::string, int> votes;
   for (std::size_t i = 0; i < k; ++i) ++votes[rows_[near[i].second].style];
   // Nearest first, so that a tie goes to the nearer style.

@@ -6,12 +6,17 @@
 // |n_generated / n_observed - 1|, and whether the left-out rule beats the
 // paper's rule and parish on every measure.
 //
-//   parcelscope_realism_bench [--variants] [CITY ...]   (default: all six; about 7 min)
+//   parcelscope_realism_bench [--variants | --votes] [CITY ...]   (default: all six; about 4-7 min)
 //
 // --variants: then, the rule's neighbours and features tried (each feature
 // left out in turn), each measured leaving each city out.
+// --votes: then, ways of voting (neighbours, extra votes for the paper's
+// style, the paper's style for blocks far from every training block), each
+// measured leaving each city out and on each city's cross-validated halves.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <map>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -56,6 +61,34 @@ generation::AutoRule leftOut(const char* city, std::size_t k, const generation::
                                        weights);
 }
 
+// A way of choosing a block's style from the training rows nearest it: `k`
+// neighbours vote, the paper's rule's style gets `paperVote` more votes (ties
+// go to it), and a block farther than `far` (squared standardised distance to
+// its nearest row) takes the paper's style.
+struct Vote {
+  std::size_t k;
+  double paperVote;
+  double far;
+};
+
+std::string choose(const generation::AutoRule& rule, const pipeline::BlockCalibration& b, const Vote& v) {
+  const auto near = rule.nearest(b.features, v.k);
+  if (near.empty() || near.front().first > v.far) return b.styleBefore;
+  std::map<std::string, double> score;
+  score[b.styleBefore] += v.paperVote;
+  for (const auto& [d, i] : near) score[rule.rows()[i].style] += 1;
+  std::string best = b.styleBefore;
+  double most = score[best];
+  for (const auto& [d, i] : near) {
+    const std::string& st = rule.rows()[i].style;
+    if (score[st] > most) {
+      best = st;
+      most = score[st];
+    }
+  }
+  return best;
+}
+
 int measuresBetter(const pipeline::FitMeasures& a, const pipeline::FitMeasures& b) {
   return (a.ksArea < b.ksArea) + (a.ksWidth < b.ksWidth) + (a.ksAspectRatio < b.ksAspectRatio) +
          (a.medianCountError < b.medianCountError);
@@ -67,6 +100,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   const bool variants = !args.empty() && args.front() == "--variants";
   if (variants) args.erase(args.begin());
+  const bool votes = !args.empty() && args.front() == "--votes";
+  if (votes) args.erase(args.begin());
   struct Run {
     const City* city;
     pipeline::Calibration c;
@@ -109,6 +144,55 @@ int main(int argc, char** argv) {
     std::printf("| %s | %s | %s | %s | %s | %s | %s | %s |\n", r.city->name, text(c.before).c_str(),
                 text(parish).c_str(), text(rule).c_str(), text(c.autoRule).c_str(), text(c.after).c_str(),
                 beatsPaper ? "yes" : "no", beatsParish ? "yes" : "no");
+  }
+  if (votes) {
+    // Each way of voting, the city left out and each city's halves
+    // cross-validated (the rule of a half trained on the other half's own
+    // calibration), against the paper's rule.
+    std::vector<Vote> ways;
+    for (std::size_t k : {3, 5, 7}) {
+      for (double paper : {0.0, 1.0, 2.0, 3.0}) {
+        if (paper >= static_cast<double>(k)) continue;
+        for (double far : {HUGE_VAL, 2.0, 1.0}) ways.push_back({k, paper, far});
+      }
+    }
+    std::printf(
+        "| vote | left out: cities / measures better | cross-validated: cities / measures better |\n|---|---|---|\n");
+    for (const Vote& v : ways) {
+      int outCities = 0, outMeasures = 0, cvCities = 0, cvMeasures = 0;
+      double outObjective = 0, cvObjective = 0;
+      std::string detail;
+      for (const Run& r : runs) {
+        const pipeline::Calibration& c = r.c;
+        const generation::AutoRule out = leftOut(r.city->name, v.k, generation::AutoRule::kWeights);
+        std::vector<std::size_t> outEntries, cvEntries(c.blocks.size());
+        for (const auto& b : c.blocks) outEntries.push_back(pipeline::entryOfStyle(c, choose(out, b, v)));
+        for (int half = 0; half < 2; ++half) {
+          std::vector<generation::AutoRule::Row> rows;
+          for (const auto& b : c.blocks) {
+            if (b.half != half) rows.push_back({b.features, b.styleHalf});
+          }
+          if (rows.empty()) continue;
+          const generation::AutoRule rule(std::move(rows), v.k);
+          for (std::size_t i = 0; i < c.blocks.size(); ++i) {
+            if (c.blocks[i].half == half) cvEntries[i] = pipeline::entryOfStyle(c, choose(rule, c.blocks[i], v));
+          }
+        }
+        const pipeline::FitMeasures fo = pipeline::fitMeasures(c.board, r.all, outEntries);
+        const pipeline::FitMeasures fc = pipeline::fitMeasures(c.board, r.all, cvEntries);
+        outCities += better(fo, c.before);
+        outMeasures += measuresBetter(fo, c.before);
+        cvCities += better(fc, c.before);
+        cvMeasures += measuresBetter(fc, c.before);
+        outObjective += pipeline::cityObjective(fo) / static_cast<double>(runs.size());
+        cvObjective += pipeline::cityObjective(fc) / static_cast<double>(runs.size());
+        detail += std::string("  ") + r.city->name + ": out " + text(fo) + ", cv " + text(fc) + "\n";
+      }
+      std::printf("| %zu | %g | %g | %d of %zu / %d of %zu / %.3f | %d of %zu / %d of %zu / %.3f |\n%s", v.k,
+                  v.paperVote, v.far, outCities, runs.size(), outMeasures, 4 * runs.size(), outObjective, cvCities,
+                  runs.size(), cvMeasures, 4 * runs.size(), cvObjective, detail.c_str());
+      std::fflush(stdout);
+    }
   }
   if (variants) {
     // Neighbours and features, each variant measured leaving each city out:

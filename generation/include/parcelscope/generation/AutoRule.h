@@ -8,6 +8,7 @@
 #include <array>
 #include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "parcelscope/core/Geometry.h"
@@ -62,6 +63,8 @@ public:
 
   /// The style of most of the nearest rows (ties: the nearest's style).
   const std::string& predict(const AutoFeatures& x) const;
+  /// The `k` rows nearest `x`, nearest first: (squared standardised distance, row).
+  std::vector<std::pair<double, std::size_t>> nearest(const AutoFeatures& x, std::size_t k) const;
 
   const std::vector<Row>& rows() const { return rows_; }
   static constexpr std::size_t kNeighbours = 3;
