@@ -156,14 +156,16 @@ std::vector<std::pair<double, std::size_t>> AutoRule::nearest(const AutoFeatures
 
 const std::string& AutoRule::predict(const AutoFeatures& x) const {
   const auto near = nearest(x, neighbours_);
-  const std::size_t k = near.size();
-  std::map<std::string, int> votes;
-  for (std::size_t i = 0; i < k; ++i) ++votes[rows_[near[i].second].style];
+  // Each neighbour votes with 1 / its distance: a block at a training row's
+  // features takes that row's style (its calibration), others lean to the
+  // nearer rows. kVoteFloor keeps a zero distance finite.
+  std::map<std::string, double> votes;
+  for (const auto& [d, i] : near) votes[rows_[i].style] += 1.0 / (std::sqrt(d) + kVoteFloor);
   // Nearest first, so that a tie goes to the nearer style.
   const std::string* best = nullptr;
-  int most = 0;
-  for (std::size_t i = 0; i < k; ++i) {
-    const std::string& s = rows_[near[i].second].style;
+  double most = 0;
+  for (const auto& [d, i] : near) {
+    const std::string& s = rows_[i].style;
     if (votes[s] > most) {
       best = &s;
       most = votes[s];

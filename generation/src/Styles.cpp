@@ -118,8 +118,8 @@ public:
             {&obbStyle(), &skeletonStyle(), &offsetStyle(), &parishStyle(), &sextonStyle(), &templateStyle()}) {}
   std::string name() const override { return "auto"; }
   std::string description() const override {
-    return "per block: the style of the most similar calibrated blocks of the shared datasets (3 nearest, in block "
-           "and observed parcel features)";
+    return "per block: the style of the most similar calibrated blocks of the shared datasets (3 nearest, each "
+           "voting by closeness, in block and observed parcel features)";
   }
   const Style& resolve(const BlockFacts& facts) const override {
     if (!facts.shape || !facts.observed || facts.observed->areas.empty()) return accessStyle().resolve(facts);

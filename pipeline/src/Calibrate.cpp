@@ -469,8 +469,9 @@ JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir
                      Json::object()
                          .set("halves", "blocks split by block key parity")
                          .set("fitted_rule",
-                              "the style most of the 3 nearest blocks of the other half got from that half's own "
-                              "calibration, in the auto rule's standardised features (calibration.csv's f_ columns)")
+                              "the style the 3 nearest blocks of the other half got from that half's own "
+                              "calibration, each voting with 1 / its distance in the auto rule's standardised "
+                              "features (calibration.csv's f_ columns)")
                          .set("fitted", fitJson(c.crossFitted))
                          .set("paper", fitJson(c.crossPaper))));
     run.set("outputs", outputs.push("run.json"));

@@ -62,22 +62,25 @@ generation::AutoRule leftOut(const char* city, std::size_t k, const generation::
 }
 
 // A way of choosing a block's style from the training rows nearest it: `k`
-// neighbours vote, the paper's rule's style gets `paperVote` more votes (ties
-// go to it), and a block farther than `far` (squared standardised distance to
-// its nearest row) takes the paper's style.
+// neighbours vote (each with weight 1, or with `weighted` 1 / distance), the
+// paper's rule's style gets `paperVote` more votes, and a block farther than
+// `far` (squared standardised distance to its nearest row) takes the paper's
+// style. Ties go to the paper's style when it has votes, else to the nearer.
 struct Vote {
   std::size_t k;
   double paperVote;
   double far;
+  bool weighted = false;
+  bool withOthers = false;  // cross-validated halves: the other cities' table rows too
 };
 
 std::string choose(const generation::AutoRule& rule, const pipeline::BlockCalibration& b, const Vote& v) {
   const auto near = rule.nearest(b.features, v.k);
   if (near.empty() || near.front().first > v.far) return b.styleBefore;
   std::map<std::string, double> score;
-  score[b.styleBefore] += v.paperVote;
-  for (const auto& [d, i] : near) score[rule.rows()[i].style] += 1;
-  std::string best = b.styleBefore;
+  if (v.paperVote > 0) score[b.styleBefore] += v.paperVote;
+  for (const auto& [d, i] : near) score[rule.rows()[i].style] += v.weighted ? 1 / (std::sqrt(d) + 1e-9) : 1.0;
+  std::string best = v.paperVote > 0 ? b.styleBefore : rule.rows()[near.front().second].style;
   double most = score[best];
   for (const auto& [d, i] : near) {
     const std::string& st = rule.rows()[i].style;
@@ -156,22 +159,30 @@ int main(int argc, char** argv) {
         for (double far : {HUGE_VAL, 2.0, 1.0}) ways.push_back({k, paper, far});
       }
     }
+    for (std::size_t k : {3, 5, 7, 11, 15}) ways.push_back({k, 0, HUGE_VAL, true});
+    for (std::size_t k : {3, 5, 7}) ways.push_back({k, 0, HUGE_VAL, true, true});
     std::printf(
-        "| vote | left out: cities / measures better | cross-validated: cities / measures better |\n|---|---|---|\n");
+        "| neighbours | paper's votes | far | weighted | left out: cities / measures better / mean objective | "
+        "cross-validated: cities / measures better / mean objective | trained on all six |\n"
+        "|---|---|---|---|---|---|---|\n");
     for (const Vote& v : ways) {
       int outCities = 0, outMeasures = 0, cvCities = 0, cvMeasures = 0;
-      double outObjective = 0, cvObjective = 0;
+      double outObjective = 0, cvObjective = 0, inObjective = 0;
+      int inCities = 0, inMeasures = 0;
       std::string detail;
       for (const Run& r : runs) {
         const pipeline::Calibration& c = r.c;
         const generation::AutoRule out = leftOut(r.city->name, v.k, generation::AutoRule::kWeights);
-        std::vector<std::size_t> outEntries, cvEntries(c.blocks.size());
+        const generation::AutoRule all = leftOut("", v.k, generation::AutoRule::kWeights);
+        std::vector<std::size_t> outEntries, inEntries, cvEntries(c.blocks.size());
         for (const auto& b : c.blocks) outEntries.push_back(pipeline::entryOfStyle(c, choose(out, b, v)));
+        for (const auto& b : c.blocks) inEntries.push_back(pipeline::entryOfStyle(c, choose(all, b, v)));
         for (int half = 0; half < 2; ++half) {
           std::vector<generation::AutoRule::Row> rows;
           for (const auto& b : c.blocks) {
             if (b.half != half) rows.push_back({b.features, b.styleHalf});
           }
+          if (v.withOthers) rows.insert(rows.end(), out.rows().begin(), out.rows().end());
           if (rows.empty()) continue;
           const generation::AutoRule rule(std::move(rows), v.k);
           for (std::size_t i = 0; i < c.blocks.size(); ++i) {
@@ -180,17 +191,24 @@ int main(int argc, char** argv) {
         }
         const pipeline::FitMeasures fo = pipeline::fitMeasures(c.board, r.all, outEntries);
         const pipeline::FitMeasures fc = pipeline::fitMeasures(c.board, r.all, cvEntries);
+        const pipeline::FitMeasures fi = pipeline::fitMeasures(c.board, r.all, inEntries);
+        inCities += better(fi, c.before);
+        inMeasures += measuresBetter(fi, c.before);
+        inObjective += pipeline::cityObjective(fi) / static_cast<double>(runs.size());
         outCities += better(fo, c.before);
         outMeasures += measuresBetter(fo, c.before);
         cvCities += better(fc, c.before);
         cvMeasures += measuresBetter(fc, c.before);
         outObjective += pipeline::cityObjective(fo) / static_cast<double>(runs.size());
         cvObjective += pipeline::cityObjective(fc) / static_cast<double>(runs.size());
-        detail += std::string("  ") + r.city->name + ": out " + text(fo) + ", cv " + text(fc) + "\n";
+        detail +=
+            std::string("  ") + r.city->name + ": out " + text(fo) + ", cv " + text(fc) + ", all " + text(fi) + "\n";
       }
-      std::printf("| %zu | %g | %g | %d of %zu / %d of %zu / %.3f | %d of %zu / %d of %zu / %.3f |\n%s", v.k,
-                  v.paperVote, v.far, outCities, runs.size(), outMeasures, 4 * runs.size(), outObjective, cvCities,
-                  runs.size(), cvMeasures, 4 * runs.size(), cvObjective, detail.c_str());
+      std::printf(
+          "| %zu | %g | %g | %s%s | %d of %zu / %d of %zu / %.3f | %d of %zu / %d of %zu / %.3f | %d / %d / %.3f |\n%s",
+          v.k, v.paperVote, v.far, v.weighted ? "yes" : "no", v.withOthers ? ", halves with the other cities" : "",
+          outCities, runs.size(), outMeasures, 4 * runs.size(), outObjective, cvCities, runs.size(), cvMeasures,
+          4 * runs.size(), cvObjective, inCities, inMeasures, inObjective, detail.c_str());
       std::fflush(stdout);
     }
   }

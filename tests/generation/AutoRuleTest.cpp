@@ -34,7 +34,7 @@ TEST(AutoRule, FeaturesDescribeTheBlockAndItsObservedParcels) {
   EXPECT_NEAR(autoFeatures(l, s, 1.0)[2], 700.0 / 1150.0, 1e-9);
 }
 
-TEST(AutoRule, PredictsTheStyleMostNearestRowsHaveTiesToTheNearest) {
+TEST(AutoRule, NearestRowsVoteByInverseDistanceTiesToTheNearest) {
   auto row = [](double x, const char* style) {
     AutoRule::Row r;
     r.features.fill(0);
@@ -46,13 +46,21 @@ TEST(AutoRule, PredictsTheStyleMostNearestRowsHaveTiesToTheNearest) {
                        row(12, "parish"), row(13, "skeleton")},
                       3);
   AutoFeatures x{};
+  x[0] = 0.5;
+  EXPECT_EQ(rule.predict(x), "sexton");  // obb 1 / 0.5 against sexton 1 / 0.5 + 1 / 1.5
   x[0] = 0.2;
-  EXPECT_EQ(rule.predict(x), "sexton");  // obb, sexton, sexton
+  EXPECT_EQ(rule.predict(x), "obb");  // obb 1 / 0.2 against sexton 1 / 0.8 + 1 / 1.8
+  x[0] = 0;
+  EXPECT_EQ(rule.predict(x), "obb");  // a training row's own features: its style
   x[0] = 12.4;
-  EXPECT_EQ(rule.predict(x), "parish");  // parish 12, skeleton 13, parish 11
+  EXPECT_EQ(rule.predict(x), "parish");  // parish 12 and 11 against skeleton 13
+  x[0] = 12.9;
+  EXPECT_EQ(rule.predict(x), "skeleton");  // skeleton 1 / 0.1 against parish 1 / 0.9 + 1 / 1.9
+  x[0] = 13;
+  EXPECT_EQ(rule.predict(x), "skeleton");  // its own row, whatever the two parish rows say
   const AutoRule pairs({row(0, "obb"), row(1, "sexton"), row(5, "skeleton"), row(6, "template")}, 2);
-  x[0] = 0.4;
-  EXPECT_EQ(pairs.predict(x), "obb");  // one vote each: the nearer
+  x[0] = 0.5;
+  EXPECT_EQ(pairs.predict(x), "obb");  // equal votes: the nearer (the first of equals)
   x[0] = 0.6;
   EXPECT_EQ(pairs.predict(x), "sexton");
 }
@@ -90,6 +98,17 @@ TEST(AutoRule, TheBundledRuleIsTrainedOnTheSixSharedDatasetsWithConcreteStyles) 
   for (const AutoRule::Row& r : rule.rows()) styles.insert(r.style);
   EXPECT_GE(styles.size(), 3u);
   for (const std::string& s : styles) EXPECT_FALSE(choosesPerBlock(style(s))) << s;
+  // A training block gives back its calibrated style (its own vote outweighs
+  // its neighbours'), and one slightly moved still does.
+  std::size_t same = 0, moved = 0;
+  for (const AutoRule::Row& r : rule.rows()) {
+    same += rule.predict(r.features) == r.style;
+    AutoFeatures x = r.features;
+    x[0] += 1e-7;
+    moved += rule.predict(x) == r.style;
+  }
+  EXPECT_EQ(same, rule.rows().size());
+  EXPECT_EQ(moved, rule.rows().size());
   // Leaving a city out leaves its rows out.
   const std::size_t withoutCambridge =
       AutoRule::fromCsv(AutoRule::bundledTable(), "auto_rule.csv", {"cambridge_ma"}).rows().size();

@@ -1,7 +1,7 @@
 #pragma once
-// The style `auto` picks per block: the style most of a block's nearest
-// neighbours got from calibration, in block features standardised over the
-// training blocks (docs/algorithms/auto.md). The training blocks are rows of
+// The style `auto` picks per block: the style a block's nearest neighbours
+// got from calibration, each voting with 1 / its distance, in block features
+// standardised over the training blocks (docs/algorithms/auto.md). The training blocks are rows of
 // a table: the bundled one (datasets/auto_rule.csv, made by
 // datasets/make_auto_rule.sh from the calibrations of the shared datasets) or
 // any a caller builds, for example from its own calibration.csv files.
@@ -61,7 +61,9 @@ public:
   /// The bundled table's text.
   static const std::string& bundledTable();
 
-  /// The style of most of the nearest rows (ties: the nearest's style).
+  /// The style with the most votes of the nearest rows, each voting with 1 /
+  /// its standardised distance (ties: the nearest's style). A block whose
+  /// features are a row's takes that row's style.
   const std::string& predict(const AutoFeatures& x) const;
   /// The `k` rows nearest `x`, nearest first: (squared standardised distance, row).
   std::vector<std::pair<double, std::size_t>> nearest(const AutoFeatures& x, std::size_t k) const;
@@ -69,6 +71,8 @@ public:
   const std::vector<Row>& rows() const { return rows_; }
   static constexpr std::size_t kNeighbours = 3;
   static constexpr AutoFeatures kWeights = {1, 1, 1, 1, 1, 1, 1};
+  /// Added to each distance before its vote is taken (standardised units).
+  static constexpr double kVoteFloor = 1e-9;
 
 private:
   std::vector<Row> rows_;
