@@ -16,6 +16,7 @@
 #include <optional>
 #include <set>
 
+#include "VectorInput.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Json.h"
 #include "parcelscope/io/Writers.h"
@@ -209,6 +210,10 @@ std::vector<fs::path> runEntries(const fs::path& folder, bool inside, std::error
 
 OutputDirectory::OutputDirectory(std::string target, const std::vector<std::string>& inputs)
     : target_(std::move(target)), inputs_(inputs) {
+  // The files a folder, list or VRT input names are inputs too.
+  for (const std::string& in : inputs) {
+    for (std::string& f : detail::filesReadWith(in)) inputs_.push_back(std::move(f));
+  }
   static std::atomic<unsigned> count{0};
   unique_ = std::to_string(::getpid()) + "-" + std::to_string(count++);
   std::error_code ec;

@@ -145,6 +145,57 @@ std::vector<std::string> inputFiles(const std::string& path) {
   return files;
 }
 
+std::vector<std::string> filesReadWith(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> out;
+  std::vector<std::pair<std::string, int>> pending = {{path, 0}};
+  while (!pending.empty()) {
+    const auto [p, depth] = pending.back();
+    pending.pop_back();
+    if (depth > 4) continue;  // nested lists and VRTs: a few levels, never a cycle
+    std::vector<std::string> named;
+    try {
+      named = inputFiles(p);
+    } catch (const Error&) {
+    }
+    std::string ext = fs::path(p).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    std::error_code ec;
+    if (named.empty() && ext == ".vrt" && fs::is_regular_file(p, ec)) {
+      QuietErrors quiet;
+      if (CPLXMLNode* root = CPLParseXMLFile(p.c_str())) {
+        std::vector<const CPLXMLNode*> nodes = {root};
+        while (!nodes.empty()) {
+          const CPLXMLNode* n = nodes.back();
+          nodes.pop_back();
+          for (; n; n = n->psNext) {
+            if (n->eType != CXT_Element) continue;
+            if (EQUAL(n->pszValue, "SrcDataSource")) {
+              const char* value = CPLGetXMLValue(n, nullptr, "");
+              const char* relative = CPLGetXMLValue(n, "relativeToVRT", "0");
+              if (*value) {
+                // Relative: to the VRT when it says so, else to the working
+                // folder; both are kept, whichever GDAL takes.
+                const fs::path source(value);
+                if (source.is_relative()) named.push_back((fs::path(p).parent_path() / source).lexically_normal());
+                if (!source.is_relative() || !EQUAL(relative, "1")) named.push_back(source.lexically_normal());
+              }
+            } else if (n->psChild) {
+              nodes.push_back(n->psChild);
+            }
+          }
+        }
+        CPLDestroyXMLNode(root);
+      }
+    }
+    for (const std::string& f : named) {
+      out.push_back(f);
+      pending.emplace_back(f, depth + 1);
+    }
+  }
+  return out;
+}
+
 // Opens `path` as a vector dataset; a folder of vector files or a list of
 // them (inputFiles) is opened as one layer, the union of each file's layer
 // `layer` (or first layer), through an in-memory OGR VRT.

@@ -29,6 +29,11 @@ std::string lastGdalMessage();
 GDALDatasetUniquePtr openVector(const std::string& path, const std::string& layer = {});
 /// The files of such an input, in order; empty when `path` is one dataset.
 std::vector<std::string> inputFiles(const std::string& path);
+/// Every file `path` makes a reader open besides itself: the files of a folder
+/// or list (inputFiles), the source datasets of an OGR VRT (SrcDataSource,
+/// relative to the VRT where it says so), and theirs in turn. What cannot be
+/// listed is left out (the reader names it). For the output folder's checks.
+std::vector<std::string> filesReadWith(const std::string& path);
 
 /// The CRS of `layer`: `crsOverride` (the --crs flag) when given, parsed into
 /// `storage` (and `overridden` set), else the one the layer declares (null:

@@ -531,6 +531,7 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
 std::vector<std::string> inputPaths(const CompareRequest& request) {
   std::vector<std::string> paths = {request.input.path};
   if (request.streets) paths.push_back(request.streets->path);
+  paths.insert(paths.end(), request.readFrom.begin(), request.readFrom.end());
   return paths;
 }
 

@@ -560,6 +560,7 @@ CompareRequest readSession(const std::string& path) {
       }
     }
   }
+  request.readFrom = {path};  // --out must not replace the session file
   return request;
 }
 

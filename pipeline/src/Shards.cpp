@@ -670,6 +670,7 @@ std::pair<CompareRequest, PreparedObserved> readShards(const std::vector<std::st
                             {"parcels_format", &request.parcelsFormat}}) {
     if (const Json* v = record.find(key); v && v->isString()) *field = v->string();
   }
+  request.readFrom = folders;  // --out must not replace a shard
   const int ranks = parts.front().count;
   return {std::move(request), prepareMerged(std::move(parts), ranks)};
 }

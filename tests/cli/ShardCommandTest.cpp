@@ -102,6 +102,21 @@ TEST(ShardCommand, ThreeShardsMergedWriteWhatOneProcessWrites) {
   EXPECT_NE(other.output.find("another request"), std::string::npos) << other.output;
   EXPECT_FALSE(fs::exists(dir / "partial"));
   EXPECT_EQ(2, runCli("compare '" + kSample + "' --shard 3/3 --out '" + (dir / "bad").string() + "'").code);
+  // Bug: a merge into one of its shard folders replaced the shard (exit 0).
+  const std::string shard0 = slurp((dir / "shard0" / "shard.bin").string());
+  for (const fs::path& into : {dir / "shard0", dir / "shard1" / "inner"}) {
+    const CliRun r = runCli("merge" + shards + " --quiet --out '" + into.string() + "'");
+    EXPECT_EQ(2, r.code) << r.output;
+    EXPECT_NE(r.output.find("input"), std::string::npos) << r.output;
+  }
+  EXPECT_EQ(slurp((dir / "shard0" / "shard.bin").string()), shard0);
+  EXPECT_FALSE(fs::exists(dir / "shard1" / "inner"));
+  // Nor may a run replace the session file it was given.
+  const std::string session = slurp((dir / "merged" / "run.json").string());
+  const CliRun again = runCli("compare --session '" + (dir / "merged" / "run.json").string() +
+                              "' --figures 0 --quiet --out '" + (dir / "merged").string() + "'");
+  EXPECT_EQ(2, again.code) << again.output;
+  EXPECT_EQ(slurp((dir / "merged" / "run.json").string()), session);
   fs::remove_all(dir);
 }
 

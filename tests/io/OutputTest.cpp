@@ -199,6 +199,34 @@ TEST(OutputDirectory, NeverOverwritesAnInput) {
   EXPECT_THROW(OutputDirectory(dir.path().string(), {input}), Error);  // --out holds the input
 }
 
+// Bug: a list or VRT naming a file inside --out (a previous run's
+// parcels.gpkg) let the run replace the folder, and the file with it.
+TEST(OutputDirectory, NeverOverwritesAFileThatAListOrAVrtNames) {
+  TempDir dir;
+  const std::string target = dir.file("run");
+  commitRun(target, kFirst);
+  const std::string named = (fs::path(target) / "parcels.csv").string();
+  const auto list = dir.write("communes.txt", "# one per line\nrun/parcels.csv\n");
+  const auto vrt = dir.write("communes.vrt",
+                             "<OGRVRTDataSource><OGRVRTUnionLayer name=\"p\"><OGRVRTLayer name=\"a\">"
+                             "<SrcDataSource relativeToVRT=\"1\">run/parcels.csv</SrcDataSource>"
+                             "</OGRVRTLayer></OGRVRTUnionLayer></OGRVRTDataSource>\n");
+  const auto nested = dir.write("lists.txt", "communes.vrt\n");
+  for (const std::string& input : {list, vrt, nested}) {
+    SCOPED_TRACE(input);
+    try {
+      OutputDirectory out(target, {input});
+      FAIL() << "a run may replace " << named;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), Error::Kind::Usage);
+      EXPECT_NE(std::string(e.what()).find("holds the input"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(snapshot(target), snapshotOf(kFirst));
+  // The same list with --out elsewhere runs.
+  EXPECT_NO_THROW(OutputDirectory(dir.file("other"), {list}));
+}
+
 // Bug: a second run into the same --out left the first run's files beside its
 // own (figures/ of a run with figures beside the tables of a run without).
 TEST(OutputDirectory, ASecondRunWithFewerFilesLeavesNoFileOfTheFirst) {

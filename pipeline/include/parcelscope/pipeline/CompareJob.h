@@ -45,10 +45,15 @@ struct CompareRequest {
   /// Format of the generated parcels written by runCompare: "gpkg"
   /// (parcels.gpkg) or "geojson" (parcels.geojson).
   std::string parcelsFormat = "gpkg";
+  /// Other files or folders the request came from (its session file, the
+  /// shard folders of a merge): inputs too for the output folder's checks.
+  /// Not written to sessions.
+  std::vector<std::string> readFrom;
 };
 
-/// The files `request` reads (its input, and its streets when given): an
-/// output folder must never hold or lie in one of them (io::OutputDirectory).
+/// The files `request` reads (its input, its streets when given, and
+/// `readFrom`): an output folder must never hold or lie in one of them
+/// (io::OutputDirectory).
 std::vector<std::string> inputPaths(const CompareRequest& request);
 
 /// The value of compare parameter `name` in `request`, or its default.
