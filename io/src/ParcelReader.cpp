@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <string_view>
@@ -207,6 +208,21 @@ void applyWhere(OGRLayer& layer, const ReadOptions& options) {
   }
 }
 
+// --where for a folder or list input, evaluated feature by feature: the union
+// of its files numbers its features in turn, and a filter set on the union
+// would number only those that pass (a feature's id would not be the one it
+// has in the file they were split from). Null when there is no --where.
+std::unique_ptr<OGRFeatureQuery> whereQuery(OGRLayer& layer, const ReadOptions& options) {
+  if (options.where.empty()) return nullptr;
+  auto query = std::make_unique<OGRFeatureQuery>();
+  CPLErrorReset();
+  if (query->Compile(&layer, options.where.c_str()) != OGRERR_NONE) {
+    throw inputError(options.path + ": --where \"" + options.where + "\" is not a valid filter on layer " +
+                     layer.GetName() + " (" + lastGdalMessage() + ")");
+  }
+  return query;
+}
+
 }  // namespace
 
 std::vector<std::string> layerNames(const std::string& path) {
@@ -281,7 +297,14 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
   result.layerName = layer->GetName();
   CleaningReport& report = result.report;
 
-  applyWhere(*layer, options);
+  // One file: the filter is set on the layer (its driver may use an index).
+  // Several files: each feature is tested as it is read (whereQuery).
+  std::unique_ptr<OGRFeatureQuery> where;
+  if (inputFiles(path).empty()) {
+    applyWhere(*layer, options);
+  } else {
+    where = whereQuery(*layer, options);
+  }
 
   // CRS: --crs replaces whatever the file declares.
   OGRSpatialReference overrideSrs;
@@ -424,6 +447,7 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
     if (featuresRead % 2000 == 0 && total > 0) {
       reportProgress(progress, 0.6 * static_cast<double>(featuresRead) / static_cast<double>(total), "reading");
     }
+    if (where && !where->Evaluate(feature.get())) continue;
     read.push_back(rawOf(*feature));
   }
   throwIfReadFailed();

@@ -329,6 +329,18 @@ TEST(ManyFiles, AFolderOrAListOfFilesIsReadAsOneLayer) {
     vrt << "</OGRVRTUnionLayer></OGRVRTDataSource>\n";
   }
   const ObservedData one = loadObserved(request.input, request.parameters);
+  // Bug: with --where, the files' features were numbered among those that pass
+  // the filter only, not as in the file they were split from.
+  CompareRequest filtered = request;
+  filtered.input.where = "use <> 'ROW' AND FID % 3 <> 1";
+  const ObservedData oneFiltered = loadObserved(filtered.input, filtered.parameters);
+  ASSERT_LT(oneFiltered.layer.parcels.size(), one.layer.parcels.size());
+  for (const fs::path& input : {dir / "communes", dir / "communes.txt"}) {
+    SCOPED_TRACE(input.string());
+    filtered.input.path = input.string();
+    expectSameObserved(oneFiltered, loadObserved(filtered.input, filtered.parameters));
+    expectSameObserved(oneFiltered, mergeShards(analyseWhole(filtered, 2)));
+  }
   for (const fs::path& input : {dir / "communes", dir / "communes.txt", dir / "communes.vrt"}) {
     SCOPED_TRACE(input.string());
     request.input.path = input.string();
