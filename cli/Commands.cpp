@@ -534,7 +534,7 @@ int compareOnRanks(const pipeline::CompareRequest& request, const std::string& o
     decoded.push_back(pipeline::decodeShard(parts[r], "rank " + std::to_string(r)));
     parts[r] = std::string();
   }
-  const pipeline::PreparedObserved prepared = pipeline::prepareMerged(std::move(decoded), size);
+  const pipeline::PreparedObserved prepared = pipeline::prepareMerged(std::move(decoded), size, request.input);
   return reportOutcome(viz::runCompare(request, out, terminalProgress(a.has("quiet")), &prepared), a);
 }
 }  // namespace

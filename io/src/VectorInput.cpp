@@ -3,9 +3,13 @@
 #include <cpl_error.h>
 #include <ogr_spatialref.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -66,6 +70,10 @@ static GDALDatasetUniquePtr openOne(const std::string& path) {
                      ", not a regular file or folder, so it is not read");
   }
   if (!folder && fs::file_size(path, ec) == 0 && !ec) throw inputError(path + ": is empty (0 bytes)");
+  // A file GDAL may not open is told as such, not as a format GDAL does not read.
+  if (!folder && ::access(path.c_str(), R_OK) != 0) {
+    throw inputError(path + ": cannot be read (" + std::strerror(errno) + ")");
+  }
   QuietErrors quiet;
   CPLErrorReset();
   GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
@@ -127,6 +135,7 @@ std::vector<std::string> inputFiles(const std::string& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   if (!fs::is_regular_file(path, ec) || (ext != ".txt" && ext != ".lst")) return {};
   std::ifstream list(path);
+  if (!list) throw inputError(path + ": cannot be read (" + std::strerror(errno) + ")");
   std::string line;
   for (int number = 1; std::getline(list, line); ++number) {
     while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();

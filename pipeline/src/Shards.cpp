@@ -219,7 +219,16 @@ ShardPart analyseShard(const CompareRequest& request, int index, int count, cons
   if (count < 1 || index < 0 || index >= count)
     throw usageError("shard " + std::to_string(index) + " of " + std::to_string(count) + " does not exist");
   const auto started = std::chrono::steady_clock::now();
-  const Strips strips{io::layerExtent(request.input), count};
+  Box extent;
+  try {
+    extent = io::layerExtent(request.input);
+  } catch (const Error&) {
+    // No extent: no feature with finite coordinates, or none at all. One
+    // process's read names why; failing that, the extent's error stands.
+    io::readParcels(request.input);
+    throw;
+  }
+  const Strips strips{extent, count};
   const double halo = 0.1 * std::max(strips.extent.width() / count, 1e-9);
   const analysis::AnalysisOptions options = analysis::analysisOptionsFrom(request.parameters);
   // Metres around a block within which every parcel must have been read: its
@@ -590,11 +599,14 @@ Json shardRecord(const ShardPart& p) {
 }
 }  // namespace
 
-PreparedObserved prepareMerged(std::vector<ShardPart> parts, int ranks) {
+PreparedObserved prepareMerged(std::vector<ShardPart> parts, int ranks, const io::ReadOptions& input) {
   Json shards = Json::array();
   for (const ShardPart& p : parts) shards.push(shardRecord(p));
   PreparedObserved prepared;
   prepared.data = std::make_shared<const ObservedData>(mergeShards(std::move(parts)));
+  // A shard's window may hold nothing; the whole layer holding nothing usable
+  // is told as one process tells it.
+  if (prepared.data->layer.parcels.empty()) io::readParcels(input);
   prepared.ranks = ranks;
   prepared.shards = std::move(shards);
   return prepared;
@@ -672,7 +684,8 @@ std::pair<CompareRequest, PreparedObserved> readShards(const std::vector<std::st
   }
   request.readFrom = folders;  // --out must not replace a shard
   const int ranks = parts.front().count;
-  return {std::move(request), prepareMerged(std::move(parts), ranks)};
+  PreparedObserved prepared = prepareMerged(std::move(parts), ranks, request.input);
+  return {std::move(request), std::move(prepared)};
 }
 
 }  // namespace parcelscope::pipeline

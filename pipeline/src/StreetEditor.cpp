@@ -625,6 +625,7 @@ EditReport StreetEditor::apply(const StreetEdit& edit) {
       }
       case StreetEdit::Op::InsertNode: {
         const std::size_t e = indexOf(g.edges, edit.edge);
+        requireWithinReach(edit.to, "the point of insert_node lies");  // NaN cut nowhere and changed nothing
         const analysis::RoadEdge& x = g.edges[e];
         // The point of the edge nearest `to`, and the edge cut there in two.
         std::size_t segment = 0;

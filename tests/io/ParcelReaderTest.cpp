@@ -4,6 +4,10 @@
 #include <gdal_utils.h>
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <sstream>
 
 #include <fstream>
@@ -428,6 +432,47 @@ TEST(ParcelReaderKeys, KeysComeFromGeometriesOrFromTheKeyField) {
   }
   o.keyFieldOptional = true;
   EXPECT_EQ(readParcels(o).parcels[1].featureKey, byGeometry.parcels[1].featureKey);
+}
+
+}  // namespace
+}  // namespace parcelscope::io
+
+namespace parcelscope::io {
+namespace {
+
+// Bug: a file (or list file) the user may not read was told as "not a file
+// format GDAL reads", or as a list naming no file. Run as another user when
+// the tests run as root (root reads mode 000 files).
+TEST(ParcelReader, AFileThatMayNotBeReadIsToldAsSuch) {
+  TempDir dir;
+  const std::string file = dir.write("parcels.geojson", test::quirksGeoJson());
+  const std::string list = dir.write("communes.txt", "parcels.geojson\n");
+  ::chmod(file.c_str(), 0);
+  ::chmod(list.c_str(), 0);
+  ::chmod(dir.path().c_str(), 0755);
+  for (const std::string& input : {file, list}) {
+    SCOPED_TRACE(input);
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      if (::geteuid() == 0 && (::setgid(65534) != 0 || ::setuid(65534) != 0)) ::_exit(77);
+      if (::access(input.c_str(), R_OK) == 0) ::_exit(77);  // readable after all: nothing to test
+      ReadOptions options;
+      options.path = input;
+      try {
+        readParcels(options);
+      } catch (const Error& e) {
+        const std::string what = e.what();
+        ::_exit(what == input + ": cannot be read (Permission denied)" ? 0 : 1);
+      }
+      ::_exit(2);
+    }
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status));
+    if (WEXITSTATUS(status) == 77) GTEST_SKIP() << "cannot run as a user who may not read the file";
+    EXPECT_EQ(WEXITSTATUS(status), 0) << "another message, or none";
+  }
 }
 
 }  // namespace

@@ -306,6 +306,41 @@ TEST(Shards, StreetBlocksAreNotSplit) {
   EXPECT_THROW(analyseShard(request, 0, 2, ShardReading{}), Error);
 }
 
+// Bug: a layer without a usable polygon was told, in shards, as "no block to
+// compare" or with GDAL's warning about an unclosed ring.
+TEST(Shards, ALayerWithoutAUsablePolygonIsToldAsOneProcessTellsIt) {
+  const fs::path dir = fs::temp_directory_path() / "parcelscope-shards-unusable";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "points.geojson")
+      << R"({"type":"FeatureCollection","features":[)"
+      << R"({"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[2.3,48.8]}},)"
+      << R"({"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[2.4,48.9]}}]})";
+  std::ofstream(dir / "nan.geojson")
+      << R"({"type":"FeatureCollection","features":[{"type":"Feature","properties":{},"geometry":)"
+      << R"({"type":"Polygon","coordinates":[[[NaN,48.8],[2.31,48.8],[2.31,48.81],[NaN,48.8]]]}}]})";
+  for (const char* name : {"points.geojson", "nan.geojson"}) {
+    SCOPED_TRACE(name);
+    CompareRequest request = test::sampleCompareRequest("obb");
+    request.input.path = (dir / name).string();
+    request.input.where.clear();
+    std::string one;
+    try {
+      io::readParcels(request.input);
+    } catch (const Error& e) {
+      one = e.what();
+    }
+    ASSERT_NE(one.find("no usable polygon"), std::string::npos) << one;
+    try {
+      prepareMerged(analyseWhole(request, 2), 2, request.input);
+      ADD_FAILURE() << "shards of an unusable layer were merged";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()), one);
+    }
+  }
+  fs::remove_all(dir);
+}
+
 TEST(ManyFiles, AFolderOrAListOfFilesIsReadAsOneLayer) {
   const fs::path dir = fs::temp_directory_path() / "parcelscope-many-files";
   fs::remove_all(dir);
@@ -393,7 +428,7 @@ TEST(SharedDatasetShards, CambridgeInThreeShardsGivesTheTablesOfOneProcess) {
   request.input.path = kCambridge;
   request.input.where = "ML <> 'ROAD'";
   auto one = std::make_shared<const ObservedData>(loadObserved(request.input, request.parameters));
-  const PreparedObserved merged = prepareMerged(analyseFiltered(request, 3), 3);
+  const PreparedObserved merged = prepareMerged(analyseFiltered(request, 3), 3, request.input);
   expectSameObserved(*one, *merged.data);
   const auto a = comparisonTables(compare(request, one));
   const auto b = comparisonTables(compare(request, merged.data));

@@ -604,6 +604,20 @@ TEST(StreetEditor, ABadEditNamesWhatIsWrongAndChangesNothing) {
     EXPECT_EQ(error.kind(), Error::Kind::Usage);
     EXPECT_NE(std::string(error.what()).find("moves a node"), std::string::npos) << error.what();
   }
+  // Bug: insert_node at NaN or infinity was "applied" and changed nothing (exit 0).
+  for (const Point at : {Point{NAN, 0}, Point{INFINITY, 1}, Point{0, 1e300}}) {
+    StreetEdit insert;
+    insert.op = StreetEdit::Op::InsertNode;
+    insert.edge = e.edge;
+    insert.to = at;
+    try {
+      editor.apply(insert);
+      ADD_FAILURE() << "insert_node at (" << at.x << ", " << at.y << ") was accepted";
+    } catch (const Error& error) {
+      EXPECT_EQ(error.kind(), Error::Kind::Usage);
+      EXPECT_NE(std::string(error.what()).find("insert_node"), std::string::npos) << error.what();
+    }
+  }
   EXPECT_TRUE(sameState(snapshot(editor), before));
   EXPECT_EQ(editor.undoSize(), 0u);
 }

@@ -84,8 +84,10 @@ JobOutcome runShard(const CompareRequest& request, int index, int count, const s
 std::pair<CompareRequest, PreparedObserved> readShards(const std::vector<std::string>& folders);
 
 /// The merged data of `parts` with run.json's record of them ("ranks",
-/// "shards": each one's blocks, parcels, windows read and seconds).
-PreparedObserved prepareMerged(std::vector<ShardPart> parts, int ranks);
+/// "shards": each one's blocks, parcels, windows read and seconds). When the
+/// shards hold no parcel at all, `input` is read in one process for the error
+/// one process gives (no usable polygon, and why).
+PreparedObserved prepareMerged(std::vector<ShardPart> parts, int ranks, const io::ReadOptions& input);
 
 /// Parses "I/N" (0 <= I < N) of --shard; throws Error(Usage).
 std::pair<int, int> parseShard(const std::string& text);
