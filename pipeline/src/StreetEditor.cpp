@@ -1037,7 +1037,10 @@ JobOutcome runEditWith(const std::function<std::unique_ptr<StreetEditor>(const P
       try {
         reports.push_back(editor.apply(edits[i]));
       } catch (const Error& e) {
-        throw Error(e.kind(),
+        // An edit the editor refuses is bad content of the edits file: an
+        // input error (exit 1, one line), whatever the editor calls it.
+        const Error::Kind kind = e.kind() == Error::Kind::Usage ? Error::Kind::Input : e.kind();
+        throw Error(kind,
                     editsPath + ": edit " + std::to_string(i) + " (" + editOpName(edits[i].op) + "): " + e.what());
       }
     }

@@ -385,9 +385,10 @@ TEST(EditCommand, EditsByKeyInTheInputsCrsAndWritesValidParcelsAndPersistence) {
   // An edit naming a node the network does not have: one line naming the file and the edit, nothing written.
   const std::string bad = dir.write("bad.json", R"([{"op": "move_node", "node": "0123456789abcdef", "to": [0, 0]}])");
   const CliRun b = run("edit '" + streets + "'" + kFlags + " --edits '" + bad + "' --out '" + dir.file("bad") + "'");
-  EXPECT_NE(b.code, 0);
+  EXPECT_EQ(b.code, 1);  // bad content of the edits file, not a usage error
   EXPECT_NE(b.output.find("bad.json: edit 0 (move_node): the network has no node 0123456789abcdef"), std::string::npos)
       << b.output;
+  EXPECT_EQ(b.output.find("--help"), std::string::npos) << b.output;
   EXPECT_FALSE(fs::exists(dir.file("bad")));
 }
 
