@@ -138,6 +138,7 @@ std::vector<std::string> inputFiles(const std::string& path) {
   if (!list) throw inputError(path + ": cannot be read (" + std::strerror(errno) + ")");
   std::string line;
   for (int number = 1; std::getline(list, line); ++number) {
+    if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // a UTF-8 byte order mark
     while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
     std::size_t start = 0;
     while (start < line.size() && std::isspace(static_cast<unsigned char>(line[start]))) ++start;
@@ -145,8 +146,17 @@ std::vector<std::string> inputFiles(const std::string& path) {
     if (line.empty() || line[0] == '#') continue;
     fs::path file(line);
     if (file.is_relative()) file = fs::path(path).parent_path() / file;
-    if (!fs::exists(file, ec)) {
-      throw inputError(path + ": line " + std::to_string(number) + ": " + file.string() + ": no such file");
+    const std::string where = path + ": line " + std::to_string(number) + ": " + file.string();
+    if (!fs::exists(file, ec)) throw inputError(where + ": no such file");
+    // A list names files: a folder or another list in it is not read as one.
+    std::string inner = file.extension().string();
+    std::transform(inner.begin(), inner.end(), inner.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (fs::is_directory(file, ec) && inner != ".gdb") {
+      throw inputError(where +
+                       ": is a folder; a list names files (give the folder itself as INPUT, or list its files)");
+    }
+    if (inner == ".txt" || inner == ".lst") {
+      throw inputError(where + ": is a list; lists do not nest (list its files here)");
     }
     files.push_back(file.lexically_normal().string());
   }

@@ -404,6 +404,23 @@ TEST(ManyFiles, AFolderOrAListOfFilesIsReadAsOneLayer) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("line 2"), std::string::npos) << e.what();
   }
+  // A list saved with a byte order mark reads; a folder or a list in a list is named.
+  std::ofstream(dir / "bom.txt") << "\xEF\xBB\xBF"
+                                 << "communes/a.geojson\n";
+  EXPECT_EQ(io::inputFiles((dir / "bom.txt").string()).front(), (dir / "communes" / "a.geojson").string());
+  std::ofstream(dir / "nested.txt") << "communes\ncommunes.txt\n";
+  std::ofstream(dir / "lists.txt") << "communes.txt\n";
+  for (const auto& [list, what] :
+       {std::pair<const char*, const char*>{"nested.txt", "is a folder"}, {"lists.txt", "lists do not nest"}}) {
+    try {
+      io::inputFiles((dir / list).string());
+      ADD_FAILURE() << list << " was read";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("line 1: ") + (dir / "communes").string()), std::string::npos)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  }
   fs::remove_all(dir);
 }
 
