@@ -87,6 +87,9 @@ constexpr double kChordSag = 0.05;                // the sharpest, for the match
 constexpr std::size_t kMaxCoarseVertices = 5000;  // blocks with more sides get no template
 constexpr int kMaxPerRow = 2000;
 constexpr std::size_t kMaxLots = 200000;
+// Parcels looked at, summed over the merges of parcels without street access
+// in one block (mergeWithoutAccess): about 2 s.
+constexpr std::size_t kMaxMergeWork = 20000000;
 constexpr double kNearBest = 0.05;   // candidates this close to the best score are drawn at random
 constexpr double kOutOfBounds = 10;  // weight of a parcel's squared log excess beyond a bound
 constexpr int kMaxWarps = 3;         // candidates warped before the block falls back
@@ -111,7 +114,10 @@ double median(std::vector<double> v) {
 }
 
 Sizes sizesFrom(const TemplateParameters& p, const ObservedSample* observed) {
-  Sizes s{p.aMin, p.aMax, p.wMin, p.wMax, std::sqrt(p.wMin * p.wMax), std::sqrt(p.aMin * p.aMax)};
+  // A lower bound of 0 (no smallest parcel) counts as a millionth of the upper
+  // one here, so that the aim stays positive (a zero aim split nothing).
+  auto mean = [](double lo, double hi) { return std::sqrt(std::max(lo, 1e-6 * hi) * hi); };
+  Sizes s{p.aMin, p.aMax, p.wMin, p.wMax, mean(p.wMin, p.wMax), mean(p.aMin, p.aMax)};
   if (observed && !observed->widths.empty()) s.width = median(observed->widths);
   if (observed && !observed->areas.empty()) s.area = median(observed->areas);
   s.width = std::clamp(s.width, s.wMin, s.wMax);
@@ -897,6 +903,19 @@ void mergeWithoutAccess(const Polygon& block, Subdivision& out, double minFronta
   const Box b = bounds(block);
   const analysis::PreparedBoundary edges(outline, std::max(1e-6, 1e-9 * (b.width() + b.height())));
   auto hasAccess = [&](const Polygon& q) { return edges.sharesAtLeast(q, minFrontage); };
+  // Each merge looks at every parcel once; passes go on while any merges. With
+  // thousands of parcels in a block (bounds of a few square metres) that grew
+  // as the cube of their number (minutes on one block): bounded, the block
+  // then falls back to obb.
+  std::size_t looked = 0;
+  auto merge = [&](std::size_t i, const std::function<bool(const Polygon&)>& eligible) {
+    looked += out.parcels.size();
+    if (looked > kMaxMergeWork) {
+      throw detail::StyleFailure("work budget: merging the parcels without street access (" +
+                                 std::to_string(out.parcels.size()) + " parcels)");
+    }
+    return detail::mergeIntoNeighbour(out.parcels, i, eligible, [&](const Polygon& u) { return validAt(u, origin); });
+  };
   // Passes until none merges: a parcel merged may give the next its
   // neighbour. When none merges into a neighbour with access, parcels without
   // access merge together (a cluster of them in the middle of a region), and
@@ -906,9 +925,7 @@ void mergeWithoutAccess(const Polygon& block, Subdivision& out, double minFronta
     const std::function<bool(const Polygon&)> eligible =
         anyNeighbour ? std::function<bool(const Polygon&)>{} : std::function<bool(const Polygon&)>{hasAccess};
     for (std::size_t i = 0; i < out.parcels.size();) {
-      if (hasAccess(out.parcels[i]) || detail::mergeIntoNeighbour(out.parcels, i, eligible, [&](const Polygon& u) {
-                                         return validAt(u, origin);
-                                       }) < 0) {
+      if (hasAccess(out.parcels[i]) || merge(i, eligible) < 0) {
         ++i;
       } else {
         merged = true;
