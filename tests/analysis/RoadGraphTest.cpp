@@ -524,3 +524,35 @@ TEST(RoadGraph, WidthsMeasuredFromTheBlocksOnEitherSide) {
 
 }  // namespace
 }  // namespace parcelscope::analysis
+
+namespace parcelscope::analysis {
+namespace {
+
+// Bug: ends were joined link by link, so ends 0.5 m apart along a row of
+// parallel streets chained into one node 100 m long and every street vanished
+// (0 edges, none counted as skipped). Ends now join only within twice the snap
+// distance of each other, and the streets stay.
+TEST(RoadGraph, EndsCloseInAChainDoNotCollapseIntoOneNode) {
+  std::vector<StreetLine> lines;
+  for (int i = 0; i < 200; ++i) lines.push_back(street({{0, 0.5 * i}, {1000, 0.5 * i}}, 4, ""));
+  const RoadGraph g = buildRoadGraph(lines);
+  // Each group of ends within 1 m of its first end joins (three streets, which
+  // then run between the same two nodes, a street apiece): about 200 / 3.
+  EXPECT_GE(g.edges.size(), 60u);
+  // Every node's ends came from within twice the snap distance: no edge is
+  // shorter than the streets' length less 2 m, and none longer.
+  for (const RoadEdge& e : g.edges) {
+    const double length = std::hypot(e.line.back().x - e.line.front().x, e.line.back().y - e.line.front().y);
+    EXPECT_NEAR(length, 1000, 2.0);
+  }
+  // A cluster that does not chain joins as before: three ends within 0.6 m.
+  const RoadGraph star = buildRoadGraph({street({{0, 0}, {100, 0}}, 4, ""), street({{0.3, 0.3}, {0, 100}}, 4, ""),
+                                         street({{-0.3, 0}, {-100, 0}}, 4, "")});
+  std::size_t degree3 = 0;
+  for (const RoadNode& n : star.nodes) degree3 += n.degree == 3;
+  EXPECT_EQ(degree3, 1u);
+  expectOrderFree(lines, "a chain of close ends");
+}
+
+}  // namespace
+}  // namespace parcelscope::analysis
