@@ -44,7 +44,7 @@ const std::vector<ParameterDescription>& sextonParameterDescriptions() {
     all.push_back(integerParameter("parcel-count",
                                    "sexton: parcels per block; 0: the block's observed count (without observed "
                                    "parcels: its area over the mean of a-min and a-max)",
-                                   "", 0.0, 1e6, 0.0, "Subdivision"));
+                                   "", 0.0, 2e5, 0.0, "Subdivision"));  // at most the work budget, kMaxLots
     all.push_back(integerParameter(
         "tries", "sexton: randomized subdivisions per block; the one closest to the observed parcels is kept", "", 1.0,
         1000.0, 50.0, "Subdivision"));
