@@ -553,10 +553,15 @@ CompareRequest readSession(const std::string& path) {
         if (!p->isObject()) throw bad("member " + where + "parameters is not an object");
         readValues(*p, where + "parameters.", override.parameters, nullptr);
       }
-      if (parsedKey) {
-        request.overrides[*parsedKey] = std::move(override);
-      } else {
-        request.overridesById[static_cast<std::int64_t>(id->number())] = std::move(override);
+      // A block named twice: which entry holds is not for the reader to guess.
+      const bool fresh = parsedKey
+                             ? request.overrides.emplace(*parsedKey, override).second
+                             : request.overridesById.emplace(static_cast<std::int64_t>(id->number()), override).second;
+      if (!fresh) {
+        throw bad("member " + where +
+                  (parsedKey ? "block_key " + keyText(*parsedKey)
+                             : "block_id " + std::to_string(static_cast<std::int64_t>(id->number()))) +
+                  ": an earlier override names the same block");
       }
     }
   }

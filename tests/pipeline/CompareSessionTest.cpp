@@ -525,6 +525,12 @@ TEST(SessionFile, BadMembersAreNamed) {
                         "overrides": [{"block_key": "00000000000000aa", "parameters": {"omega": 1e9}}]})")
                 .find("overrides[0].parameters.omega"),
             std::string::npos);
+  // Bug: a block named by two overrides took the last silently.
+  EXPECT_NE(message(R"({"parcelscope_session": 2, "input": {"path": "x"},
+                        "overrides": [{"block_key": "00000000000000aa", "style": "sexton"},
+                                      {"block_key": "00000000000000aa", "style": "obb"}]})")
+                .find("overrides[1].block_key 00000000000000aa: an earlier override names the same block"),
+            std::string::npos);
 }
 
 // Every list of parameter descriptions, by the function that returns it.
