@@ -83,6 +83,12 @@ using Stmt = std::unique_ptr<sqlite3_stmt, StmtFinalize>;
 
 }  // namespace
 
+std::string sqlQuoted(const std::string& text, char quote) {
+  std::string q(1, quote);
+  for (char c : text) q += c == quote ? std::string(2, c) : std::string(1, c);
+  return q + quote;
+}
+
 void fillRtree(const std::string& path, const std::string& rtreeName, std::vector<RtreeEntry> entries,
                const std::string& afterSql) {
   sqlite3* raw = nullptr;
@@ -106,11 +112,7 @@ void fillRtree(const std::string& path, const std::string& rtreeName, std::vecto
     sqlite3_reset(s);
   };
   // Shadow table names, quoted as identifiers.
-  auto shadow = [&](const char* suffix) {
-    std::string q = "\"";
-    for (char c : rtreeName + suffix) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-    return q + "\"";
-  };
+  auto shadow = [&](const char* suffix) { return sqlQuoted(rtreeName + suffix, '"'); };
 
   exec("BEGIN");
   // Node size: that of the empty root SQLite wrote when it made the table (it

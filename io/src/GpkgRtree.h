@@ -25,4 +25,8 @@ struct RtreeEntry {
 void fillRtree(const std::string& path, const std::string& rtreeName, std::vector<RtreeEntry> entries,
                const std::string& afterSql);
 
+/// `text` quoted for SQL with `quote` (' for a string, " for a name), the
+/// quote character doubled inside.
+std::string sqlQuoted(const std::string& text, char quote);
+
 }  // namespace parcelscope::io::detail

@@ -15,6 +15,7 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "GpkgRtree.h"
 #include "OgrConvert.h"
 #include "VectorInput.h"
 #include "parcelscope/core/Error.h"
@@ -157,13 +158,10 @@ Cleaned cleanFeature(const Feature& f, const LocalFrame& frame) {
 void restrictToWindow(GDALDataset& ds, OGRLayer& layer, const std::string& where, const Box& window) {
   if (!EQUAL(ds.GetDriverName(), "GPKG") || !*layer.GetFIDColumn() || !*layer.GetGeometryColumn()) return;
   const std::string rtree = std::string("rtree_") + layer.GetName() + "_" + layer.GetGeometryColumn();
-  auto quoted = [](const std::string& text, char quote) {
-    std::string q(1, quote);
-    for (char c : text) q += c == quote ? std::string(2, c) : std::string(1, c);
-    return q + quote;
-  };
+
   {
-    const std::string probe = "SELECT name FROM sqlite_master WHERE type = 'table' AND name = " + quoted(rtree, '\'');
+    const std::string probe =
+        "SELECT name FROM sqlite_master WHERE type = 'table' AND name = " + detail::sqlQuoted(rtree, '\'');
     OGRLayer* found = ds.ExecuteSQL(probe.c_str(), nullptr, nullptr);
     const bool indexed = found && found->GetFeatureCount() > 0;
     if (found) ds.ReleaseResultSet(found);
@@ -181,7 +179,7 @@ void restrictToWindow(GDALDataset& ds, OGRLayer& layer, const std::string& where
   bound("maxy", ">=", window.minY);
   bound("miny", "<=", window.maxY);
   if (box.empty()) return;  // the whole layer
-  const std::string fid = quoted(layer.GetFIDColumn(), '"'), table = quoted(rtree, '"');
+  const std::string fid = detail::sqlQuoted(layer.GetFIDColumn(), '"'), table = detail::sqlQuoted(rtree, '"');
   const std::string filter = (where.empty() ? "" : "(" + where + ") AND ") + "(" + fid + " IN (SELECT id FROM " +
                              table + " WHERE " + box + ") OR " + fid + " NOT IN (SELECT id FROM " + table + "))";
   CPLErrorReset();

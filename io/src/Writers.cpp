@@ -231,20 +231,16 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
     const std::string table = layer->GetName(), column = layer->GetGeometryColumn();
     if (layer->SyncToDisk() != OGRERR_NONE) throw fail("cannot create layer " + layerName);
     const std::string trigger = "rtree_" + table + "_" + column + "_insert";
-    auto quoted = [](const std::string& s, char q) {
-      std::string r(1, q);
-      for (char c : s) r += c == q ? std::string(2, q) : std::string(1, c);
-      return r + q;
-    };
     if (OGRLayer* found = ds->ExecuteSQL(
-            ("SELECT sql FROM sqlite_master WHERE type = 'trigger' AND name = " + quoted(trigger, '\'')).c_str(),
+            ("SELECT sql FROM sqlite_master WHERE type = 'trigger' AND name = " + detail::sqlQuoted(trigger, '\''))
+                .c_str(),
             nullptr, nullptr)) {
       if (auto f = std::unique_ptr<OGRFeature>(found->GetNextFeature())) insertTrigger = f->GetFieldAsString(0);
       ds->ReleaseResultSet(found);
     }
     if (!insertTrigger.empty()) {
       rtreeName = "rtree_" + table + "_" + column;
-      ds->ExecuteSQL(("DROP TRIGGER " + quoted(trigger, '"')).c_str(), nullptr, nullptr);
+      ds->ExecuteSQL(("DROP TRIGGER " + detail::sqlQuoted(trigger, '"')).c_str(), nullptr, nullptr);
       if (CPLGetLastErrorType() == CE_Failure) throw fail("cannot prepare the spatial index");
     }
   }
