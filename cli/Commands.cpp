@@ -384,10 +384,9 @@ int generateCommand(const std::vector<std::string>& args) {
   const std::vector<ParameterDescription> params =
       joined(generation::generationParameterDescriptions(), pipeline::streetParameters());
   if (wantsHelp(args)) {
-    std::fputs(usageText("parcelscope generate INPUT [--style obb|skeleton|offset|auto] [options] [--seed N] --out DIR",
-                         flags, params)
-                   .c_str(),
-               stdout);
+    std::fputs(
+        usageText("parcelscope generate INPUT [--style STYLE] [options] [--seed N] --out DIR", flags, params).c_str(),
+        stdout);
     std::fputs(
         "\nINPUT holds block polygons (e.g. blocks.gpkg from 'parcelscope stats', whose a_min, a_max,\n"
         "w_min and w_max fields are used per block unless given here), or observed parcels with\n"
@@ -443,7 +442,7 @@ int compareCommand(const std::vector<std::string>& args) {
   flags.push_back({"quiet", "no progress or summary on stderr", false});
   const auto params = joined(pipeline::compareParameters(), pipeline::streetParameters());
   if (wantsHelp(args)) {
-    std::fputs(usageText("parcelscope compare INPUT|--session FILE [--style obb|skeleton|offset|auto] [--k 2] [--seed "
+    std::fputs(usageText("parcelscope compare INPUT|--session FILE [--style STYLE] [--k 2] [--seed "
                          "N] [options] --out DIR",
                          flags, params)
                    .c_str(),
