@@ -451,7 +451,7 @@ CompareRequest readSession(const std::string& path) {
   }
   // Versions 1 and 2 are read; a later one may mean what this version cannot.
   if (const Json* v = root.find("parcelscope_session"); !v->isNumber() || !(v->number() == 1 || v->number() == 2)) {
-    throw bad("version " + (v->isNumber() ? v->dump(0) : std::string("?")) +
+    throw bad("version " + v->dump(0) + (v->isNumber() ? "" : " (a number is expected)") +
               " is not one this version reads (1 or 2): write it again with this version of ParcelScope");
   }
   auto text = [&](const Json& object, const char* key, const std::string& where) -> std::string {

@@ -517,6 +517,10 @@ TEST(SessionFile, BadMembersAreNamed) {
             std::string::npos);
   // Bug: a session of a later version (99) was read as if it were this one's.
   EXPECT_NE(message(R"({"parcelscope_session": 99, "input": {"path": "x"}})").find("version 99"), std::string::npos);
+  // Bug: a version written as a string was told as "version ?".
+  EXPECT_NE(
+      message(R"({"parcelscope_session": "2", "input": {"path": "x"}})").find("version \"2\" (a number is expected)"),
+      std::string::npos);
   // Bug: a value out of range was told later, as if given on the command line.
   EXPECT_NE(message(R"({"parcelscope_session": 2, "input": {"path": "x"}, "parameters": {"w-max": -3}})")
                 .find("parameters.w-max: --w-max -3 is outside"),
