@@ -92,10 +92,16 @@ static GDALDatasetUniquePtr openOne(const std::string& path) {
 
 namespace {
 
-// Extensions of the vector files a folder input is made of (shapefiles by their .shp).
-bool isVectorFile(const std::filesystem::path& p) {
+// The extension of `p`, in lower case (".gpkg").
+std::string lowerExtension(const std::filesystem::path& p) {
   std::string ext = p.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+// Extensions of the vector files a folder input is made of (shapefiles by their .shp).
+bool isVectorFile(const std::filesystem::path& p) {
+  const std::string ext = lowerExtension(p);
   for (const char* known :
        {".gpkg", ".geojson", ".json", ".topojson", ".shp", ".fgb", ".gml", ".kml", ".sqlite", ".tab", ".mif"}) {
     if (ext == known) return true;
@@ -131,8 +137,7 @@ std::vector<std::string> inputFiles(const std::string& path) {
     std::sort(files.begin(), files.end());
     return files;
   }
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = lowerExtension(path);
   if (!fs::is_regular_file(path, ec) || (ext != ".txt" && ext != ".lst")) return {};
   std::ifstream list(path);
   if (!list) throw inputError(path + ": cannot be read (" + std::strerror(errno) + ")");
@@ -149,8 +154,7 @@ std::vector<std::string> inputFiles(const std::string& path) {
     const std::string where = path + ": line " + std::to_string(number) + ": " + file.string();
     if (!fs::exists(file, ec)) throw inputError(where + ": no such file");
     // A list names files: a folder or another list in it is not read as one.
-    std::string inner = file.extension().string();
-    std::transform(inner.begin(), inner.end(), inner.begin(), [](unsigned char c) { return std::tolower(c); });
+    const std::string inner = lowerExtension(file);
     if (fs::is_directory(file, ec) && inner != ".gdb") {
       throw inputError(where +
                        ": is a folder; a list names files (give the folder itself as INPUT, or list its files)");
@@ -171,16 +175,14 @@ std::vector<std::string> filesReadWith(const std::string& path) {
   while (!pending.empty()) {
     const auto [p, depth] = pending.back();
     pending.pop_back();
-    if (depth > 4) continue;  // nested lists and VRTs: a few levels, never a cycle
+    if (depth > 4) continue;  // VRTs naming VRTs or lists: a few levels, never a cycle
     std::vector<std::string> named;
     try {
       named = inputFiles(p);
     } catch (const Error&) {
     }
-    std::string ext = fs::path(p).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
     std::error_code ec;
-    if (named.empty() && ext == ".vrt" && fs::is_regular_file(p, ec)) {
+    if (named.empty() && lowerExtension(p) == ".vrt" && fs::is_regular_file(p, ec)) {
       QuietErrors quiet;
       if (CPLXMLNode* root = CPLParseXMLFile(p.c_str())) {
         std::vector<const CPLXMLNode*> nodes = {root};
