@@ -40,6 +40,12 @@ const std::vector<ParameterDescription>& skeletonParameterDescriptions() {
                     "Which street a corner parcel faces: street-width, the wider one (the longer one when "
                     "widths are equal or unknown); street-length, the longer one",
                     {"street-width", "street-length"}, "street-width", "Skeleton"),
+      enumParameter(
+          "slice-widths",
+          "Widths of the parcels cut along a street: even, the paper's (W_min + W_max) / 2 displaced by "
+          "omega; observed, drawn from the block's observed parcel widths and scaled to fill each street (their "
+          "spread is the irregularity: omega moves no cut; even where the block has no observed parcel)",
+          {"even", "observed"}, "observed", "Skeleton"),
       booleanParameter("patio-obb",
                        "Subdivide patios with the OBB style; no: each patio is one parcel (style offset: always "
                        "yes)",
@@ -59,6 +65,7 @@ SkeletonParameters skeletonParametersFrom(const ParameterValues& values) {
   p.streetAngle = get("street-angle", p.streetAngle);
   p.corner = get("corner-rule", 0) >= 0.5 ? CornerRule::StreetLength : CornerRule::StreetWidth;
   p.subdividePatios = get("patio-obb", 0) >= 0.5;
+  p.observedSliceWidths = get("slice-widths", 1) >= 0.5;
   return p;
 }
 
@@ -960,11 +967,36 @@ private:
     const double length = end - start;
     std::vector<double> cuts;
     if (length <= 0) return cuts;
+    if (!p_.sliceWidths.empty()) return drawnCuts(start, length);
     const int n = std::max(1, static_cast<int>(std::lround(length / target_)));
     const double spacing = length / n, sigma = std::sqrt(3.0 * p_.bounds.omega);
     for (int k = 1; k < n; ++k) {
       const double shift = std::clamp(sigma * rng_.normal(), -0.45 * spacing, 0.45 * spacing);
       cuts.push_back(start + k * spacing + shift);
+    }
+    return cuts;
+  }
+
+  // Widths drawn from p_.sliceWidths until they cover the strip (the last
+  // kept when that comes closer to its length), then scaled to fill it.
+  std::vector<double> drawnCuts(double start, double length) {
+    const std::vector<double>& sample = p_.sliceWidths;
+    std::vector<double> widths;
+    double sum = 0;
+    while (sum < length && static_cast<double>(widths.size()) < kMaxStripParcels) {
+      const auto i = static_cast<std::size_t>(rng_.uniform() * static_cast<double>(sample.size()));
+      widths.push_back(sample[std::min(i, sample.size() - 1)]);
+      sum += widths.back();
+    }
+    if (widths.size() > 1 && sum - length > length - (sum - widths.back())) {
+      sum -= widths.back();
+      widths.pop_back();
+    }
+    std::vector<double> cuts;
+    double at = 0;
+    for (std::size_t k = 0; k + 1 < widths.size(); ++k) {
+      at += widths[k];
+      cuts.push_back(start + at * length / sum);
     }
     return cuts;
   }
@@ -1601,6 +1633,11 @@ public:
     if (offset_) {
       if (p.offset <= 0) p.offset = kDefaultOffsetStyleDepth;
       p.subdividePatios = true;
+    }
+    if (p.observedSliceWidths && r.observed) {
+      for (double w : r.observed->widths) {
+        if (std::isfinite(w) && w > 0) p.sliceWidths.push_back(w);
+      }
     }
     // The layout checks for itself that it was made for this block and these parameters.
     const SkeletonLayout* layout = r.previous ? r.previous->skeletonLayout.get() : nullptr;

@@ -106,6 +106,10 @@ public:
   const Style& resolve(const BlockFacts& facts) const override {
     return std::isfinite(facts.accessShare) && facts.accessShare < kAccessSkeletonShare ? obbStyle() : skeletonStyle();
   }
+  // The paper slices each street evenly (4.2, step 4).
+  void pinValues(ParameterValues& values) const override {
+    if (values.count("slice-widths")) values["slice-widths"] = 0;
+  }
 };
 
 // auto: the style the calibrated blocks most like this one got

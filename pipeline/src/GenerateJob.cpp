@@ -191,6 +191,7 @@ std::vector<BlockPlan> planBlocks(const GenerateRequest& request, const BlockInp
     const Style& concrete = chosen.resolve({e.accessShare, &e.shape, e.observed.get(), e.observedShare});
     plan.style = concrete.name();
     plan.values = styleValues(concrete, v);
+    chosen.pinValues(plan.values);
     plan.values["a-min"] = p.aMin;
     plan.values["a-max"] = p.aMax;
     plan.values["w-min"] = p.wMin;

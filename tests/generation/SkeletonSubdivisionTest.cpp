@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -65,6 +66,56 @@ TEST(SkeletonSubdivision, RectangleGivesTwoRowsBackToBackAlongTheCentreLine) {
   EXPECT_EQ(above, 8);
   EXPECT_EQ(s.withoutAccess, 0);
   EXPECT_EQ(s.patioParcels, 0);
+}
+
+TEST(SkeletonSubdivision, OneDrawnSliceWidthCutsEachStreetAtThatWidth) {
+  // The rectangle above with slice widths drawn from {15}: 120 m of street
+  // at 15 m is 8 parcels a row, each 15 m wide, whatever W_min and W_max say.
+  const Polygon block = rect(0, 0, 120, 50);
+  SkeletonParameters p = params(100, 2000, 4, 60, 0.3);
+  p.sliceWidths = {15};
+  const Subdivision s = subdivideSkeleton(block, p, 7);
+  ASSERT_FALSE(s.fallback) << s.fallbackReason;
+  EXPECT_TILES(block, s.parcels, "rectangle, drawn widths");
+  int interior = 0;
+  for (const Polygon& q : s.parcels) {
+    const Box b = bounds(q);
+    if (b.minX < kNode || b.maxX > 120 - kNode) continue;  // the rows' ends
+    EXPECT_NEAR(b.maxX - b.minX, 15, kNode);
+    ++interior;
+  }
+  EXPECT_EQ(s.parcels.size(), 16u);
+  EXPECT_EQ(interior, 12);
+}
+
+TEST(SkeletonSubdivision, DrawnSliceWidthsComeFromTheSampleScaledToFillTheStreet) {
+  // Widths drawn from {8, 24}: within a row every parcel away from the ends
+  // is 8 s or 24 s wide, s the row's one scale factor (near 1), and both occur.
+  const Polygon block = rect(0, 0, 400, 60);
+  SkeletonParameters p = params(10, 1e5, 2, 100);
+  p.sliceWidths = {8, 24};
+  const Subdivision s = subdivideSkeleton(block, p, 11);
+  ASSERT_FALSE(s.fallback) << s.fallbackReason;
+  EXPECT_TILES(block, s.parcels, "drawn widths");
+  for (const bool lower : {true, false}) {
+    std::vector<double> widths;
+    for (const Polygon& q : s.parcels) {
+      const Box b = bounds(q);
+      if (b.minX < 40 || b.maxX > 360 || (b.maxY <= 30 + kNode) != lower) continue;
+      widths.push_back(b.maxX - b.minX);
+    }
+    ASSERT_GE(widths.size(), 8u);
+    const double narrow = *std::min_element(widths.begin(), widths.end());
+    EXPECT_NEAR(narrow / 8, 1, 0.25);
+    int small = 0, large = 0;
+    for (double w : widths) {
+      small += std::abs(w - narrow) < kNode;
+      large += std::abs(w - 3 * narrow) < kNode;
+    }
+    EXPECT_EQ(small + large, static_cast<int>(widths.size()));
+    EXPECT_GT(small, 0);
+    EXPECT_GT(large, 0);
+  }
 }
 
 TEST(SkeletonSubdivision, LShapedBlockGivesParcelsAlongEveryStreet) {
@@ -254,6 +305,16 @@ SkeletonParameters randomParameters(std::mt19937_64& rng, double a, bool offset,
   return p;
 }
 
+// A skewed sample of 1 to 30 slice widths around the bounds' middle (its own
+// random stream, so the shapes stay those of the seed).
+std::vector<double> drawnWidths(int i, const ObbParameters& b) {
+  std::mt19937_64 rng(0x51CE0000u + static_cast<std::uint64_t>(i));
+  std::lognormal_distribution<double> w(std::log(0.5 * (b.wMin + b.wMax)), 0.5);
+  std::vector<double> out(1 + rng() % 30);
+  for (double& x : out) x = w(rng);
+  return out;
+}
+
 TEST(SkeletonSubdivision, RandomShapesAreTiledValidlyWithStreetAccess) {
   std::mt19937_64 rng = test::seededRandom(20261122, "random shapes");
   std::uniform_real_distribution<double> u(0, 1);
@@ -262,7 +323,8 @@ TEST(SkeletonSubdivision, RandomShapesAreTiledValidlyWithStreetAccess) {
     const int kind = i % test::kShapeKinds;
     const Polygon block = test::randomShape(rng, kind);
     const double a = area(block);
-    const SkeletonParameters p = randomParameters(rng, a, i % 4 == 0, i % 8 == 0, i % 2 != 0);
+    SkeletonParameters p = randomParameters(rng, a, i % 4 == 0, i % 8 == 0, i % 2 != 0);
+    if (i % 3 == 1) p.sliceWidths = drawnWidths(i, p.bounds);
     const std::uint64_t s = rng();
     const Subdivision sub = subdivideSkeleton(block, p, s);
     const std::string what = "shape " + std::to_string(i) + " kind " + std::to_string(kind) +
@@ -311,7 +373,8 @@ TEST(SkeletonSubdivision, FloatingPointRouteAgreesWithTheExactRoute) {
   for (int i = 0; i < 300 / test::kSanitizerDivisor; ++i) {
     const Polygon block = test::randomShape(rng, i % test::kShapeKinds);
     const double a = area(block);
-    const SkeletonParameters p = randomParameters(rng, a, i % 4 == 0, i % 8 == 0, i % 2 != 0);
+    SkeletonParameters p = randomParameters(rng, a, i % 4 == 0, i % 8 == 0, i % 2 != 0);
+    if (i % 3 == 1) p.sliceWidths = drawnWidths(i, p.bounds);
     const std::uint64_t s = rng();
     const Subdivision fast = subdivideSkeleton(block, p, s);
     SkeletonReuse exactOnly;

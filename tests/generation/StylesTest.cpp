@@ -68,6 +68,13 @@ TEST(Styles, AccessAndAutoChoosePerBlockAndDoNotSubdivideThemselves) {
   EXPECT_EQ(&obbStyle().resolve({0.5}), &obbStyle());
   EXPECT_TRUE(choosesPerBlock(autoStyle()));
   EXPECT_TRUE(choosesPerBlock(accessStyle()));
+  // The paper's rule slices evenly (its skeleton's default draws observed widths); auto pins nothing.
+  ParameterValues values = styleValues(skeletonStyle(), {});
+  EXPECT_EQ(values.at("slice-widths"), 1);
+  autoStyle().pinValues(values);
+  EXPECT_EQ(values.at("slice-widths"), 1);
+  accessStyle().pinValues(values);
+  EXPECT_EQ(values.at("slice-widths"), 0);
   EXPECT_FALSE(choosesPerBlock(sextonStyle()));
   for (const char* name : {"auto", "access"})
     EXPECT_THROW(subdivideBlock(test::rect(0, 0, 60, 40), name, {}, 1), Error);

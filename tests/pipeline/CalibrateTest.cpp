@@ -3,6 +3,8 @@
 // rule is measured on blocks it was not fitted on.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <numeric>
 #include <set>
@@ -60,6 +62,37 @@ TEST(Calibrate, CalibratedStylesLowerTheCityObjectiveAndTheSessionReproducesThem
     }
   }
   EXPECT_EQ(improvable, 0);
+  // No worse than any of its starts: each block's style of least distance, of
+  // least count error, and the paper's rule.
+  std::vector<std::size_t> nearest(n), counted(n);
+  for (std::size_t b = 0; b < n; ++b) {
+    auto cmp = [&](std::size_t e) -> const analysis::Comparison& {
+      return c.board.entries[e].result.blocks[b].comparison;
+    };
+    auto count = [&](std::size_t e) {
+      return std::fabs(static_cast<double>(cmp(e).generated.parcels) /
+                           static_cast<double>(std::max<std::int64_t>(1, cmp(e).observed.parcels)) -
+                       1);
+    };
+    std::vector<std::size_t> concreteEntries;
+    for (std::size_t e = 0; e < c.board.entries.size(); ++e) {
+      if (!generation::choosesPerBlock(generation::style(c.board.entries[e].style))) concreteEntries.push_back(e);
+    }
+    nearest[b] = concreteEntries.front();
+    for (std::size_t e : concreteEntries) {
+      if (calibrationDistance(cmp(e)) < calibrationDistance(cmp(nearest[b]))) nearest[b] = e;
+    }
+    counted[b] = nearest[b];  // ties in count: least distance
+    for (std::size_t e : concreteEntries) {
+      if (count(e) < count(counted[b]) ||
+          (count(e) == count(counted[b]) && calibrationDistance(cmp(e)) < calibrationDistance(cmp(counted[b])))) {
+        counted[b] = e;
+      }
+    }
+  }
+  EXPECT_LE(objective, calibrationObjective(fitMeasures(c.board, all, nearest), c.before) + 1e-12);
+  EXPECT_LE(objective, calibrationObjective(fitMeasures(c.board, all, counted), c.before) + 1e-12);
+  EXPECT_LE(objective, calibrationObjective(fitMeasures(c.board, all, c.entryBefore), c.before) + 1e-12);
   // The session file gives, through compare, the measures calibrate reports.
   test::TempDir dir;
   const std::string out = dir.file("calibrated");

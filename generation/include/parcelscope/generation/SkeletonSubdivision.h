@@ -62,6 +62,12 @@ struct SkeletonParameters {
   double streetAngle = 30;  ///< degrees; contour corners turning less continue the same logical street
   CornerRule corner = CornerRule::StreetWidth;
   bool subdividePatios = false;  ///< patios subdivided with the OBB style instead of one parcel each
+  /// Slice widths to draw from (m), e.g. the block's observed parcel widths:
+  /// each strip is cut into widths drawn from these, scaled to fill it. Empty:
+  /// the paper's even spacing, (W_min + W_max) / 2 displaced by omega.
+  std::vector<double> sliceWidths;
+  /// slice-widths = observed: the style fills sliceWidths from the block's observed parcels.
+  bool observedSliceWidths = false;
 };
 
 /// Descriptions of the skeleton-only parameters (offset, street-angle,

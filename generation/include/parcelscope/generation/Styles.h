@@ -68,6 +68,9 @@ public:
   /// The concrete style a block is subdivided with: this one, or for a style
   /// that chooses per block (auto), the one it picks.
   virtual const Style& resolve(const BlockFacts&) const { return *this; }
+  /// Values a style that chooses per block fixes for the style it picked
+  /// (access: the paper's even slices), whatever the run's values say.
+  virtual void pinValues(ParameterValues&) const {}
   /// Subdivides one block. Deterministic: the same block, values and seed give
   /// the same parcels. Geometric failures come back in the Subdivision (failed,
   /// or fallback to obb with the reason); memory, a stop or a usage error throw.

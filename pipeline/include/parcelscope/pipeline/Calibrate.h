@@ -80,17 +80,19 @@ double cityObjective(const FitMeasures& f);
 /// Weight of a measure's excess over the paper's rule in calibrationObjective().
 constexpr double kExcessWeight = 10;
 
-/// What the calibration lowers: cityObjective(f), plus kExcessWeight times
-/// each measure's excess over the paper's rule's `paper` on the same blocks,
-/// so that a calibration that can be better than the paper's rule on every
-/// measure is preferred to one better on the sum only.
+/// What the calibration lowers: cityObjective(f), plus the largest of its four
+/// measures (so that no measure is left far behind the others), plus
+/// kExcessWeight times each measure's excess over the paper's rule's `paper`
+/// on the same blocks, so that a calibration that can be better than the
+/// paper's rule on every measure is preferred to one better on the sum only.
 double calibrationObjective(const FitMeasures& f, const FitMeasures& paper);
 
 /// Runs every concrete style on `request`'s blocks (request.style is ignored)
-/// and calibrates: each block first takes its style of least distance; when
-/// the paper's rule scores better city-wide, the blocks start from its choice
-/// instead; then, twice over the blocks, a block's style is changed wherever
-/// that lowers calibrationObjective(). Throws as compare().
+/// and calibrates: from three starts (each block's style of least distance,
+/// the paper's rule, each block's style of least count error), up to four
+/// times over the blocks, a block's style is changed wherever that lowers
+/// calibrationObjective(); the start that ends lowest wins. The searches (the
+/// city's and the cross-validation halves') run in parallel. Throws as compare().
 Calibration calibrate(const CompareRequest& request, const ProgressFn& progress = {});
 
 /// The leaderboard entry of style `style`; throws std::logic_error when absent.
