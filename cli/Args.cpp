@@ -9,8 +9,6 @@
 
 namespace parcelscope::cli {
 
-namespace {
-
 // Whether strtod would read all of `text` as a number that is not written in
 // decimal: hexadecimal ("0x2", "0x1p3"), "inf", "infinity" or "nan". Leading
 // blanks, which strtod skips, are allowed as before.
@@ -37,8 +35,6 @@ bool readsAsNonDecimalNumber(const std::string& text) {
   }
   return i != text.size();
 }
-
-}  // namespace
 
 Args::Args(const std::vector<std::string>& args, const std::vector<FlagSpec>& flags,
            const std::vector<ParameterDescription>& parameters)

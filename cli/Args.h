@@ -45,6 +45,10 @@ private:
 /// Help text listing flags, then the parameters by group (ParameterDescription::group,
 /// in order of first appearance), each with unit, range, default and help, and an
 /// enum's labels with their numbers.
+/// Whether strtod would read all of `text` as a number not written in decimal:
+/// hexadecimal ("0x2", "0x1p3"), "inf", "infinity" or "nan" (leading blanks allowed).
+bool readsAsNonDecimalNumber(const std::string& text);
+
 std::string usageText(const std::string& synopsis, const std::vector<FlagSpec>& flags,
                       const std::vector<ParameterDescription>& parameters);
 

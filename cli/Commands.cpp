@@ -90,23 +90,30 @@ io::StreetReadOptions streetOptions(const Args& a, const std::string& path, cons
   o.nameField = a.value("name-field").value_or("");
   o.noNodeWhere = a.value("no-node-where").value_or("");
   if (const auto widths = a.value("class-widths")) {
+    auto trimmed = [](const std::string& t) {
+      const std::size_t first = t.find_first_not_of(" \t");
+      return first == std::string::npos ? std::string() : t.substr(first, t.find_last_not_of(" \t") - first + 1);
+    };
     std::size_t at = 0;
     while (at <= widths->size()) {
       const std::size_t comma = std::min(widths->find(',', at), widths->size());
       const std::string item = widths->substr(at, comma - at);
       const std::size_t eq = item.rfind('=');
+      const std::string name = eq == std::string::npos ? std::string() : trimmed(item.substr(0, eq));
+      const std::string number = eq == std::string::npos ? std::string() : trimmed(item.substr(eq + 1));
       double w = NAN;
       std::size_t used = 0;
       try {
-        if (eq != std::string::npos) w = std::stod(item.substr(eq + 1), &used);
+        if (!number.empty() && !readsAsNonDecimalNumber(number)) w = std::stod(number, &used);
       } catch (const std::exception&) {
       }
-      if (eq == std::string::npos || eq == 0 || used != item.size() - eq - 1 || !std::isfinite(w) || w < 0 ||
-          w > io::kMaxStreetWidth) {
-        throw usageError("--class-widths: '" + item + "' is not CLASS=METRES (a width of 0 to " +
+      if (name.empty() || used != number.size() || !std::isfinite(w) || w < 0 || w > io::kMaxStreetWidth) {
+        throw usageError("--class-widths: '" + item + "' is not CLASS=METRES (a decimal width of 0 to " +
                          std::to_string(static_cast<int>(io::kMaxStreetWidth)) + " m)");
       }
-      o.classWidths[item.substr(0, eq)] = w;
+      if (!o.classWidths.emplace(name, w).second) {
+        throw usageError("--class-widths: class '" + name + "' is given twice");
+      }
       at = comma + 1;
     }
     if (o.classField.empty()) throw usageError("--class-widths needs --class-field");

@@ -396,6 +396,20 @@ CompareRequest withAbsolutePaths(CompareRequest request) {
   return request;
 }
 
+Json streetOptionsJson(const io::StreetReadOptions& st) {
+  Json classWidths = Json::object();
+  for (const auto& [value, width] : st.classWidths) classWidths.set(value, width);
+  return Json::object()
+      .set("path", st.path)
+      .set("layer", st.layer)
+      .set("where", st.where)
+      .set("width_field", st.widthField)
+      .set("class_field", st.classField)
+      .set("class_widths", classWidths)
+      .set("name_field", st.nameField)
+      .set("no_node_where", st.noNodeWhere);
+}
+
 Json sessionJson(const CompareRequest& request) {
   Json parameters = Json::object();
   for (const auto& name : request.explicitParameters) {
@@ -418,19 +432,7 @@ Json sessionJson(const CompareRequest& request) {
                                        .set("where", request.input.where)
                                        .set("crs", request.input.crsOverride)
                                        .set("key_field", request.input.keyField));
-  if (const auto& st = request.streets) {
-    Json classWidths = Json::object();
-    for (const auto& [value, width] : st->classWidths) classWidths.set(value, width);
-    session.set("streets", Json::object()
-                               .set("path", st->path)
-                               .set("layer", st->layer)
-                               .set("where", st->where)
-                               .set("width_field", st->widthField)
-                               .set("class_field", st->classField)
-                               .set("class_widths", classWidths)
-                               .set("name_field", st->nameField)
-                               .set("no_node_where", st->noNodeWhere));
-  }
+  if (const auto& st = request.streets) session.set("streets", streetOptionsJson(*st));
   return session.set("style", request.style)
       .set("metric", request.metric)
       .set("parameters", parameters)

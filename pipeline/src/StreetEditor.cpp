@@ -275,9 +275,14 @@ std::shared_ptr<const StreetEditor::State> StreetEditor::build(std::shared_ptr<c
   }
   // The observed layer itself, shared (not copied on every edit).
   if (observed_) s->inputs.source = std::shared_ptr<const io::ParcelLayer>(observed_, &observed_->layer);
-  // An override stays with its block's key; a block gone takes its override with it.
+  // An override stays with its block's key; a block gone takes its override
+  // with it. The first state's overrides must name blocks of the network, as
+  // compare and generate require.
   std::set<Key> keys;
   for (const BlockInputs::Entry& e : s->inputs.entries) keys.insert(e.blockKey);
+  for (const auto& [key, o] : previous ? BlockOverrides{} : overrides) {
+    if (!keys.count(key)) throw usageError("block " + keyText(key) + ": no such block (override)");
+  }
   for (auto it = overrides.begin(); it != overrides.end();) {
     it = keys.count(it->first) ? std::next(it) : overrides.erase(it);
   }

@@ -11,6 +11,7 @@
 #include "parcelscope/core/Parallel.h"
 #include "parcelscope/io/OutputDirectory.h"
 #include "parcelscope/io/Writers.h"
+#include "parcelscope/pipeline/CompareSession.h"
 
 namespace parcelscope::pipeline {
 
@@ -370,7 +371,7 @@ JobOutcome writeBlocks(io::OutputDirectory& out, const io::StreetReadOptions& st
   }
   const auto written = writeStreetLayers(out, network, withParcels);
   Json run = runRecord("blocks", parameters);
-  run.set("streets", streetRecord(network));
+  run.set("streets", streetRecord(network).set("options", streetOptionsJson(streets)));
   if (parcels) {
     addObservedRecord(run, observed);
   }

@@ -5,6 +5,9 @@
 // order of the input's features; generated parcels tile their street blocks.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -244,6 +247,10 @@ TEST(BlocksCommand, BadStreetInputsAreOneLineErrors) {
       {"blocks '" + streets + "' --class-field NAME --class-widths 'East 0=abc' --out '" + dir.file("o3") + "'", 2,
        "--class-widths"},
       {"blocks '" + streets + "' --class-widths 'a=3' --out '" + dir.file("o4") + "'", 2, "needs --class-field"},
+      {"blocks '" + streets + "' --class-field NAME --class-widths 'a=0x10' --out '" + dir.file("o7") + "'", 2,
+       "decimal width"},
+      {"blocks '" + streets + "' --class-field NAME --class-widths 'a=3,b=4,a=5' --out '" + dir.file("o8") + "'", 2,
+       "class 'a' is given twice"},
       {"generate --width-field W --out '" + dir.file("o5") + "'", 2, "needs --streets"},
       {"blocks '" + streets + "' --no-node-where 'NO SUCH' --out '" + dir.file("o6") + "'", 1, "--no-node-where"},
   };
@@ -254,6 +261,18 @@ TEST(BlocksCommand, BadStreetInputsAreOneLineErrors) {
     // One line; a usage error adds where to find the usage.
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), c.code == 2 ? 2 : 1) << r.output;
   }
+  // Blanks around a class and its width are not part of them.
+  const CliRun spaced =
+      run("blocks '" + streets + "' --class-field NAME --class-widths ' East 0 = 12 , x=3' --quiet --out '" +
+          dir.file("o9") + "'");
+  EXPECT_EQ(spaced.code, 0) << spaced.output;
+  // run.json records the street options, the classes as read.
+  std::ifstream in(dir.file("o9") + "/run.json");
+  const std::string record((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const char* text : {"\"class_widths\": {", "\"East 0\": 12", "\"x\": 3"}) {
+    EXPECT_NE(record.find(text), std::string::npos) << text << "\n" << record;
+  }
+  EXPECT_NE(record.find("\"class_field\": \"NAME\""), std::string::npos) << record;
 }
 
 // Streets read in the parcels' frame: 6,000 km away they are refused, naming

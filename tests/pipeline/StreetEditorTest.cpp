@@ -562,6 +562,25 @@ TEST(StreetEditor, EditsWrittenAndReplayedGiveTheSameParcelsAndKeys) {
   EXPECT_EQ(editor.labels(), replay.labels());
 }
 
+// Bug: an override naming a block the network lacks was dropped with exit 0
+// (compare and generate refuse it).
+TEST(StreetEditor, AnOverrideOfABlockTheNetworkLacksIsRefused) {
+  GenerateRequest r = sampleStreets();
+  StreetEditor plain(r);
+  const Key known = plain.parcels().blockKeys.front();
+  r.overrides[known].style = "obb";
+  EXPECT_NO_THROW(StreetEditor{r});
+  r.overrides[0x0123456789abcdefull].style = "obb";
+  try {
+    StreetEditor editor(r);
+    FAIL() << "an override of no block is refused";
+  } catch (const Error& error) {
+    EXPECT_EQ(error.kind(), Error::Kind::Usage);
+    EXPECT_NE(std::string(error.what()).find("block 0123456789abcdef: no such block"), std::string::npos)
+        << error.what();
+  }
+}
+
 TEST(StreetEditor, ABadEditNamesWhatIsWrongAndChangesNothing) {
   StreetEditor editor(sampleStreets());
   const Snapshot before = snapshot(editor);

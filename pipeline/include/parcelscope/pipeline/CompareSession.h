@@ -79,6 +79,8 @@ private:
 /// ones}, "overrides": [{"block_key", "style", "parameters"}]} (an override
 /// read by block id from a version 1 file is written back by block_id).
 Json sessionJson(const CompareRequest& request);
+/// The street options as a session file holds them (member `streets`).
+Json streetOptionsJson(const io::StreetReadOptions& streets);
 
 /// `request` with its input's and streets' paths made absolute (a record
 /// written in another folder than the one they were given from: a run's
