@@ -14,6 +14,7 @@
 #include "CompareStages.h"
 #include "parcelscope/core/Error.h"
 #include "parcelscope/core/Parallel.h"
+#include "parcelscope/generation/Styles.h"
 #include "parcelscope/io/Writers.h"
 
 namespace parcelscope::pipeline {
@@ -501,7 +502,28 @@ CompareRequest readSession(const std::string& path) {
     }
     request.streets = std::move(o);
   }
-  if (const std::string style = text(root, "style", ""); !style.empty()) request.style = style;
+  // Styles and bounds are checked here, naming the file and the member, not
+  // later as if given on the command line.
+  auto checkStyleName = [&](const std::string& style, const std::string& member, bool all) {
+    if (style.empty() || (all && style == "all")) return;
+    try {
+      generation::style(style);
+    } catch (const Error& e) {
+      throw bad("member " + member + ": " + e.what());
+    }
+  };
+  auto checkBounds = [&](const ParameterValues& values, const std::string& member) {
+    for (const auto& [low, high] : {std::pair{"a-min", "a-max"}, std::pair{"w-min", "w-max"}}) {
+      const auto l = values.find(low), h = values.find(high);
+      if (l != values.end() && h != values.end() && l->second > h->second) {
+        throw bad("member " + member + ": " + low + " is above " + high);
+      }
+    }
+  };
+  if (const std::string style = text(root, "style", ""); !style.empty()) {
+    checkStyleName(style, "style", true);
+    request.style = style;
+  }
   if (const std::string metric = text(root, "metric", ""); !metric.empty()) {
     try {
       analysis::parcelQuantity(metric);
@@ -533,6 +555,7 @@ CompareRequest readSession(const std::string& path) {
   if (const Json* p = root.find("parameters")) {
     if (!p->isObject()) throw bad("member parameters is not an object");
     readValues(*p, "parameters.", request.parameters, &request.explicitParameters);
+    checkBounds(request.parameters, "parameters");
   }
   if (const Json* o = root.find("overrides")) {
     if (!o->isArray()) throw bad("member overrides is not an array");
@@ -551,9 +574,11 @@ CompareRequest readSession(const std::string& path) {
       }
       pipeline::BlockOverride override;
       override.style = text(item, "style", where);
+      checkStyleName(override.style, where + "style", false);
       if (const Json* p = item.find("parameters")) {
         if (!p->isObject()) throw bad("member " + where + "parameters is not an object");
         readValues(*p, where + "parameters.", override.parameters, nullptr);
+        checkBounds(override.parameters, where + "parameters");
       }
       // A block named twice: which entry holds is not for the reader to guess.
       const bool fresh = parsedKey

@@ -535,6 +535,25 @@ TEST(SessionFile, BadMembersAreNamed) {
                                       {"block_key": "00000000000000aa", "style": "obb"}]})")
                 .find("overrides[1].block_key 00000000000000aa: an earlier override names the same block"),
             std::string::npos);
+  // Bug: an unknown style and crossed bounds were told later without the file.
+  EXPECT_NE(message(R"({"parcelscope_session": 2, "input": {"path": "x"}, "style": "obbb"})")
+                .find("member style: no subdivision style 'obbb'"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"parcelscope_session": 2, "input": {"path": "x"},
+                        "overrides": [{"block_key": "00000000000000aa", "style": "all"}]})")
+                .find("member overrides[0].style: no subdivision style 'all'"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"parcelscope_session": 2, "input": {"path": "x"},
+                        "overrides": [{"block_key": "00000000000000aa", "parameters": {"a-min": 500, "a-max": 100}}]})")
+                .find("member overrides[0].parameters: a-min is above a-max"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"parcelscope_session": 2, "input": {"path": "x"}, "parameters": {"w-min": 9, "w-max": 3}})")
+                .find("member parameters: w-min is above w-max"),
+            std::string::npos);
+  // The style "all" of a compare session reads.
+  const std::string all =
+      dir.write("all.json", R"({"parcelscope_session": 2, "input": {"path": "x"}, "style": "all"})");
+  EXPECT_EQ(readSession(all).style, "all");
 }
 
 // Every list of parameter descriptions, by the function that returns it.
