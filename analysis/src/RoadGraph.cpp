@@ -92,6 +92,9 @@ std::pair<Point, Point> pointAt(const Polyline& line, double s) {
   return {line.front(), {1, 0}};
 }
 
+// Mixed into the key of a block that faces no street.
+constexpr Key kStreetlessBlockKey = 0x5354524545544c53ull;
+
 Key positionKey(const Point& p) {
   return mixKeys(static_cast<Key>(std::llround(p.x * 100)), static_cast<Key>(std::llround(p.y * 100)));
 }
@@ -1038,7 +1041,9 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
           for (const Ring& h : part.holes) faceRing(h);
           std::sort(facedKeys.begin(), facedKeys.end());
           facedKeys.erase(std::unique(facedKeys.begin(), facedKeys.end()), facedKeys.end());
-          b.key = setKey(facedKeys);
+          // A block facing no street (closed by the parcels' outline alone)
+          // is keyed by its place: setKey of no key is 0 for every such block.
+          b.key = facedKeys.empty() ? mixKeys(kStreetlessBlockKey, positionKey(centroid(part))) : setKey(facedKeys);
           b.shape = std::move(part);
           result.blocks.push_back(std::move(b));
         }

@@ -6,6 +6,8 @@
 // direction of the input lines.
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -129,6 +131,33 @@ TEST(RoadGraph, GridGivesOneBlockPerCellInsetByHalfTheWidths) {
   }
   expectCoverage(b, "grid");
   expectOrderFree(grid(4, 100), "grid");
+}
+
+// Bug: blocks closed by boundary lines alone (the parcels' outline, no street)
+// all had key 0 (a key of no street), told apart only by their order.
+TEST(RoadGraph, BlocksFacingNoStreetAreKeyedByTheirPlace) {
+  auto boundarySquare = [](double x0, double y0) {
+    StreetLine s = street({{x0, y0}, {x0 + 80, y0}, {x0 + 80, y0 + 60}, {x0, y0 + 60}, {x0, y0}}, 0.0);
+    s.boundary = true;
+    return s;
+  };
+  std::vector<StreetLine> lines = grid(2, 100);
+  lines.push_back(boundarySquare(500, 0));
+  lines.push_back(boundarySquare(800, 300));
+  const Built b = build(lines);
+  std::vector<Key> streetless;
+  for (const StreetBlock& s : b.blocks.blocks) {
+    if (bounds(s.shape).minX >= 500) streetless.push_back(s.key);
+  }
+  ASSERT_EQ(streetless.size(), 2u);
+  EXPECT_NE(streetless[0], 0u);
+  EXPECT_NE(streetless[1], 0u);
+  EXPECT_NE(streetless[0], streetless[1]);
+  // A third such block elsewhere leaves their keys as they were.
+  lines.push_back(boundarySquare(-600, -600));
+  std::set<Key> again;
+  for (const StreetBlock& s : build(lines).blocks.blocks) again.insert(s.key);
+  EXPECT_TRUE(again.count(streetless[0]) && again.count(streetless[1]));
 }
 
 TEST(RoadGraph, WidthsDifferEdgeByEdgeAndEachBlockEdgeKnowsItsStreet) {
