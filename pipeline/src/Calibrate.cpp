@@ -506,6 +506,7 @@ Table calibrationTable(const Calibration& c) {
                {"style_half", T::String, ""},  {"style_auto", T::String, ""}};
   for (const char* name : generation::autoFeatureNames()) t.columns.push_back({name, T::Real, ""});
   for (const BlockCalibration& b : c.blocks) {
+    if (b.observedParcels == 0) continue;  // a street block without observed parcels: nothing calibrated
     t.rows.push_back({b.blockId, keyText(b.blockKey), b.observedParcels, std::int64_t(b.half), b.styleBefore,
                       b.distanceBefore, b.styleAfter, b.distanceAfter, b.stylePredicted, b.styleHalf, b.styleAuto});
     for (double f : b.features) t.rows.back().push_back(f);

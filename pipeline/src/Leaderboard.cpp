@@ -110,6 +110,7 @@ Table leaderboardBlockTable(const Leaderboard& board) {
   t.columns.push_back({"best_style", Column::Type::String, ""});
   const analysis::ObservedAnalysis& a = board.observed->analysis;
   for (std::size_t b = 0; b < a.blocks.size(); ++b) {
+    if (a.blocks[b].parcels.empty()) continue;  // a street block without observed parcels: nothing to fit
     std::vector<Value> row = {static_cast<std::int64_t>(a.blocks[b].id), keyText(a.blocks[b].key),
                               static_cast<std::int64_t>(a.blocks[b].parcels.size())};
     for (double fit : board.blockFit[b]) row.push_back(fit);
