@@ -358,6 +358,11 @@ public:
     }
     outlineEdges_ = outlineEdges;
     target_ = 0.5 * (p.bounds.wMin + p.bounds.wMax);
+    if (!p.sliceWidths.empty()) {  // drawn widths (at least W_min each): their mean
+      double sum = 0;
+      for (double w : p.sliceWidths) sum += w;
+      target_ = sum / static_cast<double>(p.sliceWidths.size());
+    }
   }
 
   // Runs every step; `memo` gives steps 1-3 when an earlier run built them
@@ -506,8 +511,8 @@ private:
       }
     }
     ringStart_.push_back(static_cast<int>(edges_.size()));
-    // Step 4 cuts the streets into parcels of the mean width: their count is
-    // known now, before any exact construction.
+    // Step 4 cuts the streets into parcels of the mean width (even or drawn):
+    // their count is known now, before any exact construction.
     double street = 0;
     for (int g = ringStart_[0]; g < ringStart_[1]; ++g) street += edges_[g].length;
     if (!(street / target_ <= kMaxStripParcels)) {
@@ -1547,6 +1552,14 @@ Subdivision subdivideSkeleton(const Polygon& block, const SkeletonParameters& pa
   SkeletonParameters p = parameters;
   p.bounds.aMax = std::max(p.bounds.aMax, p.bounds.aMin);
   p.bounds.wMax = std::max(p.bounds.wMax, p.bounds.wMin);
+  // Drawn widths: finite and positive, none narrower than W_min (a split may
+  // not make a narrower parcel; sliver parcels in the sample would otherwise
+  // cut a street into thousands of slices).
+  std::vector<double> widths;
+  for (double w : p.sliceWidths) {
+    if (std::isfinite(w) && w > 0) widths.push_back(std::max(w, p.bounds.wMin));
+  }
+  p.sliceWidths = std::move(widths);
   auto layout = std::make_shared<SkeletonLayout>();
   const SkeletonLayout* previous = reuse.previous;
   const bool sameBlockAsBefore = previous && sameBlock(previous->block, block);

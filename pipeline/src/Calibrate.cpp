@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <numeric>
 #include <sstream>
 
@@ -241,12 +242,14 @@ constexpr int kRefinePasses = 4;
 // The calibration of the blocks `blocks` from the choice `choice` (other
 // blocks' entries are left): passes over the blocks changing a block's style
 // wherever that lowers calibrationObjective() over those blocks, against the
-// paper's rule's measures there. calibrate() runs it from three starts (the
-// per-block optimum, the paper's rule, each block's least count error) and
-// keeps the lowest: the per-block optimum need not add up to a city-wide one
-// (a block's KS is measured on a few parcels), and one block's change barely
-// moves the median count error, so that stays low only from a start where most
-// blocks have their count. Returns early, empty, when `stop` is set.
+// measures there of the paper's rule, the leaderboard entries `paperEntries`
+// (style access). calibrate() runs it from three starts (the per-block
+// optimum, the styles the paper's rule picks, each block's least count error)
+// and keeps the lowest: the per-block optimum need not add up to a city-wide
+// one (a block's KS is measured on a few parcels), and one block's change
+// barely moves the median count error, so that stays low only from a start
+// where most blocks have their count. Returns early, empty, when `stop()`
+// says so.
 struct Refined {
   std::vector<std::size_t> choice;
   double objective = HUGE_VAL;
@@ -254,16 +257,16 @@ struct Refined {
 
 Refined refineChoice(const Leaderboard& board, const std::vector<std::vector<std::vector<int>>>& parcels,
                      const std::vector<std::size_t>& blocks, const std::vector<std::size_t>& candidates,
-                     const std::vector<std::size_t>& paperChoice, std::vector<std::size_t> choice,
-                     const std::atomic<bool>& stop) {
-  const FitMeasures paper = measure(board, parcels, blocks, paperChoice);
+                     const std::vector<std::size_t>& paperEntries, std::vector<std::size_t> choice,
+                     const std::function<bool()>& stop) {
+  const FitMeasures paper = measure(board, parcels, blocks, paperEntries);
   auto objective = [&](const FitMeasures& f) { return calibrationObjective(f, paper); };
   ChoiceMeasure measured(board, parcels, blocks, candidates, choice);
   double current = objective(measured.current());
   for (int pass = 0; pass < kRefinePasses; ++pass) {
     bool changed = false;
     for (std::size_t b : blocks) {
-      if (stop) return {};
+      if (stop()) return {};
       const std::size_t kept = choice[b];
       std::size_t chosen = kept;
       for (std::size_t e : candidates) {
@@ -376,7 +379,8 @@ Calibration calibrate(const CompareRequest& request, const ProgressFn& progress)
   const auto parcels = parcelsByBlock(board);
   c.before = measure(board, parcels, all, before);
   const std::vector<std::size_t> perBlock = best;
-  std::vector<std::size_t> paperChoice(n);  // auto's choice is one of the candidates, with the same parcels
+  std::vector<std::size_t> paperChoice(
+      n);  // the styles access picks, as candidates (their skeleton may slice otherwise)
   for (std::size_t b = 0; b < n; ++b) {
     paperChoice[b] = best[b];
     for (std::size_t e : candidates) {
@@ -410,12 +414,19 @@ Calibration calibrate(const CompareRequest& request, const ProgressFn& progress)
   const std::vector<std::vector<std::size_t>> starts = {perBlock, paperChoice, countFirst};
   std::vector<Refined> refined(blockSets.size() * starts.size());
   std::atomic<bool> stop{false};
+  // Several threads: the calling thread reports progress (the tick below) and
+  // sets `stop` when asked to; one thread: the searches report it themselves.
+  const bool oneThread = workerCount() == 1;
+  const std::function<bool()> poll = [&] {
+    if (oneThread) reportProgress(progress, 0.95, "calibrating");
+    return stop.load();
+  };
   parallelFor(
       refined.size(),
       [&](std::size_t t) {
         const auto& blocks = blockSets[t / starts.size()];
         if (!blocks.empty()) {
-          refined[t] = refineChoice(board, parcels, blocks, candidates, paperChoice, starts[t % starts.size()], stop);
+          refined[t] = refineChoice(board, parcels, blocks, candidates, before, starts[t % starts.size()], poll);
         }
       },
       [&](std::size_t) {

@@ -88,6 +88,24 @@ TEST(SkeletonSubdivision, OneDrawnSliceWidthCutsEachStreetAtThatWidth) {
   EXPECT_EQ(interior, 12);
 }
 
+// Bug: one observed sliver (1 mm wide) cut the streets into some 10,000
+// slices per strip, merged back one by one (minutes; a crash by stack depth).
+TEST(SkeletonSubdivision, DrawnWidthsAreAtLeastWMinAndCountInTheWorkBudget) {
+  const Polygon block = rect(0, 0, 120, 50);
+  SkeletonParameters p = params(100, 2000, 15, 15);
+  p.sliceWidths = {0.001, std::nan(""), -3, 0};
+  const Subdivision s = subdivideSkeleton(block, p, 7);
+  ASSERT_FALSE(s.fallback) << s.fallbackReason;
+  EXPECT_TILES(block, s.parcels, "slivers drawn at W_min");
+  EXPECT_EQ(s.parcels.size(), 16u);  // as with 15 m: 8 a row
+  p.bounds.wMin = 0;                 // no floor: the drawn widths' mean counts in the budget
+  p.bounds.aMin = 0;
+  const Subdivision over = subdivideSkeleton(block, p, 7);
+  EXPECT_TRUE(over.fallback);
+  EXPECT_NE(over.fallbackReason.find("work budget"), std::string::npos) << over.fallbackReason;
+  EXPECT_TILES(block, over.parcels, "over the budget");
+}
+
 TEST(SkeletonSubdivision, DrawnSliceWidthsComeFromTheSampleScaledToFillTheStreet) {
   // Widths drawn from {8, 24}: within a row every parcel away from the ends
   // is 8 s or 24 s wide, s the row's one scale factor (near 1), and both occur.
