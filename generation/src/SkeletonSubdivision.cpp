@@ -30,10 +30,12 @@ namespace parcelscope::generation {
 
 const std::vector<ParameterDescription>& skeletonParameterDescriptions() {
   static const std::vector<ParameterDescription> d = {
-      realParameter("offset",
-                    "d_offset: depth of the parcel strips from the street; a patio fills what lies deeper. 0: no "
-                    "patio, parcels reach the skeleton's centre line (style offset: 0 means 30 m)",
-                    "m", 0.0, 1e5, 0.0, "Skeleton"),
+      realParameter(
+          "offset",
+          "d_offset: depth of the parcel strips from the street; a patio fills what lies deeper. 0: no "
+          "patio, parcels reach the skeleton's centre line (style offset: 0 means the block's mean observed parcel "
+          "length, or 30 m without observed parcels)",
+          "m", 0.0, 1e5, 0.0, "Skeleton"),
       realParameter("street-angle", "Contour corners turning by less than this continue the same logical street", "deg",
                     0.0, 180.0, 30.0, "Skeleton"),
       enumParameter("corner-rule",
@@ -1622,14 +1624,15 @@ namespace parcelscope::generation {
 namespace {
 
 // skeleton: straight-skeleton strips along the streets (Vanegas et al. 2012,
-// section 4.2); offset: the same with a finite d_offset (30 m unless given)
-// and the patios subdivided with obb.
+// section 4.2); offset: the same with a finite d_offset (unless given: the block's mean observed parcel length, else 30
+// m) and the patios subdivided with obb.
 class SkeletonStyle : public Style {
 public:
   explicit SkeletonStyle(bool offset) : offset_(offset) {}
   std::string name() const override { return offset_ ? "offset" : "skeleton"; }
   std::string description() const override {
-    return offset_ ? "skeleton with a finite offset (30 m unless --offset) and patios subdivided by OBB"
+    return offset_ ? "skeleton with a finite offset (the block's mean observed parcel length, else 30 m, unless "
+                     "--offset) and patios subdivided by OBB"
                    : "straight-skeleton strips along the streets (4.2); --offset M leaves patios";
   }
   const std::vector<ParameterDescription>& parameters() const override {
@@ -1644,6 +1647,20 @@ public:
   Subdivision run(const StyleRun& r) const override {
     SkeletonParameters p = skeletonParametersFrom(r.values);
     if (offset_) {
+      // d_offset not given: the parcel depth of the block, its observed
+      // parcels' mean length (long side of their bounding rectangle).
+      if (p.offset <= 0 && r.observed && !r.observed->widths.empty()) {
+        double sum = 0;
+        std::size_t n = 0;
+        for (std::size_t i = 0; i < r.observed->widths.size() && i < r.observed->aspectRatios.size(); ++i) {
+          const double length = r.observed->widths[i] * r.observed->aspectRatios[i];
+          if (std::isfinite(length) && length > 0) {
+            sum += length;
+            ++n;
+          }
+        }
+        if (n > 0) p.offset = sum / static_cast<double>(n);
+      }
       if (p.offset <= 0) p.offset = kDefaultOffsetStyleDepth;
       p.subdividePatios = true;
     }
@@ -1658,7 +1675,7 @@ public:
   }
 
 private:
-  static constexpr double kDefaultOffsetStyleDepth = 30.0;  // m, style offset without --offset
+  static constexpr double kDefaultOffsetStyleDepth = 30.0;  // m, style offset without --offset or observed parcels
   bool offset_;
 };
 

@@ -8,6 +8,8 @@
 #include <set>
 
 #include "TestUtil.h"
+#include "generation/StyleRun.h"
+#include "generation/TilingCheck.h"
 #include "parcelscope/core/Error.h"
 
 namespace parcelscope::generation {
@@ -85,6 +87,32 @@ TEST(Styles, AccessAndAutoChoosePerBlockAndDoNotSubdivideThemselves) {
     if (choosesPerBlock(*s)) continue;
     for (const auto& d : s->parameters()) EXPECT_EQ(names.count(d.name), 1u) << s->name() << ": " << d.name;
   }
+}
+
+// The offset style's d_offset, when not given, is the block's parcel depth:
+// its observed parcels' mean length (30 m without observed parcels).
+TEST(Styles, OffsetDepthIsTheObservedParcelsMeanLength) {
+  const Polygon block = test::rect(0, 0, 200, 100);
+  auto patioArea = [&](const Subdivision& s) {
+    double inner = 0;  // parcels away from every street: the patio's
+    for (const Polygon& q : s.parcels) {
+      const Box b = bounds(q);
+      if (b.minX > 1 && b.maxX < 199 && b.minY > 1 && b.maxY < 99) inner += area(q);
+    }
+    return inner;
+  };
+  ObservedSample observed;
+  observed.widths = {10, 10, 12};
+  observed.aspectRatios = {2, 1.5, 2.5};  // lengths 20, 15, 30: mean 21.67 m
+  const Subdivision deep = test::runStyle(offsetStyle(), block, {{"slice-widths", 0}}, 1);
+  const Subdivision fitted = test::runStyle(offsetStyle(), block, {{"slice-widths", 0}}, 1, &observed);
+  const double d = (20.0 + 15.0 + 30.0) / 3;
+  EXPECT_TILES(block, fitted.parcels, "offset, observed depth");
+  EXPECT_NEAR(patioArea(deep), 140.0 * 40.0, 1e-3);  // the skeleton's input is jittered by up to 1e-6 m
+  EXPECT_NEAR(patioArea(fitted), (200 - 2 * d) * (100 - 2 * d), 1e-3);
+  // A depth given wins.
+  const Subdivision given = test::runStyle(offsetStyle(), block, {{"slice-widths", 0}, {"offset", 25}}, 1, &observed);
+  EXPECT_NEAR(patioArea(given), 150.0 * 50.0, 1e-3);
 }
 
 TEST(Styles, ConcreteStylesTileARectangleReproducibly) {
