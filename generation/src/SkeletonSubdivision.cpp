@@ -1664,11 +1664,8 @@ public:
       if (p.offset <= 0) p.offset = kDefaultOffsetStyleDepth;
       p.subdividePatios = true;
     }
-    if (p.observedSliceWidths && r.observed) {
-      for (double w : r.observed->widths) {
-        if (std::isfinite(w) && w > 0) p.sliceWidths.push_back(w);
-      }
-    }
+    // subdivideSkeleton keeps the finite, positive widths, each at least W_min.
+    if (p.observedSliceWidths && r.observed) p.sliceWidths = r.observed->widths;
     // The layout checks for itself that it was made for this block and these parameters.
     const SkeletonLayout* layout = r.previous ? r.previous->skeletonLayout.get() : nullptr;
     return subdivideSkeleton(r.block, p, r.seed, r.streetWidths, {layout, r.record});

@@ -20,16 +20,22 @@
 
 namespace parcelscope::pipeline {
 
+namespace {
+// |n_generated / n_observed - 1| of a block; 0 without observed parcels.
+double countError(const analysis::Comparison& c) {
+  return c.observed.parcels > 0
+             ? std::fabs(static_cast<double>(c.generated.parcels) / static_cast<double>(c.observed.parcels) - 1)
+             : 0.0;
+}
+}  // namespace
+
 double calibrationDistance(const analysis::Comparison& c) {
   double d = 0;
   for (analysis::ComparedMetric m : analysis::kComparedMetrics) {
     const double ks = c.distances(m).ks;
     d += std::isfinite(ks) ? ks : 1.0;
   }
-  if (c.observed.parcels > 0) {
-    d += std::fabs(static_cast<double>(c.generated.parcels) / static_cast<double>(c.observed.parcels) - 1);
-  }
-  return d;
+  return d + countError(c);
 }
 
 namespace {
@@ -379,8 +385,8 @@ Calibration calibrate(const CompareRequest& request, const ProgressFn& progress)
   const auto parcels = parcelsByBlock(board);
   c.before = measure(board, parcels, all, before);
   const std::vector<std::size_t> perBlock = best;
-  std::vector<std::size_t> paperChoice(
-      n);  // the styles access picks, as candidates (their skeleton may slice otherwise)
+  // The styles access picks, as candidates (their skeleton may slice otherwise).
+  std::vector<std::size_t> paperChoice(n);
   for (std::size_t b = 0; b < n; ++b) {
     paperChoice[b] = best[b];
     for (std::size_t e : candidates) {
@@ -390,15 +396,10 @@ Calibration calibrate(const CompareRequest& request, const ProgressFn& progress)
   // The third start: each block's style of least count error (then of least distance).
   std::vector<std::size_t> countFirst(n);
   for (std::size_t b = 0; b < n; ++b) {
-    const auto& result = [&](std::size_t e) -> const analysis::Comparison& {
+    auto result = [&](std::size_t e) -> const analysis::Comparison& {
       return board.entries[e].result.blocks[b].comparison;
     };
-    auto error = [&](std::size_t e) {
-      const analysis::Comparison& cmp = result(e);
-      return cmp.observed.parcels > 0
-                 ? std::fabs(static_cast<double>(cmp.generated.parcels) / static_cast<double>(cmp.observed.parcels) - 1)
-                 : 0.0;
-    };
+    auto error = [&](std::size_t e) { return countError(result(e)); };
     countFirst[b] = perBlock[b];
     for (std::size_t e : candidates) {
       const double de = error(e), dk = error(countFirst[b]);
