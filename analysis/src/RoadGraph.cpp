@@ -95,8 +95,10 @@ std::pair<Point, Point> pointAt(const Polyline& line, double s) {
 // Mixed into the key of a block that faces no street.
 constexpr Key kStreetlessBlockKey = 0x5354524545544c53ull;
 
-Key positionKey(const Point& p) {
-  return mixKeys(static_cast<Key>(std::llround(p.x * 100)), static_cast<Key>(std::llround(p.y * 100)));
+// The key of a position: its key place, rounded to the key cell.
+Key positionKey(const KeyPlace& keyPlace, const Point& p) {
+  const Point q = keyPlace ? keyPlace(p) : Point{p.x * 100, p.y * 100};
+  return mixKeys(static_cast<Key>(std::llround(q.x)), static_cast<Key>(std::llround(q.y)));
 }
 
 std::pair<long long, long long> gridCell(const Point& p, double cell) {
@@ -333,6 +335,7 @@ void splitAt(std::vector<Polyline>& pieces, const std::vector<Point>& at) {
 
 RoadGraph buildRoadGraph(const std::vector<StreetLine>& input, const RoadGraphOptions& options) {
   RoadGraph graph;
+  graph.keyPlace = options.keyPlace;
   RoadGraphReport& report = graph.report;
   report.lines = static_cast<std::int64_t>(input.size());
   std::vector<Polyline> lines(input.size());
@@ -414,11 +417,17 @@ RoadGraph buildRoadGraph(const std::vector<StreetLine>& input, const RoadGraphOp
 
   // Nodes by position on the noding grid.
   std::map<std::pair<long long, long long>, int> nodeAt;
+  std::vector<std::pair<long long, long long>> nodeCells;
   auto nodeOf = [&](const Point& p) {
     const std::pair<long long, long long> cell{std::llround(p.x / kGrid), std::llround(p.y / kGrid)};
     auto [it, added] = nodeAt.emplace(cell, static_cast<int>(graph.nodes.size()));
-    // Keyed by the same 1 mm cell that makes it one node: distinct nodes, distinct keys.
-    if (added) graph.nodes.push_back({mixKeys(static_cast<Key>(cell.first), static_cast<Key>(cell.second)), p, 0});
+    // Keyed by the place of the 1 mm cell that makes it one node (nodes of
+    // one key are told apart below).
+    if (added) {
+      const Point centre{static_cast<double>(cell.first) * kGrid, static_cast<double>(cell.second) * kGrid};
+      graph.nodes.push_back({positionKey(options.keyPlace, centre), p, 0});
+      nodeCells.push_back(cell);
+    }
     return it->second;
   };
   for (std::size_t k = 0; k < pieces.size(); ++k) {
@@ -462,6 +471,21 @@ RoadGraph buildRoadGraph(const std::vector<StreetLine>& input, const RoadGraphOp
     e.line = std::move(line);
     graph.edges.push_back(std::move(e));
   }
+  // Nodes of one key (distinct cells of one key cell): told apart by their cells.
+  {
+    std::vector<std::size_t> byKey(graph.nodes.size());
+    std::iota(byKey.begin(), byKey.end(), 0);
+    std::sort(byKey.begin(), byKey.end(), [&](std::size_t a, std::size_t b) {
+      return graph.nodes[a].key != graph.nodes[b].key ? graph.nodes[a].key < graph.nodes[b].key
+                                                      : nodeCells[a] < nodeCells[b];
+    });
+    std::vector<Key> keys;
+    for (std::size_t i : byKey) keys.push_back(graph.nodes[i].key);
+    for (std::size_t i = 1, run = 0; i < byKey.size(); ++i) {
+      run = keys[i] == keys[i - 1] ? run + 1 : 0;
+      if (run) graph.nodes[byKey[i]].key = mixKeys(keys[i], run);
+    }
+  }
   // Keys; edges run from the node of lesser key; nodes and edges sorted by key.
   for (RoadEdge& e : graph.edges) {
     Key a = graph.nodes[static_cast<std::size_t>(e.from)].key, b = graph.nodes[static_cast<std::size_t>(e.to)].key;
@@ -472,7 +496,7 @@ RoadGraph buildRoadGraph(const std::vector<StreetLine>& input, const RoadGraphOp
     } else if (a == b && signedArea(e.line) < 0) {
       std::reverse(e.line.begin(), e.line.end());  // a loop runs counter-clockwise
     }
-    e.key = mixKeys(mixKeys(a, b), positionKey(pointAt(e.line, 0.5 * length(e.line)).first));
+    e.key = mixKeys(mixKeys(a, b), positionKey(options.keyPlace, pointAt(e.line, 0.5 * length(e.line)).first));
     ++graph.nodes[static_cast<std::size_t>(e.from)].degree;
     ++graph.nodes[static_cast<std::size_t>(e.to)].degree;
   }
@@ -1043,7 +1067,8 @@ StreetBlocks streetBlocks(const RoadGraph& graph, const StreetBlockOptions& opti
           facedKeys.erase(std::unique(facedKeys.begin(), facedKeys.end()), facedKeys.end());
           // A block facing no street (closed by the parcels' outline alone)
           // is keyed by its place: setKey of no key is 0 for every such block.
-          b.key = facedKeys.empty() ? mixKeys(kStreetlessBlockKey, positionKey(centroid(part))) : setKey(facedKeys);
+          b.key = facedKeys.empty() ? mixKeys(kStreetlessBlockKey, positionKey(graph.keyPlace, centroid(part)))
+                                    : setKey(facedKeys);
           b.shape = std::move(part);
           result.blocks.push_back(std::move(b));
         }

@@ -49,6 +49,12 @@ Point LocalFrame::toSource(const Point& p) const {
   return {p.x / unit_ + x0_, p.y / unit_ + y0_};
 }
 
+Point LocalFrame::keyPlace(const Point& p) const {
+  const Point s = toSource(p);
+  const double scale = tm_ ? unit_ * 1e7 : unit_ * 100;
+  return {s.x * scale, s.y * scale};
+}
+
 double LocalFrame::distanceFromCentre(double x, double y) const {
   if (tm_) {
     // Haversine: the transverse Mercator is no guide this far (it folds).

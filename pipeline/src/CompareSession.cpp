@@ -89,8 +89,13 @@ void measureDeferred(const pipeline::BlockInputs& inputs,
                : std::function<void(std::size_t)>());
 }
 
+bool sameSample(const generation::ObservedSample* a, const generation::ObservedSample* b) {
+  if (!a || !b) return a == b;
+  return a->areas == b->areas && a->widths == b->widths && a->aspectRatios == b->aspectRatios;
+}
+
 // Fills `outcomes` and `done` of the new entries from the old ones that hold
-// the same block part (key and part), shape and plan.
+// the same block part (key and part), shape, plan and observed sample.
 void carryOver(const pipeline::BlockInputs& oldInputs, const std::vector<pipeline::BlockPlan>& oldPlans,
                const std::vector<std::shared_ptr<pipeline::BlockOutcome>>& oldOutcomes,
                const pipeline::BlockInputs& inputs, const std::vector<pipeline::BlockPlan>& plans,
@@ -105,6 +110,10 @@ void carryOver(const pipeline::BlockInputs& oldInputs, const std::vector<pipelin
     if (it == old.end()) continue;
     const std::size_t j = it->second;
     if (!oldOutcomes[j] || oldPlans[j] != plans[k] || !sameVertices(oldInputs.entries[j].shape, e.shape)) continue;
+    // What the styles read of the observed parcels (the skeleton's slice
+    // widths, the offset depth): a street block keeps its key and shape when
+    // the parcels in it change.
+    if (!sameSample(oldInputs.entries[j].observed.get(), e.observed.get())) continue;
     if (generation::style(plans[k].style).usesStreetWidths()) {
       const bool widths = inputs.widths.size() == inputs.entries.size() &&
                           oldInputs.widths.size() == oldInputs.entries.size() &&

@@ -147,6 +147,7 @@ analysis::RoadGraph renoded(const analysis::RoadGraph& graph, const std::set<std
   lines.insert(lines.end(), added.begin(), added.end());
   analysis::RoadGraphOptions options;
   options.snap = snap;
+  options.keyPlace = graph.keyPlace;
   analysis::RoadGraph out = analysis::buildRoadGraph(lines, options);
   // A node within the noding grid's cell (1 mm) of a node before is that node:
   // noding may move a node by a rounding, and an edit replayed from a file

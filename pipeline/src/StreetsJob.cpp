@@ -62,6 +62,9 @@ StreetNetwork buildNetwork(const io::StreetReadOptions& streets, const Parameter
   for (const io::StreetFeature& f : n.layer.streets) lines.push_back({f.line, f.width, f.name, f.noNode, f.key});
   analysis::RoadGraphOptions options;
   options.snap = value(parameters, "street-snap");
+  // Keys from the input's own coordinates: the frame's origin follows the
+  // parcels (or streets) read, and moves when some are added.
+  options.keyPlace = [frame = n.layer.frame](const Point& p) { return frame.keyPlace(p); };
   if (observed && !observed->analysis.blocks.empty()) {
     // The study area's edge: where the parcels end (a city limit) closes the
     // faces the network leaves open there. The outline of every parcel block

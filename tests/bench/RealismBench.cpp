@@ -6,13 +6,18 @@
 // |n_generated / n_observed - 1|, and whether the left-out rule beats the
 // paper's rule and parish on every measure.
 //
-//   parcelscope_realism_bench [--variants | --votes] [CITY ...]   (default: all six; about 4-7 min)
+//   parcelscope_realism_bench [--variants | --votes | --labels | --quantiles] [CITY ...]
+//   (default: all six; about 4-7 min)
 //
 // --variants: then, the rule's neighbours and features tried (each feature
 // left out in turn), each measured leaving each city out.
 // --votes: then, ways of voting (neighbours, extra votes for the paper's
 // style, the paper's style for blocks far from every training block), each
 // measured leaving each city out and on each city's cross-validated halves.
+// --labels: then, training labels (calibrated, or each block's own best
+// style) and choices (the vote, or one of the nearest drawn at random).
+// --quantiles: then, percentiles of area, width and aspect ratio, observed,
+// the paper's rule and the rule with the city left out.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +27,8 @@
 #include <vector>
 
 #include "parcelscope/generation/AutoRule.h"
+#include "parcelscope/generation/Styles.h"
+#include "parcelscope/pipeline/BlockSource.h"
 #include "parcelscope/pipeline/Calibrate.h"
 
 using namespace parcelscope;
@@ -99,6 +106,18 @@ int measuresBetter(const pipeline::FitMeasures& a, const pipeline::FitMeasures& 
          (a.medianCountError < b.medianCountError);
 }
 
+// Cities better than the paper's rule on all four measures, measures better,
+// and the mean objective over `cities` cities.
+struct Tally {
+  int cities = 0, measures = 0;
+  double objective = 0;
+  void add(const pipeline::FitMeasures& f, const pipeline::FitMeasures& paper, std::size_t of) {
+    cities += better(f, paper);
+    measures += measuresBetter(f, paper);
+    objective += pipeline::cityObjective(f) / static_cast<double>(of);
+  }
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -107,6 +126,10 @@ int main(int argc, char** argv) {
   if (variants) args.erase(args.begin());
   const bool votes = !args.empty() && args.front() == "--votes";
   if (votes) args.erase(args.begin());
+  const bool labels = !args.empty() && args.front() == "--labels";
+  if (labels) args.erase(args.begin());
+  const bool quantiles = !args.empty() && args.front() == "--quantiles";
+  if (quantiles) args.erase(args.begin());
   struct Run {
     const City* city;
     pipeline::Calibration c;
@@ -174,9 +197,7 @@ int main(int argc, char** argv) {
         "cross-validated: cities / measures better / mean objective | trained on all six |\n"
         "|---|---|---|---|---|---|---|\n");
     for (const Vote& v : ways) {
-      int outCities = 0, outMeasures = 0, cvCities = 0, cvMeasures = 0;
-      double outObjective = 0, cvObjective = 0, inObjective = 0;
-      int inCities = 0, inMeasures = 0;
+      Tally outTally, cvTally, inTally;
       std::string detail;
       for (const Run& r : runs) {
         const pipeline::Calibration& c = r.c;
@@ -200,15 +221,9 @@ int main(int argc, char** argv) {
         const pipeline::FitMeasures fo = pipeline::fitMeasures(c.board, r.all, outEntries);
         const pipeline::FitMeasures fc = pipeline::fitMeasures(c.board, r.all, cvEntries);
         const pipeline::FitMeasures fi = pipeline::fitMeasures(c.board, r.all, inEntries);
-        inCities += better(fi, c.before);
-        inMeasures += measuresBetter(fi, c.before);
-        inObjective += pipeline::cityObjective(fi) / static_cast<double>(runs.size());
-        outCities += better(fo, c.before);
-        outMeasures += measuresBetter(fo, c.before);
-        cvCities += better(fc, c.before);
-        cvMeasures += measuresBetter(fc, c.before);
-        outObjective += pipeline::cityObjective(fo) / static_cast<double>(runs.size());
-        cvObjective += pipeline::cityObjective(fc) / static_cast<double>(runs.size());
+        inTally.add(fi, c.before, runs.size());
+        outTally.add(fo, c.before, runs.size());
+        cvTally.add(fc, c.before, runs.size());
         detail +=
             std::string("  ") + r.city->name + ": out " + text(fo) + ", cv " + text(fc) + ", all " + text(fi) + "\n";
       }
@@ -216,10 +231,140 @@ int main(int argc, char** argv) {
           "| %zu | %g | %g | %s%s%s | %d of %zu / %d of %zu / %.3f | %d of %zu / %d of %zu / %.3f | %d / %d / %.3f "
           "|\n%s",
           v.k, v.paperVote, v.far, v.weighted ? "yes" : "no", v.withOthers ? ", halves with the other cities" : "",
-          v.prior ? ", prior skeleton" : "", outCities, runs.size(), outMeasures, 4 * runs.size(), outObjective,
-          cvCities, runs.size(), cvMeasures, 4 * runs.size(), cvObjective, inCities, inMeasures, inObjective,
-          detail.c_str());
+          v.prior ? ", prior skeleton" : "", outTally.cities, runs.size(), outTally.measures, 4 * runs.size(),
+          outTally.objective, cvTally.cities, runs.size(), cvTally.measures, 4 * runs.size(), cvTally.objective,
+          inTally.cities, inTally.measures, inTally.objective, detail.c_str());
       std::fflush(stdout);
+    }
+  }
+  if (quantiles) {
+    // Where the distributions differ: the 10th, 50th and 90th percentiles of
+    // area, width and aspect ratio, observed, the paper's rule and the rule
+    // with the city left out.
+    auto pct = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      std::string out;
+      for (double q : {0.1, 0.5, 0.9}) {
+        char c[32];
+        std::snprintf(c, sizeof c, "%s%.3g", out.empty() ? "" : " / ",
+                      v.empty() ? NAN : v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))]);
+        out += c;
+      }
+      return out;
+    };
+    std::printf(
+        "| dataset | parcels | area p10 / p50 / p90 (m2) | width p10 / p50 / p90 (m) | aspect ratio p10 / p50 / p90 "
+        "|\n|---|---|---|---|---|\n");
+    for (const Run& r : runs) {
+      const pipeline::Calibration& c = r.c;
+      std::vector<double> a, w, q;
+      for (std::size_t b = 0; b < c.blocks.size(); ++b) {
+        const auto s = pipeline::observedSample(c.board.observed->analysis, b);
+        a.insert(a.end(), s->areas.begin(), s->areas.end());
+        w.insert(w.end(), s->widths.begin(), s->widths.end());
+        q.insert(q.end(), s->aspectRatios.begin(), s->aspectRatios.end());
+      }
+      std::printf("| %s observed | %zu | %s | %s | %s |\n", r.city->name, a.size(), pct(a).c_str(), pct(w).c_str(),
+                  pct(q).c_str());
+      const std::vector<std::size_t> out = pipeline::entriesOf(
+          c, leftOut(r.city->name, generation::AutoRule::kNeighbours, generation::AutoRule::kWeights));
+      for (const auto& [name, entries] :
+           {std::pair<const char*, std::vector<std::size_t>>{"paper", c.entryBefore}, {"left out", out}}) {
+        a.clear(), w.clear(), q.clear();
+        for (const auto& m : pipeline::generatedMetrics(c.board, entries)) {
+          a.push_back(m.area), w.push_back(m.width), q.push_back(m.aspectRatio);
+        }
+        std::printf("| %s %s | %zu | %s | %s | %s |\n", r.city->name, name, a.size(), pct(a).c_str(), pct(w).c_str(),
+                    pct(q).c_str());
+      }
+    }
+  }
+  if (labels) {
+    // Labels and draws: each block of the training cities labelled with its
+    // calibrated style (city-wide) or with its own best style (least
+    // calibrationDistance, the block alone); a block's style the vote of its
+    // k nearest (1 / distance) or one of its k nearest drawn at random (from
+    // the block's key), so that the training labels' mixture is kept.
+    std::vector<std::vector<std::string>> ownBest(runs.size());
+    for (std::size_t ri = 0; ri < runs.size(); ++ri) {
+      const pipeline::Calibration& c = runs[ri].c;
+      for (std::size_t b = 0; b < c.blocks.size(); ++b) {
+        double least = HUGE_VAL;
+        std::string style;
+        for (const auto& e : c.board.entries) {
+          if (generation::choosesPerBlock(generation::style(e.style))) continue;
+          const double d = pipeline::calibrationDistance(e.result.blocks[b].comparison);
+          if (d < least) least = d, style = e.style;
+        }
+        ownBest[ri].push_back(style);
+      }
+    }
+    auto mix = [](std::uint64_t x) {
+      x += 0x9e3779b97f4a7c15ULL;
+      x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+      x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+      return x ^ (x >> 31);
+    };
+    std::printf(
+        "| labels | k | choice | left out: cities / measures better / mean objective | cross-validated: cities / "
+        "measures better / mean objective |\n|---|---|---|---|---|\n");
+    for (int own = 0; own < 2; ++own) {
+      for (std::size_t k : {1, 3, 5, 7, 11}) {
+        for (int draw = 0; draw < 2; ++draw) {
+          if (k == 1 && draw) continue;
+          auto pick = [&](const generation::AutoRule& rule, const pipeline::BlockCalibration& b) {
+            const auto near = rule.nearest(b.features, k);
+            if (draw) {
+              const std::size_t j = mix(static_cast<std::uint64_t>(b.blockKey)) % near.size();
+              return rule.rows()[near[j].second].style;
+            }
+            std::map<std::string, double> score;
+            for (const auto& [d, i] : near) score[rule.rows()[i].style] += 1 / (std::sqrt(d) + 1e-9);
+            std::string best = rule.rows()[near.front().second].style;
+            for (const auto& [st, w] : score) {
+              if (w > score[best]) best = st;
+            }
+            return best;
+          };
+          Tally outTally, cvTally;
+          std::string detail;
+          for (std::size_t ri = 0; ri < runs.size(); ++ri) {
+            const pipeline::Calibration& c = runs[ri].c;
+            std::vector<generation::AutoRule::Row> train;
+            for (std::size_t rj = 0; rj < runs.size(); ++rj) {
+              if (rj == ri) continue;
+              const auto& cb = runs[rj].c.blocks;
+              for (std::size_t b = 0; b < cb.size(); ++b) {
+                train.push_back({cb[b].features, own ? ownBest[rj][b] : cb[b].styleAfter});
+              }
+            }
+            const generation::AutoRule out(std::move(train), k);
+            std::vector<std::size_t> outEntries, cvEntries(c.blocks.size());
+            for (const auto& b : c.blocks) outEntries.push_back(pipeline::entryOfStyle(c, pick(out, b)));
+            for (int half = 0; half < 2; ++half) {
+              std::vector<generation::AutoRule::Row> rows;
+              for (std::size_t b = 0; b < c.blocks.size(); ++b) {
+                if (c.blocks[b].half != half)
+                  rows.push_back({c.blocks[b].features, own ? ownBest[ri][b] : c.blocks[b].styleHalf});
+              }
+              if (rows.empty()) continue;
+              const generation::AutoRule rule(std::move(rows), k);
+              for (std::size_t b = 0; b < c.blocks.size(); ++b) {
+                if (c.blocks[b].half == half) cvEntries[b] = pipeline::entryOfStyle(c, pick(rule, c.blocks[b]));
+              }
+            }
+            const pipeline::FitMeasures fo = pipeline::fitMeasures(c.board, runs[ri].all, outEntries);
+            const pipeline::FitMeasures fc = pipeline::fitMeasures(c.board, runs[ri].all, cvEntries);
+            outTally.add(fo, c.before, runs.size());
+            cvTally.add(fc, c.before, runs.size());
+            detail += std::string("  ") + runs[ri].city->name + ": out " + text(fo) + ", cv " + text(fc) + "\n";
+          }
+          std::printf("| %s | %zu | %s | %d / %d / %.3f | %d / %d / %.3f |\n%s", own ? "own best" : "calibrated", k,
+                      draw ? "draw" : "vote", outTally.cities, outTally.measures, outTally.objective, cvTally.cities,
+                      cvTally.measures, cvTally.objective, detail.c_str());
+          std::fflush(stdout);
+        }
+      }
     }
   }
   if (variants) {

@@ -200,6 +200,113 @@ CompareRequest gridRequest(const TempDir& dir) {
   return request;
 }
 
+// gridOfBlocks' street centre lines, one line between each two crossings.
+io::StreetReadOptions gridStreets(const TempDir& dir) {
+  std::string lines;
+  auto line = [&](double x0, double y0, double x1, double y1) {
+    char f[256];
+    std::snprintf(
+        f, sizeof f,
+        R"(%s{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[%.1f,%.1f],[%.1f,%.1f]]}})",
+        lines.empty() ? "" : ",", x0, y0, x1, y1);
+    lines += f;
+  };
+  for (int i = 0; i <= 8; ++i) {
+    for (int j = 0; j <= 6; ++j) {
+      const double x = 500000 + i * 90 - 5, y = 5000000 + j * 90 - 5;
+      if (i < 8) line(x, y, x + 90, y);
+      if (j < 6) line(x, y, x, y + 90);
+    }
+  }
+  io::StreetReadOptions streets;
+  streets.path = dir.write(
+      "streets.geojson",
+      R"({"type":"FeatureCollection","crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::32631"}},"features":[)" +
+          lines + "]}");
+  return streets;
+}
+
+// gridOfBlocks with the first block's four parcels replaced by `features`
+// (GeoJSON features, each followed by a comma), written as `name`.
+std::string gridWithFirstBlock(const TempDir& dir, const CompareRequest& grid, const std::string& features,
+                               const std::string& name) {
+  std::ifstream in(grid.input.path);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t start = text.find("{\"type\":\"Feature\",");
+  std::size_t end = start;
+  for (int p = 0; p < 4; ++p) end = text.find("{\"type\":\"Feature\",", end + 1);
+  return dir.write(name, text.substr(0, start) + features + text.substr(end));
+}
+
+// A square parcel feature (and a comma) of the ring `xy` (x0, y0, x1, y1, ...).
+std::string ringFeature(const std::vector<double>& xy) {
+  std::string ring;
+  for (std::size_t i = 0; i + 1 < xy.size(); i += 2) {
+    char p[64];
+    std::snprintf(p, sizeof p, "%s[%.1f,%.1f]", ring.empty() ? "" : ",", xy[i], xy[i + 1]);
+    ring += p;
+  }
+  return R"({"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[)" + ring + "]]}},";
+}
+
+// A reload keeps a block's parcels only when what its style read of the block
+// is the same. Blocks from a street network keep their keys and shapes when
+// the parcels change; here the bounds are the user's, so the first block's
+// plan does not move when its observed parcels are cut otherwise, but the
+// skeleton draws its slice widths from them.
+TEST(CompareSession, ReloadRegeneratesAStreetBlockWhoseObservedParcelsChanged) {
+  TempDir dir;
+  CompareRequest request = gridRequest(dir);
+  request.streets = gridStreets(dir);
+  request.style = "skeleton";
+  request.parameters["a-min"] = 100;
+  request.parameters["a-max"] = 2000;
+  request.parameters["w-min"] = 5;
+  request.parameters["w-max"] = 50;
+  request.explicitParameters = {"a-min", "a-max", "w-min", "w-max"};
+  CompareSession session;
+  const auto first = session.update(request);
+  ASSERT_EQ(first.blocksTotal, 48u);
+  // The first block's four 40 x 40 m parcels as four strips of 20 x 80 m
+  // (the frame, from the features' median centre, stays).
+  std::string strips;
+  for (int p = 0; p < 4; ++p) {
+    const double x0 = 500000 + 20 * p, y0 = 5000000;
+    strips += ringFeature({x0, y0, x0 + 20, y0, x0 + 20, y0 + 80, x0, y0 + 80, x0, y0});
+  }
+  request.input.path = gridWithFirstBlock(dir, request, strips, "strips.geojson");
+  const auto u = session.update(request);
+  EXPECT_TRUE(u.reloaded);
+  EXPECT_EQ(u.blocksRegenerated, 1u);
+  expectSameResult(*u.result, compare(request));
+}
+
+// Street blocks keep their keys when parcels are added: here each of the
+// first block's parcels is cut along a diagonal, which moves the local frame
+// (its origin is the features' median centre); keys are drawn from the
+// input's own coordinates.
+TEST(CompareSession, StreetBlockKeysStayWhenParcelsAreAdded) {
+  TempDir dir;
+  CompareRequest request = gridRequest(dir);
+  request.streets = gridStreets(dir);
+  const CompareResult before = compare(request);
+  std::string halves;
+  for (int p = 0; p < 4; ++p) {
+    const double x0 = 500000 + (p % 2) * 40, y0 = 5000000 + (p / 2) * 40;
+    halves += ringFeature({x0, y0, x0 + 40, y0, x0 + 40, y0 + 40, x0, y0});
+    halves += ringFeature({x0, y0, x0 + 40, y0 + 40, x0, y0 + 40, x0, y0});
+  }
+  request.input.path = gridWithFirstBlock(dir, request, halves, "halves.geojson");
+  const CompareResult after = compare(request);
+  ASSERT_NE(before.observed->layer.frame.describe(), after.observed->layer.frame.describe());
+  EXPECT_EQ(after.observed->layer.parcels.size(), before.observed->layer.parcels.size() + 4);
+  std::set<Key> keysBefore, keysAfter;
+  for (Key k : before.generated.blockKeys) keysBefore.insert(k);
+  for (Key k : after.generated.blockKeys) keysAfter.insert(k);
+  EXPECT_EQ(keysBefore.size(), 48u);
+  EXPECT_EQ(keysAfter, keysBefore);
+}
+
 // While many blocks are regenerated, results in between mix new and old
 // blocks, each block still tiled; the final result equals compare().
 TEST(CompareSession, ResultsInBetweenTileEveryBlock) {

@@ -380,25 +380,39 @@ TEST(StreetEditor, ALockedParcelKeepsItsGeometryWhileItsBlockIsSubdividedAroundI
   const Key node = busiestNode(editor);
   const StreetEdit move = moveNodeBy(editor, node, 2, 1);
   const EditReport dry = editor.apply(move);
+  std::map<Key, Polygon> moved;  // the affected blocks after the move
+  for (const auto& b : editor.network().blocks.blocks) moved.emplace(b.key, b.shape);
   ASSERT_TRUE(editor.undo());
   ASSERT_FALSE(dry.blocksAffected.empty());
-  const Key block = dry.blocksAffected.front();
-  // The block's parcel farthest from the node: still inside after the move.
+  // Of the first affected block whose parcel farthest from the node still lies
+  // inside it after the move, that parcel.
   const GeneratedParcels& g = editor.parcels();
   Point at;
   for (const auto& n : editor.network().graph.nodes) {
     if (n.key == node) at = n.at;
   }
+  Key block = 0;
   int chosen = -1;
-  double farthest = -1;
-  for (std::size_t b = 0; b < g.blocks.size(); ++b) {
-    if (g.blockKeys[b] != block) continue;
-    for (int i : g.blocks[b].parcels) {
-      const Point c = centroid(g.parcels[static_cast<std::size_t>(i)]);
-      if (std::hypot(c.x - at.x, c.y - at.y) > farthest) {
-        farthest = std::hypot(c.x - at.x, c.y - at.y);
-        chosen = i;
+  for (const Key candidate : dry.blocksAffected) {
+    int farthestParcel = -1;
+    double farthest = -1;
+    for (std::size_t b = 0; b < g.blocks.size(); ++b) {
+      if (g.blockKeys[b] != candidate) continue;
+      for (int i : g.blocks[b].parcels) {
+        const Point c = centroid(g.parcels[static_cast<std::size_t>(i)]);
+        if (std::hypot(c.x - at.x, c.y - at.y) > farthest) {
+          farthest = std::hypot(c.x - at.x, c.y - at.y);
+          farthestParcel = i;
+        }
       }
+    }
+    const auto m = moved.find(candidate);
+    if (farthestParcel < 0 || m == moved.end()) continue;
+    const Polygon& p = g.parcels[static_cast<std::size_t>(farthestParcel)];
+    if (geos::intersectionArea(p, m->second) >= (1 - 1e-9) * area(p)) {
+      block = candidate;
+      chosen = farthestParcel;
+      break;
     }
   }
   ASSERT_GE(chosen, 0);

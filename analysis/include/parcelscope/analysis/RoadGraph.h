@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -39,20 +40,27 @@ struct StreetLine {
   bool boundary = false;
 };
 
+/// Where keys drawn from positions see a local point, in steps of a key cell
+/// (about a centimetre; see io::LocalFrame::keyPlace): the input's own
+/// coordinates, so that keys do not move with the local frame, whose origin
+/// follows the data. Null: local metres, in centimetres.
+using KeyPlace = std::function<Point(const Point&)>;
+
 struct RoadGraphOptions {
   /// Endpoints closer than this (m) become one node; a free end this close to
   /// another line meets it there (a T-junction).
   double snap = 1.0;
+  KeyPlace keyPlace;
 };
 
 struct RoadNode {
-  Key key = 0;  ///< from its cell of the 1 mm noding grid (the cell that makes it one node)
+  Key key = 0;  ///< from its place (the key place of its cell of the 1 mm noding grid)
   Point at;
   int degree = 0;  ///< edges ending here (a loop counts twice); 1: a dead end
 };
 
 struct RoadEdge {
-  Key key = 0;  ///< from its end nodes' keys and its middle point
+  Key key = 0;  ///< from its end nodes' keys and its middle point's key place
   int from = -1, to = -1;
   /// From node `from` to node `to`: the edge's geometry, or, for a curved
   /// edge, its cubic Bezier flattened (see setCurve).
@@ -81,6 +89,7 @@ struct RoadGraph {
   std::vector<RoadNode> nodes;
   std::vector<RoadEdge> edges;
   RoadGraphReport report;
+  KeyPlace keyPlace;  ///< the options' (block keys are drawn from it too)
 };
 
 /// The graph of `lines`. Deterministic, and independent of the order of

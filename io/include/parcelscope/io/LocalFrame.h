@@ -37,6 +37,11 @@ public:
   Point toLocal(double x, double y) const;
   /// Local metres back to input coordinates.
   Point toSource(const Point& p) const;
+  /// Where keys drawn from positions see local point `p`: its input
+  /// coordinates in steps of about a centimetre (hundredths of a metre in a
+  /// projected CRS, 1e-7 degree in a geographic one), the same whatever the
+  /// frame's origin, which follows the data.
+  Point keyPlace(const Point& p) const;
   /// The frame as numbers, and back: fromState(state()) converts exactly as
   /// this frame does (frames sent between processes).
   std::vector<double> state() const;
