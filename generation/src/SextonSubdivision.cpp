@@ -75,9 +75,30 @@ constexpr double kOblong = 0.5;                    // blocks narrower than 1:2 (
 constexpr double kSpineTurn = 20.0 * kPi / 180.0;  // spine simplification: summed turning before a new vertex
 constexpr double kMinAreaShare = 0.75;             // of a-min, the smallest parcel a split may make
 constexpr double kSquareEnough = 0.25;             // aspect (width / length) limit of the rectangularity rule
-constexpr double kMinPieceShare = 0.3;             // of the parcel split, each piece's least area
-constexpr double kPositionSd = 0.15;  // of the side's length: spread of the split position about its middle
-constexpr int kAttempts = 10;         // random splits tried on one parcel
+// Aspect (width / length) no piece goes below, even with the constraints
+// relaxed, in a block without observed parcels (see leastAspect).
+constexpr double kSliverAspect = 0.1;
+
+// The least aspect (width / length) a piece may have with the constraints
+// relaxed: that of the block's observed parcels at their 90th percentile of
+// aspect ratio (length / width), at most kSquareEnough; kSliverAspect without
+// observed parcels. A block that reaches its count only with thinner slivers
+// than its observed parcels stops short.
+double leastAspect(const ObservedSample* observed) {
+  std::vector<double> ratios;
+  if (observed) {
+    for (double r : observed->aspectRatios) {
+      if (std::isfinite(r) && r >= 1) ratios.push_back(r);
+    }
+  }
+  if (ratios.empty()) return kSliverAspect;
+  const auto at = ratios.begin() + static_cast<long>(0.9 * static_cast<double>(ratios.size() - 1));
+  std::nth_element(ratios.begin(), at, ratios.end());
+  return std::min(kSquareEnough, 1.0 / *at);
+}
+constexpr double kMinPieceShare = 0.3;  // of the parcel split, each piece's least area
+constexpr double kPositionSd = 0.15;    // of the side's length: spread of the split position about its middle
+constexpr int kAttempts = 10;           // random splits tried on one parcel
 // When no random split is admissible: the largest parcels scanned, and the
 // positions along each road side tried, middle first.
 constexpr std::size_t kScanParcels = 8;
@@ -241,7 +262,8 @@ std::vector<Polygon> spineSplit(const Polygon& block) {
 
 class SextonSubdivider {
 public:
-  SextonSubdivider(const Polygon& block, const SextonParameters& p) : block_(block), outline_{block.outer, {}}, p_(p) {
+  SextonSubdivider(const Polygon& block, const SextonParameters& p, double leastAspect)
+      : block_(block), outline_{block.outer, {}}, p_(p), leastAspect_(leastAspect) {
     const Box b = bounds(block);
     tolerance_ = std::max(1e-6, 1e-9 * (b.width() + b.height()));
     outlineEdges_ = std::make_unique<analysis::PreparedBoundary>(outline_, tolerance_);
@@ -358,7 +380,7 @@ private:
     work_ += parcel.outer.size();
     if (work_ > kMaxSplitWork)
       throw detail::WorkBudgetExceeded("work budget: more than 4e8 vertices visited by split lines");
-    const double before = relax < Relax::Rectangularity ? aspectOf(parcel) : 0;
+    const double before = aspectOf(parcel);
     auto admissible = [&](const std::vector<Polygon>& pieces) {
       // Two pieces, as the paper's splits make; more, once the constraints
       // are relaxed, where a concave parcel leaves no line that makes two
@@ -370,9 +392,11 @@ private:
         if (relax < Relax::Variation && a < kMinPieceShare * parcelArea) return false;  // limited variation
       }
       for (const Polygon& q : pieces) {
+        const double aspect = aspectOf(q);
         if (relax < Relax::Rectangularity) {  // limited rectangularity
-          const double aspect = aspectOf(q);
           if (before > kSquareEnough ? aspect < kSquareEnough : aspect <= before) return false;
+        } else if (aspect < leastAspect_ && aspect < before) {
+          return false;  // no sliver thinner than the observed ones, where the parcel split was none
         }
         if (!outlineEdges_->sharesAtLeast(q, frontage_)) return false;  // road access
       }
@@ -417,6 +441,7 @@ private:
   const Polygon& block_;
   const Polygon outline_;
   SextonParameters p_;
+  double leastAspect_ = kSliverAspect;
   double tolerance_ = 1e-6;
   double frontage_ = 1;
   std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;
@@ -468,7 +493,7 @@ Subdivision subdivideSexton(const StyleRun& r) {
         std::vector<Polygon> start = spineSplit(local);
         // More spine pieces than parcels wanted: the spine is dropped (3.4.1).
         if (start.empty() || start.size() > wanted) start = {local};
-        SextonSubdivider subdivider(local, p);
+        SextonSubdivider subdivider(local, p, leastAspect(r.observed));
         subdivider.setScanBudget(wanted);  // as many scans as parcels wanted, over all tries
         // The try closest to the observed parcels among those that reached the
         // target count (when none did, among all).

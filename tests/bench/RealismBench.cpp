@@ -19,6 +19,7 @@
 // --quantiles: then, percentiles of area, width and aspect ratio, observed,
 // the paper's rule and the rule with the city left out.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -277,6 +278,40 @@ int main(int argc, char** argv) {
         std::printf("| %s %s | %zu | %s | %s | %s |\n", r.city->name, name, a.size(), pct(a).c_str(), pct(w).c_str(),
                     pct(q).c_str());
       }
+      // Per style the left-out rule picks: its blocks, parcels, and the share
+      // of them above the observed 90th percentile of aspect ratio (0.10 if
+      // the style's tail were the observed one).
+      std::vector<double> observedAspect;
+      for (std::size_t b = 0; b < c.blocks.size(); ++b) {
+        const auto s = pipeline::observedSample(c.board.observed->analysis, b);
+        observedAspect.insert(observedAspect.end(), s->aspectRatios.begin(), s->aspectRatios.end());
+      }
+      std::sort(observedAspect.begin(), observedAspect.end());
+      const double tail =
+          observedAspect[static_cast<std::size_t>(0.9 * static_cast<double>(observedAspect.size() - 1))];
+      // Each block's parcels in generatedMetrics' order (blocks in order).
+      const auto metrics = pipeline::generatedMetrics(c.board, out);
+      std::vector<std::size_t> first(out.size() + 1, 0);
+      for (std::size_t b = 0; b < out.size(); ++b) {
+        const std::vector<std::size_t> prefix(out.begin(), out.begin() + static_cast<long>(b) + 1);
+        first[b + 1] = pipeline::generatedMetrics(c.board, prefix).size();
+      }
+      std::map<std::string, std::array<std::size_t, 3>> byStyle;  // blocks, parcels, above
+      for (std::size_t b = 0; b < out.size(); ++b) {
+        auto& t = byStyle[c.board.entries[out[b]].style];
+        ++t[0];
+        for (std::size_t i = first[b]; i < first[b + 1]; ++i) {
+          ++t[1];
+          t[2] += metrics[i].aspectRatio > tail;
+        }
+      }
+      std::printf("  %s (observed p90 aspect ratio %.2f), left out, per style: blocks / parcels / share above it:",
+                  r.city->name, tail);
+      for (const auto& [style, t] : byStyle) {
+        std::printf(" %s %zu / %zu / %.2f;", style.c_str(), t[0], t[1],
+                    t[1] ? static_cast<double>(t[2]) / static_cast<double>(t[1]) : 0.0);
+      }
+      std::printf("\n");
     }
   }
   if (labels) {

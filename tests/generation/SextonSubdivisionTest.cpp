@@ -3,6 +3,8 @@
 // many tries against the observed parcels.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "RandomShapes.h"
@@ -88,6 +90,43 @@ TEST(Sexton, OfManyTriesKeepsTheOneClosestToTheObservedParcels) {
   };
   EXPECT_LE(distance(many), distance(one));
   EXPECT_EQ(many.parcels.size(), 8u);
+}
+
+// Reaching the target count may take slivers (every parcel needs road
+// access); with the constraints relaxed, no piece is thinner than the block's
+// observed parcels at their 90th percentile of aspect ratio (at most 1:4),
+// 1:10 without observed parcels: the block stops short instead.
+TEST(Sexton, NoSliverThinnerThanTheObservedParcelsToReachTheCount) {
+  const Polygon block = test::rect(0, 0, 60, 60);
+  const ParameterValues values{{"parcel-count", 80}, {"a-min", 10}, {"w-min", 1}, {"tries", 5}};
+  auto thinnest = [](const Subdivision& s) {
+    double least = 1;
+    for (const Polygon& p : s.parcels) {
+      const OrientedBox b = minimumAreaBox(p.outer);
+      least = std::min(least, b.width / b.length);
+    }
+    return least;
+  };
+  auto observedOf = [](double aspect) {
+    ObservedSample o;
+    o.areas.assign(80, 45.0);
+    o.widths.assign(80, std::sqrt(45.0 / aspect));
+    o.aspectRatios.assign(80, aspect);
+    return o;
+  };
+  const ObservedSample squares = observedOf(1), long8 = observedOf(8);
+  const Subdivision fromSquares = sexton(block, values, 2, &squares);
+  const Subdivision fromLong = sexton(block, values, 2, &long8);
+  const Subdivision alone = sexton(block, values, 2);
+  for (const Subdivision* s : {&fromSquares, &fromLong, &alone}) EXPECT_TILES(block, s->parcels, "60 x 60");
+  EXPECT_LT(fromSquares.parcels.size(), 80u);
+  EXPECT_GE(thinnest(fromSquares), 0.25 - 1e-9);
+  EXPECT_GE(thinnest(fromLong), 0.125 - 1e-9);
+  EXPECT_LT(thinnest(fromLong), 0.25);
+  EXPECT_GT(fromLong.parcels.size(), fromSquares.parcels.size());
+  EXPECT_GE(thinnest(alone), 0.1 - 1e-9);
+  std::printf("parcels of 80: %zu (observed squares), %zu (observed 1:8), %zu (none)\n", fromSquares.parcels.size(),
+              fromLong.parcels.size(), alone.parcels.size());
 }
 
 // Random shapes: a tiling, valid, reproducible, every parcel with access
