@@ -95,10 +95,19 @@ std::pair<Point, Point> pointAt(const Polyline& line, double s) {
 // Mixed into the key of a block that faces no street.
 constexpr Key kStreetlessBlockKey = 0x5354524545544c53ull;
 
-// The key of a position: its key place, rounded to the key cell.
+// Key cells (about 1 cm each, see KeyPlace) per cell of a position key: about
+// a metre. The noded network's points lie on the local frame's 1 mm grid
+// (kGrid), so they move by up to half of it when the frame moves; a key drawn
+// from a point flips where the point lies that close to a cell's edge, for
+// 1 in 2,000 points at a metre (1 in 20 at a centimetre). Nodes closer than a
+// metre (with less snapping) share a key and are told apart by their cells.
+constexpr double kPositionCell = 100;
+
+// The key of a position: its key place, rounded to kPositionCell key cells.
 Key positionKey(const KeyPlace& keyPlace, const Point& p) {
   const Point q = keyPlace ? keyPlace(p) : Point{p.x * 100, p.y * 100};
-  return mixKeys(static_cast<Key>(std::llround(q.x)), static_cast<Key>(std::llround(q.y)));
+  return mixKeys(static_cast<Key>(std::llround(q.x / kPositionCell)),
+                 static_cast<Key>(std::llround(q.y / kPositionCell)));
 }
 
 std::pair<long long, long long> gridCell(const Point& p, double cell) {

@@ -129,6 +129,23 @@ void collectPolygons(const GEOSGeometry* g, std::vector<Polygon>& out) {
 
 bool valid(const GEOSGeometry* g) { return g && GEOSisValid_r(context(), g) == 1; }
 
+// Whether a polygon of `g` has a hole closer than `grid` to its outer ring:
+// valid, but a sliver of the shell between them, or a hole meant to be a
+// notch (a cut along the shell, off by roundings).
+bool holeNearShell(const GEOSGeometry* g, double grid) {
+  GEOSContextHandle_t ctx = context();
+  for (int i = 0, n = GEOSGetNumGeometries_r(ctx, g); i < n; ++i) {
+    const GEOSGeometry* p = GEOSGetGeometryN_r(ctx, g, i);
+    if (GEOSGeomTypeId_r(ctx, p) != GEOS_POLYGON) continue;
+    const GEOSGeometry* shell = GEOSGetExteriorRing_r(ctx, p);
+    for (int h = 0, holes = GEOSGetNumInteriorRings_r(ctx, p); h < holes; ++h) {
+      double d = 0;
+      if (GEOSDistance_r(ctx, shell, GEOSGetInteriorRingN_r(ctx, p, h), &d) == 1 && d < grid) return true;
+    }
+  }
+  return false;
+}
+
 // GEOS buffer with mitred joins.
 Geom mitreBuffer(const GEOSGeometry* g, double distance) {
   constexpr double kMitreLimit = 5.0;  // spikes sharper than ~23 degrees are bevelled
@@ -407,8 +424,10 @@ std::vector<Polygon> difference(const Polygon& a, const std::vector<const Polygo
   }
   // Floating overlay first (GEOS's own fallbacks make it robust in nearly
   // every case), one cutter at a time (cheaper than their union first); snap
-  // rounding on the grid when that fails or gives an invalid result (it costs
-  // more: GEOS 3.11 seeds a random device per call).
+  // rounding on the grid when that fails, gives an invalid result, or leaves
+  // a hole within the grid of its outer ring (a cutter along the shell but
+  // for roundings; see holeNearShell) (it costs more: GEOS 3.11 seeds a
+  // random device per call).
   Geom d(GEOSGeom_clone_r(ctx, ga.get()));
   for (const Polygon* c : cut) {
     if (!d) break;
@@ -416,7 +435,7 @@ std::vector<Polygon> difference(const Polygon& a, const std::vector<const Polygo
     d.reset(gcut ? GEOSDifference_r(ctx, d.get(), gcut.get()) : nullptr);
   }
   Geom cutUnion;
-  if (!valid(d.get())) {
+  if (!valid(d.get()) || holeNearShell(d.get(), grid)) {
     Geom gc = toGeos(cut);
     cutUnion.reset(gc ? GEOSUnaryUnionPrec_r(ctx, gc.get(), grid) : nullptr);
     d.reset(cutUnion ? GEOSDifferencePrec_r(ctx, ga.get(), cutUnion.get(), grid) : nullptr);

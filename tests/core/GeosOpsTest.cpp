@@ -108,5 +108,30 @@ TEST(GeosOps, ValidPartsSplitsABowTieAndKeepsValidPolygonsAsTheyAre) {
   }
 }
 
+// A parcel at a block's corner whose two sides lie along the block's sides
+// but for roundings (here within 1e-9 m: a street block and a parcel kept
+// from before an edit), cut from the block: the floating-point overlay left
+// it as a hole touching the outer ring at the corner, 1e-9 m from it along
+// both sides, a valid polygon no subdivision handles (the OBB style cut a
+// parcel out of it with the hole on its boundary). The difference is snapped
+// onto the grid instead: a notched block without a hole.
+TEST(GeosOps, DifferenceOfAParcelAlongTheBlocksSidesLeavesNoHoleAlongThem) {
+  const Polygon block{{{-270.43074263688999, -209.04606807798413},
+                       {-108.0549876026318, -209.04791037842418},
+                       {-106.29216526534026, -105.52568432912841},
+                       {-270.42634170653474, -106.44453814850729}},
+                      {}};
+  const Polygon corner{{{-270.43074263688999, -209.04606807798413},
+                        {-251.40226464919601, -209.04628397335202},
+                        {-251.40197371504448, -183.40407519399548},
+                        {-270.42964272915174, -183.4032590322266}},
+                       {}};
+  const auto rest = difference(block, {&corner}, 1e-6);
+  ASSERT_EQ(rest.size(), 1u);
+  EXPECT_TRUE(rest[0].holes.empty()) << rest[0].holes.size() << " holes";
+  EXPECT_TRUE(isValid(rest[0]));
+  EXPECT_NEAR(area(rest[0]), area(block) - area(corner), 1e-6 * area(block));
+}
+
 }  // namespace
 }  // namespace parcelscope::geos

@@ -205,10 +205,11 @@ io::StreetReadOptions gridStreets(const TempDir& dir) {
   std::string lines;
   auto line = [&](double x0, double y0, double x1, double y1) {
     char f[256];
+    // Off the whole metres, as real lines are.
     std::snprintf(
         f, sizeof f,
-        R"(%s{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[%.1f,%.1f],[%.1f,%.1f]]}})",
-        lines.empty() ? "" : ",", x0, y0, x1, y1);
+        R"(%s{"type":"Feature","properties":{},"geometry":{"type":"LineString","coordinates":[[%.6f,%.6f],[%.6f,%.6f]]}})",
+        lines.empty() ? "" : ",", x0 + 0.123456, y0 + 0.654321, x1 + 0.123456, y1 + 0.654321);
     lines += f;
   };
   for (int i = 0; i <= 8; ++i) {

@@ -72,8 +72,9 @@ LineFaces polygonizeLines(const std::vector<Polyline>& noded);
 std::vector<Polygon> bufferedUnion(const std::vector<const Polyline*>& lines, const std::vector<double>& halfWidths,
                                    int quadrantSegments = 4);
 
-/// `a` minus the union of `cut` (floating overlay; where that fails or is
-/// invalid, snap rounding on a `grid`-metre grid); normalised valid parts. Throws Error(Geometry) if GEOS fails.
+/// `a` minus the union of `cut` (floating overlay; where that fails, is
+/// invalid or leaves a hole within `grid` of its outer ring, snap rounding on a
+/// `grid`-metre grid); normalised valid parts. Throws Error(Geometry) if GEOS fails.
 std::vector<Polygon> difference(const Polygon& a, const std::vector<const Polygon*>& cut, double grid);
 
 /// Indices of the `lines` that come within `distances[i]` of `polygon`
