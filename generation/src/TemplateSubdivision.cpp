@@ -105,6 +105,7 @@ constexpr double kMaxObbShare = 0.5;
 // medians of its observed parcels (without: the bounds' geometric means).
 struct Sizes {
   double aMin, aMax, wMin, wMax, width, area;
+  double aspect = 0;  // median observed aspect ratio (length / width); 0: none
 };
 
 double median(std::vector<double> v) {
@@ -120,6 +121,13 @@ Sizes sizesFrom(const TemplateParameters& p, const ObservedSample* observed) {
   Sizes s{p.aMin, p.aMax, p.wMin, p.wMax, mean(p.wMin, p.wMax), mean(p.aMin, p.aMax)};
   if (observed && !observed->widths.empty()) s.width = median(observed->widths);
   if (observed && !observed->areas.empty()) s.area = median(observed->areas);
+  if (observed) {
+    std::vector<double> ratios;
+    for (double r : observed->aspectRatios) {
+      if (std::isfinite(r) && r >= 1) ratios.push_back(r);
+    }
+    if (!ratios.empty()) s.aspect = median(ratios);
+  }
   s.width = std::clamp(s.width, s.wMin, s.wMax);
   s.area = std::clamp(s.area, s.aMin, s.aMax);
   return s;
@@ -145,7 +153,10 @@ Count parcelsAlong(double length, double depth, const Sizes& s) {
     const double f = length / n, parcel = a / n, w = std::min(f, depth);
     const double ew = excess(w, s.wMin, s.wMax), ea = excess(parcel, s.aMin, s.aMax);
     const double lf = std::log(f / s.width), la = std::log(parcel / s.area);
-    const double cost = 0.5 * (lf * lf + la * la) + kOutOfBounds * (ew * ew + ea * ea);
+    // The parcel's shape too: a deep row of narrow parcels matches width and
+    // area and still makes strips the observed parcels are not.
+    const double lr = s.aspect > 0 ? std::log(std::max(f, depth) / w / s.aspect) : 0.0;
+    const double cost = 0.5 * (lf * lf + la * la + lr * lr) + kOutOfBounds * (ew * ew + ea * ea);
     if (cost < best.cost) best = {static_cast<int>(n), cost};
   }
   return best;

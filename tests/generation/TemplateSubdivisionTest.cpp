@@ -3,6 +3,8 @@
 // used as split lines.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <map>
 #include <random>
 
@@ -48,6 +50,41 @@ TEST(Template, ARectangleGetsARowOrGridWithParcelsWithinTheBounds) {
   EXPECT_EQ(fitted.variant, "grid");
   EXPECT_EQ(fitted.parcels.size(), 20u);
   for (const Polygon& p : fitted.parcels) EXPECT_NEAR(area(p), 600, 1e-6);
+}
+
+// A row's count follows the observed parcels' shape too, not only their
+// frontage and area: the same widths and areas, observed as near squares, give
+// fewer and squarer parcels than observed as strips.
+TEST(Template, TheCountFollowsTheObservedAspectRatio) {
+  const Polygon block = test::rect(0, 0, 200, 80);
+  const ParameterValues bounds = {{"a-min", 50}, {"a-max", 5000}, {"w-min", 2}, {"w-max", 100}};
+  auto observedOf = [](double aspect) {
+    ObservedSample o;
+    o.areas.assign(20, 200.0);
+    o.widths.assign(20, 10.0);
+    o.aspectRatios.assign(20, aspect);
+    return o;
+  };
+  auto medianAspect = [](const Subdivision& s) {
+    std::vector<double> r;
+    for (const Polygon& p : s.parcels) {
+      const OrientedBox b = minimumAreaBox(p.outer);
+      r.push_back(b.length / b.width);
+    }
+    std::sort(r.begin(), r.end());
+    return r[r.size() / 2];
+  };
+  const ObservedSample squares = observedOf(1.2), strips = observedOf(4);
+  const Subdivision fromSquares = withTemplate(block, bounds, 1, &squares);
+  const Subdivision fromStrips = withTemplate(block, bounds, 1, &strips);
+  ASSERT_FALSE(fromSquares.fallback) << fromSquares.fallbackReason;
+  ASSERT_FALSE(fromStrips.fallback) << fromStrips.fallbackReason;
+  EXPECT_TILES(block, fromSquares.parcels, "200 x 80");
+  EXPECT_LT(fromSquares.parcels.size(), fromStrips.parcels.size());
+  EXPECT_LT(medianAspect(fromSquares), medianAspect(fromStrips));
+  std::printf("parcels %zu (observed 1:1.2), %zu (observed 1:4); median aspect %.2f, %.2f\n",
+              fromSquares.parcels.size(), fromStrips.parcels.size(), medianAspect(fromSquares),
+              medianAspect(fromStrips));
 }
 
 TEST(Template, ADeadEndGetsTheSpikeATriangleARowAndADiscFallsBack) {
