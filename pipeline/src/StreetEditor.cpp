@@ -132,6 +132,26 @@ void moveNodes(analysis::RoadGraph& graph, const std::set<std::size_t>& nodes,
   }
 }
 
+// Keys unique again after some `items` (nodes or edges) took the keys of
+// their counterparts before (`kept`): buildRoadGraph keys positions to about a
+// metre and tells items of one key apart by their order, so an item new to the
+// network may have drawn a key an item before had (one kept, or a street cut
+// in two). Such an item takes another, mixed from its own (in the items'
+// order: deterministic).
+template <typename Item>
+void uniqueKeys(std::vector<Item>& items, const std::vector<char>& kept, const std::vector<Item>& before) {
+  std::set<Key> used;
+  for (const Item& b : before) used.insert(b.key);
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (kept[i]) used.insert(items[i].key);
+  }
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (kept[i]) continue;
+    while (used.count(items[i].key)) items[i].key = mixKeys(items[i].key, 0x52454b4559ull);
+    used.insert(items[i].key);
+  }
+}
+
 // `graph` with the edges `removed` left out and the lines `added`, noded again
 // (analysis::buildRoadGraph). A node where a node was keeps its key; an edge
 // with the same vertices as an edge before keeps its key and its curve's
@@ -160,7 +180,9 @@ analysis::RoadGraph renoded(const analysis::RoadGraph& graph, const std::set<std
   };
   for (std::size_t i = 0; i < graph.nodes.size(); ++i) cells[cellOf(graph.nodes[i].at)].push_back(i);
   std::set<std::size_t> taken;
-  for (analysis::RoadNode& n : out.nodes) {
+  std::vector<char> nodeKept(out.nodes.size(), 0);
+  for (std::size_t ni = 0; ni < out.nodes.size(); ++ni) {
+    analysis::RoadNode& n = out.nodes[ni];
     const auto [cx, cy] = cellOf(n.at);
     double nearest = kSame;
     long best = -1;
@@ -180,7 +202,9 @@ analysis::RoadGraph renoded(const analysis::RoadGraph& graph, const std::set<std
     if (best < 0) continue;
     taken.insert(static_cast<std::size_t>(best));
     n.key = graph.nodes[static_cast<std::size_t>(best)].key;
+    nodeKept[ni] = 1;
   }
+  uniqueKeys(out.nodes, nodeKept, graph.nodes);
   // An edge whose end nodes are those of an edge before (by key) and whose
   // vertices lie within 1 mm of its vertices, either way along, is that edge.
   const auto along = [&](const std::vector<Point>& a, const std::vector<Point>& b, bool reversed) {
@@ -200,7 +224,9 @@ analysis::RoadGraph renoded(const analysis::RoadGraph& graph, const std::set<std
     edgesBetween[std::minmax(a, b)].push_back(k);
   }
   std::set<std::size_t> edgeTaken;
-  for (analysis::RoadEdge& e : out.edges) {
+  std::vector<char> edgeKept(out.edges.size(), 0);
+  for (std::size_t ei = 0; ei < out.edges.size(); ++ei) {
+    analysis::RoadEdge& e = out.edges[ei];
     const Key a = out.nodes[static_cast<std::size_t>(e.from)].key, b = out.nodes[static_cast<std::size_t>(e.to)].key;
     const auto it = edgesBetween.find(std::minmax(a, b));
     if (it == edgesBetween.end()) continue;
@@ -211,11 +237,13 @@ analysis::RoadGraph renoded(const analysis::RoadGraph& graph, const std::set<std
       if (!forward && !along(e.line, old.line, true)) continue;
       edgeTaken.insert(k);
       e.key = old.key;
+      edgeKept[ei] = 1;
       if (old.controls && forward && graph.nodes[static_cast<std::size_t>(old.from)].key == a)
         e.controls = old.controls;
       break;
     }
   }
+  uniqueKeys(out.edges, edgeKept, graph.edges);
   // Sorted by key again, as buildRoadGraph leaves them.
   std::vector<std::size_t> order(out.nodes.size());
   std::iota(order.begin(), order.end(), 0);

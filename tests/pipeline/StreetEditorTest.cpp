@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -370,6 +371,50 @@ TEST(StreetEditor, AStreetAddedSplitsABlockDeletedJoinsItAndANodeInsertedSplitsA
   EXPECT_EQ(editor.network().graph.edges.size(), edges + 1);
   EXPECT_EQ(editor.parcels().blocks.size(), blocks);
   EXPECT_GE(static_cast<double>(ri.matched), 0.8 * static_cast<double>(ri.parcelsBefore));
+}
+
+// Keys are drawn from positions to about a metre; a node inserted 1.2 m from
+// an intersection shares its key cell. It must not take the intersection's
+// key (which the intersection keeps), nor its two streets that of the street
+// cut: every node and edge key stays unique, and a move by the intersection's
+// key moves the intersection.
+TEST(StreetEditor, ANodeInsertedBesideAnotherTakesAKeyOfItsOwn) {
+  StreetEditor editor(sampleStreets());
+  const Key node = busiestNode(editor);
+  const auto& g = editor.network().graph;
+  std::size_t at = 0;
+  while (g.nodes[at].key != node) ++at;
+  const auto street = std::find_if(g.edges.begin(), g.edges.end(), [&](const auto& e) {
+    return !e.boundary && e.line.size() == 2 &&
+           (static_cast<std::size_t>(e.from) == at || static_cast<std::size_t>(e.to) == at);
+  });
+  ASSERT_NE(street, g.edges.end());
+  const Point from = g.nodes[at].at,
+              other = static_cast<std::size_t>(street->from) == at ? street->line.back() : street->line.front();
+  const double length = std::hypot(other.x - from.x, other.y - from.y);
+  ASSERT_GT(length, 5.0);
+  auto unique = [](std::vector<Key> keys) {
+    std::sort(keys.begin(), keys.end());
+    return std::adjacent_find(keys.begin(), keys.end()) == keys.end();
+  };
+  for (const double d : {1.2, 0.6, 0.3}) {
+    SCOPED_TRACE(d);
+    StreetEditor e(sampleStreets());
+    StreetEdit insert;
+    insert.op = StreetEdit::Op::InsertNode;
+    insert.edge = street->key;
+    insert.to = {from.x + d * (other.x - from.x) / length, from.y + d * (other.y - from.y) / length};
+    e.apply(insert);
+    std::vector<Key> nodes, edges;
+    for (const auto& n : e.network().graph.nodes) nodes.push_back(n.key);
+    for (const auto& x : e.network().graph.edges) edges.push_back(x.key);
+    EXPECT_TRUE(unique(nodes)) << "node keys";
+    EXPECT_TRUE(unique(edges)) << "edge keys";
+    EXPECT_EQ(std::count(edges.begin(), edges.end(), street->key), 0) << "the street cut keeps its key";
+    for (const auto& n : e.network().graph.nodes) {
+      if (n.key == node) EXPECT_EQ(n.degree, g.nodes[at].degree) << "the intersection keeps its key";
+    }
+  }
 }
 
 // Lipp et al. 2011's anchored assignment: a locked parcel keeps its geometry
