@@ -131,16 +131,24 @@ bool valid(const GEOSGeometry* g) { return g && GEOSisValid_r(context(), g) == 1
 
 // Whether a polygon of `g` has a hole closer than `grid` to its outer ring:
 // valid, but a sliver of the shell between them, or a hole meant to be a
-// notch (a cut along the shell, off by roundings).
+// notch (a cut along the shell, off by roundings). The shell is prepared (an
+// index of its segments), so that a block of thousands of holes stays cheap.
 bool holeNearShell(const GEOSGeometry* g, double grid) {
   GEOSContextHandle_t ctx = context();
+  struct DestroyPrepared {
+    GEOSContextHandle_t ctx;
+    void operator()(const GEOSPreparedGeometry* p) const { GEOSPreparedGeom_destroy_r(ctx, p); }
+  };
   for (int i = 0, n = GEOSGetNumGeometries_r(ctx, g); i < n; ++i) {
     const GEOSGeometry* p = GEOSGetGeometryN_r(ctx, g, i);
     if (GEOSGeomTypeId_r(ctx, p) != GEOS_POLYGON) continue;
-    const GEOSGeometry* shell = GEOSGetExteriorRing_r(ctx, p);
-    for (int h = 0, holes = GEOSGetNumInteriorRings_r(ctx, p); h < holes; ++h) {
-      double d = 0;
-      if (GEOSDistance_r(ctx, shell, GEOSGetInteriorRingN_r(ctx, p, h), &d) == 1 && d < grid) return true;
+    const int holes = GEOSGetNumInteriorRings_r(ctx, p);
+    if (holes <= 0) continue;
+    std::unique_ptr<const GEOSPreparedGeometry, DestroyPrepared> shell(
+        GEOSPrepare_r(ctx, GEOSGetExteriorRing_r(ctx, p)), DestroyPrepared{ctx});
+    if (!shell) continue;
+    for (int h = 0; h < holes; ++h) {
+      if (GEOSPreparedDistanceWithin_r(ctx, shell.get(), GEOSGetInteriorRingN_r(ctx, p, h), grid) == 1) return true;
     }
   }
   return false;
@@ -435,10 +443,13 @@ std::vector<Polygon> difference(const Polygon& a, const std::vector<const Polygo
     d.reset(gcut ? GEOSDifference_r(ctx, d.get(), gcut.get()) : nullptr);
   }
   Geom cutUnion;
-  if (!valid(d.get()) || holeNearShell(d.get(), grid)) {
+  const bool floatingValid = valid(d.get());
+  if (!floatingValid || holeNearShell(d.get(), grid)) {
     Geom gc = toGeos(cut);
     cutUnion.reset(gc ? GEOSUnaryUnionPrec_r(ctx, gc.get(), grid) : nullptr);
-    d.reset(cutUnion ? GEOSDifferencePrec_r(ctx, ga.get(), cutUnion.get(), grid) : nullptr);
+    Geom snapped(cutUnion ? GEOSDifferencePrec_r(ctx, ga.get(), cutUnion.get(), grid) : nullptr);
+    // A valid floating result is kept when snapping fails.
+    if (snapped || !floatingValid) d = std::move(snapped);
   }
   if (!d) throw geometryError("difference of a polygon and " + std::to_string(cut.size()) + " polygons failed");
   collectPolygons(d.get(), out);
