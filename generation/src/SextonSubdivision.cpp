@@ -48,6 +48,11 @@ const std::vector<ParameterDescription>& sextonParameterDescriptions() {
     all.push_back(integerParameter(
         "tries", "sexton: randomized subdivisions per block; the one closest to the observed parcels is kept", "", 1.0,
         1000.0, 50.0, "Subdivision"));
+    all.push_back(enumParameter(
+        "interior-parcels",
+        "sexton: none, every parcel on a street (the paper); observed, as many parcels without street access as "
+        "the block's observed share, cut off along the street at the observed parcels' median length",
+        {"none", "observed"}, "observed", "Subdivision"));
     return all;
   }();
   return d;
@@ -57,6 +62,7 @@ struct SextonParameters {
   double aMin = 200, aMax = 800, wMin = 8, minFrontage = 1;
   int count = 0;  // 0: derived
   int tries = 50;
+  bool interior = true;  // interior-parcels observed
 };
 
 SextonParameters sextonParametersFrom(const ParameterValues& v) {
@@ -67,6 +73,9 @@ SextonParameters sextonParametersFrom(const ParameterValues& v) {
   }
   readValue(v, "parcel-count", p.count);
   readValue(v, "tries", p.tries);
+  double interior = 1;
+  readValue(v, "interior-parcels", interior);
+  p.interior = interior >= 0.5;
   return p;
 }
 
@@ -262,8 +271,22 @@ std::vector<Polygon> spineSplit(const Polygon& block) {
 
 class SextonSubdivider {
 public:
-  SextonSubdivider(const Polygon& block, const SextonParameters& p, double leastAspect)
-      : block_(block), outline_{block.outer, {}}, p_(p), leastAspect_(leastAspect) {
+  SextonSubdivider(const Polygon& block, const SextonParameters& p, const ObservedSample* observed)
+      : block_(block), outline_{block.outer, {}}, p_(p), leastAspect_(leastAspect(observed)) {
+    // Interior parcels: the block's observed share without street access, at
+    // the observed parcels' median length from the street.
+    if (p.interior && observed && std::isfinite(observed->accessShare)) {
+      std::vector<double> lengths;
+      for (std::size_t i = 0; i < observed->widths.size() && i < observed->aspectRatios.size(); ++i) {
+        const double l = observed->widths[i] * observed->aspectRatios[i];
+        if (std::isfinite(l) && l > 0) lengths.push_back(l);
+      }
+      if (!lengths.empty()) {
+        std::nth_element(lengths.begin(), lengths.begin() + static_cast<long>(lengths.size() / 2), lengths.end());
+        depth_ = lengths[lengths.size() / 2];
+        interiorShare_ = std::clamp(1 - observed->accessShare, 0.0, 1.0);
+      }
+    }
     const Box b = bounds(block);
     tolerance_ = std::max(1e-6, 1e-9 * (b.width() + b.height()));
     outlineEdges_ = std::make_unique<analysis::PreparedBoundary>(outline_, tolerance_);
@@ -279,6 +302,7 @@ public:
   // One randomized subdivision from `start`, towards `target` parcels.
   std::vector<Polygon> subdivide(const std::vector<Polygon>& start, std::size_t target, detail::Rng rng) {
     std::vector<Polygon> parcels = start;
+    interiorLeft_ = static_cast<std::size_t>(std::floor(interiorShare_ * static_cast<double>(target)));
     std::vector<double> areas;
     std::vector<std::vector<Side>> road;  // each parcel's road-facing sides
     for (const Polygon& q : parcels) {
@@ -288,6 +312,9 @@ public:
     int relaxed = 0;  // once a level is needed, the rest of this subdivision keeps it
     // Parcel `pick` replaced by the pieces of its split.
     auto apply = [&](std::size_t pick, std::vector<Polygon>& pieces) {
+      for (const Polygon& q : pieces) {
+        if (interiorLeft_ > 0 && !outlineEdges_->sharesAtLeast(q, frontage_)) --interiorLeft_;
+      }
       parcels[pick] = std::move(pieces[0]);
       areas[pick] = area(parcels[pick]);
       road[pick] = roadSides(parcels[pick]);
@@ -345,6 +372,13 @@ private:
                                 std::size_t maxPieces, Relax relax, detail::Rng& rng) {
     if (road.empty()) return {};
     const Side& s = road[static_cast<std::size_t>(rng.uniform() * static_cast<double>(road.size()))];
+    if (interiorLeft_ > 0 && depth_ > 0 && rng.uniform() < interiorShare_) {
+      // Along the street, at the observed depth: the back piece an interior parcel.
+      const Point mid{0.5 * (s.a.x + s.b.x), 0.5 * (s.a.y + s.b.y)}, inward{-s.dir.y, s.dir.x};
+      const SplitLine line{{mid.x + depth_ * inward.x, mid.y + depth_ * inward.y}, s.dir};
+      std::vector<Polygon> pieces = cutAlong(parcel, parcelArea, line, maxPieces, relax, true);
+      if (!pieces.empty()) return pieces;
+    }
     const double f = std::clamp(0.5 + kPositionSd * rng.normal(), 0.05, 0.95);
     return splitAt(parcel, parcelArea, s, f, maxPieces, relax);
   }
@@ -377,6 +411,13 @@ private:
   std::vector<Polygon> splitAt(const Polygon& parcel, double parcelArea, const Side& s, double f, std::size_t maxPieces,
                                Relax relax) {
     const SplitLine line{{s.a.x + f * (s.b.x - s.a.x), s.a.y + f * (s.b.y - s.a.y)}, {-s.dir.y, s.dir.x}};
+    return cutAlong(parcel, parcelArea, line, maxPieces, relax, false);
+  }
+
+  // The split of `parcel` by `line`, when admissible; with `interior`, one
+  // piece may lack road access (an interior parcel, of the block's budget).
+  std::vector<Polygon> cutAlong(const Polygon& parcel, double parcelArea, const SplitLine& line, std::size_t maxPieces,
+                                Relax relax, bool interior) {
     work_ += parcel.outer.size();
     if (work_ > kMaxSplitWork)
       throw detail::WorkBudgetExceeded("work budget: more than 4e8 vertices visited by split lines");
@@ -398,9 +439,10 @@ private:
         } else if (aspect < leastAspect_ && aspect < before) {
           return false;  // no sliver thinner than the observed ones, where the parcel split was none
         }
-        if (!outlineEdges_->sharesAtLeast(q, frontage_)) return false;  // road access
       }
-      return true;
+      std::size_t without = 0;
+      for (const Polygon& q : pieces) without += !outlineEdges_->sharesAtLeast(q, frontage_);  // road access
+      return interior ? without == 1 && pieces.size() == 2 : without == 0;
     };
     // Random lines are many: one the floating-point split cannot make (it meets
     // a hole) is dropped rather than made exactly, except on parcels without
@@ -442,6 +484,9 @@ private:
   const Polygon outline_;
   SextonParameters p_;
   double leastAspect_ = kSliverAspect;
+  double interiorShare_ = 0;      // observed share of parcels without street access
+  double depth_ = 0;              // observed median parcel length
+  std::size_t interiorLeft_ = 0;  // interior parcels this try may still make
   double tolerance_ = 1e-6;
   double frontage_ = 1;
   std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;
@@ -493,7 +538,7 @@ Subdivision subdivideSexton(const StyleRun& r) {
         std::vector<Polygon> start = spineSplit(local);
         // More spine pieces than parcels wanted: the spine is dropped (3.4.1).
         if (start.empty() || start.size() > wanted) start = {local};
-        SextonSubdivider subdivider(local, p, leastAspect(r.observed));
+        SextonSubdivider subdivider(local, p, r.observed);
         subdivider.setScanBudget(wanted);  // as many scans as parcels wanted, over all tries
         // The try closest to the observed parcels among those that reached the
         // target count (when none did, among all).

@@ -10,12 +10,15 @@ namespace parcelscope::pipeline {
 std::shared_ptr<generation::ObservedSample> observedSample(const analysis::ObservedAnalysis& analysis,
                                                            std::size_t block) {
   auto sample = std::make_shared<generation::ObservedSample>();
+  double with = 0;
   for (int i : analysis.blocks[block].parcels) {
     const analysis::ParcelMetrics& m = analysis.metrics[static_cast<std::size_t>(i)];
     sample->areas.push_back(m.area);
     sample->widths.push_back(m.width);
     sample->aspectRatios.push_back(m.aspectRatio);
+    with += m.streetAccess;
   }
+  if (!sample->areas.empty()) sample->accessShare = with / static_cast<double>(sample->areas.size());
   return sample;
 }
 

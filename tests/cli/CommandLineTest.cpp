@@ -271,7 +271,10 @@ TEST(GenerateCommand, SkeletonOffsetAndAutoStylesRunOnTheSample) {
     const std::string json = slurp(out + "/run.json");
     EXPECT_NE(json.find("\"style\": \"" + std::string(style) + "\""), std::string::npos) << json;
     EXPECT_NE(json.find("\"blocks\": 10"), std::string::npos) << json;
-    EXPECT_NE(json.find("\"parcels_without_street_access\": 0"), std::string::npos) << json;
+    // auto may pick sexton, which makes interior parcels where the observed ones are.
+    if (std::string(style) != "auto") {
+      EXPECT_NE(json.find("\"parcels_without_street_access\": 0"), std::string::npos) << json;
+    }
     EXPECT_NE(json.find("\"blocks_by_style\""), std::string::npos) << json;
     writtenParcels(out);
     if (std::string(style) == "offset") {

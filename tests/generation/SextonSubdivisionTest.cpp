@@ -21,6 +21,15 @@ Subdivision sexton(const Polygon& block, const ParameterValues& values, std::uin
   return test::runStyle(sextonStyle(), block, values, seed, observed);
 }
 
+// `n` observed parcels alike.
+ObservedSample sampleOf(std::size_t n, double area, double width, double aspectRatio) {
+  ObservedSample o;
+  o.areas.assign(n, area);
+  o.widths.assign(n, width);
+  o.aspectRatios.assign(n, aspectRatio);
+  return o;
+}
+
 TEST(Sexton, AnOblongBlockIsCutAlongItsSpineFromEndToEnd) {
   // 120 x 40 (1:3): the spine runs along the middle; two parcels wanted: the two halves.
   const Polygon block = test::rect(0, 0, 120, 40);
@@ -61,10 +70,7 @@ TEST(Sexton, OfManyTriesKeepsTheOneClosestToTheObservedParcels) {
   // Observed: 8 equal lots of 20 x 50 m. More tries can only bring the kept
   // subdivision closer (the first tries are among them).
   const Polygon block = test::rect(0, 0, 160, 50);
-  ObservedSample observed;
-  observed.areas.assign(8, 1000.0);
-  observed.widths.assign(8, 20.0);
-  observed.aspectRatios.assign(8, 2.5);
+  const ObservedSample observed = sampleOf(8, 1000, 20, 2.5);
   const Subdivision one = sexton(block, {{"tries", 1}, {"a-min", 400}, {"w-min", 10}}, 5, &observed);
   const Subdivision many = sexton(block, {{"tries", 60}, {"a-min", 400}, {"w-min", 10}}, 5, &observed);
   EXPECT_EQ(one.targetParcels, 8);
@@ -107,14 +113,7 @@ TEST(Sexton, NoSliverThinnerThanTheObservedParcelsToReachTheCount) {
     }
     return least;
   };
-  auto observedOf = [](double aspect) {
-    ObservedSample o;
-    o.areas.assign(80, 45.0);
-    o.widths.assign(80, std::sqrt(45.0 / aspect));
-    o.aspectRatios.assign(80, aspect);
-    return o;
-  };
-  const ObservedSample squares = observedOf(1), long8 = observedOf(8);
+  const ObservedSample squares = sampleOf(80, 45, std::sqrt(45.0), 1), long8 = sampleOf(80, 45, std::sqrt(45.0 / 8), 8);
   const Subdivision fromSquares = sexton(block, values, 2, &squares);
   const Subdivision fromLong = sexton(block, values, 2, &long8);
   const Subdivision alone = sexton(block, values, 2);
@@ -127,6 +126,30 @@ TEST(Sexton, NoSliverThinnerThanTheObservedParcelsToReachTheCount) {
   EXPECT_GE(thinnest(alone), 0.1 - 1e-9);
   std::printf("parcels of 80: %zu (observed squares), %zu (observed 1:8), %zu (none)\n", fromSquares.parcels.size(),
               fromLong.parcels.size(), alone.parcels.size());
+}
+
+// Where a third of the block's observed parcels have no street access,
+// sexton cuts some parcels off along the street at the observed depth
+// (interior parcels); `interior-parcels none` (the paper) keeps every parcel
+// on a street.
+TEST(Sexton, InteriorParcelsFollowTheObservedShareWithoutStreetAccess) {
+  const Polygon block = test::rect(0, 0, 120, 120);
+  ObservedSample observed = sampleOf(30, 480, 20, 1.2);
+  observed.accessShare = 2.0 / 3.0;
+  const ParameterValues values{{"a-min", 100}, {"w-min", 4}, {"tries", 10}};
+  ParameterValues paper = values;
+  paper["interior-parcels"] = 0;
+  const Subdivision s = sexton(block, values, 3, &observed), p = sexton(block, paper, 3, &observed);
+  EXPECT_TILES(block, s.parcels, "120 x 120");
+  EXPECT_TILES(block, p.parcels, "120 x 120, the paper's");
+  EXPECT_EQ(s.targetParcels, 30);
+  EXPECT_EQ(p.withoutAccess, 0);
+  EXPECT_EQ(test::measuredWithoutAccess(block, p.parcels, 2.0), 0);
+  EXPECT_GT(s.withoutAccess, 0);
+  EXPECT_LE(s.withoutAccess, 10);  // at most the observed third of the 30 wanted
+  EXPECT_EQ(test::measuredWithoutAccess(block, s.parcels, 2.0), s.withoutAccess);
+  std::printf("%zu parcels, %d without street access (the paper's: %zu, %d)\n", s.parcels.size(), s.withoutAccess,
+              p.parcels.size(), p.withoutAccess);
 }
 
 // Random shapes: a tiling, valid, reproducible, every parcel with access

@@ -122,6 +122,15 @@ TEST_P(RealBlocks, EveryBlockIsTiledValidlyWithStreetAccess) {
     // street is kept when no union with a neighbour is a valid polygon
     // (docs/algorithms/template.md: at most 0.4 % measured).
     EXPECT_LE(withoutAccess, parcels / 200);
+  } else if (style == "sexton") {
+    // Interior parcels: per block at most its observed share without street
+    // access of its target count (sexton.md).
+    for (std::size_t k = 0; k < n; ++k) {
+      const generation::ObservedSample* o = inputs.entries[k].observed.get();
+      const double share = o && std::isfinite(o->accessShare) ? 1 - o->accessShare : 0.0;
+      EXPECT_LE(results[k].withoutAccess, std::floor(share * results[k].targetParcels + 1e-9))
+          << dataset.file << " block entry " << k;
+    }
   } else {
     EXPECT_EQ(withoutAccess, 0);
   }

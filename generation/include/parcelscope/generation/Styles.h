@@ -4,6 +4,7 @@
 // style lists, the run record and the pipeline read this registry; adding a
 // style is one source file defining a Style and one line in the registry's
 // list (generation/src/Styles.cpp).
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -20,6 +21,7 @@ namespace parcelscope::generation {
 /// side), as analysis measures them.
 struct ObservedSample {
   std::vector<double> areas, widths, aspectRatios;
+  double accessShare = NAN;  ///< share of the parcels with street access; NaN when unknown
 };
 
 /// One block's run of a style.
