@@ -91,7 +91,7 @@ void measureDeferred(const pipeline::BlockInputs& inputs,
 
 bool sameSample(const generation::ObservedSample* a, const generation::ObservedSample* b) {
   if (!a || !b) return a == b;
-  return a->areas == b->areas && a->widths == b->widths && a->aspectRatios == b->aspectRatios;
+  return *a == *b;
 }
 
 // Fills `outcomes` and `done` of the new entries from the old ones that hold

@@ -22,6 +22,11 @@ namespace parcelscope::generation {
 struct ObservedSample {
   std::vector<double> areas, widths, aspectRatios;
   double accessShare = NAN;  ///< share of the parcels with street access; NaN when unknown
+  /// The same parcels' values, field by field (an unknown share equals an unknown one).
+  bool operator==(const ObservedSample& o) const {
+    const bool share = accessShare == o.accessShare || (std::isnan(accessShare) && std::isnan(o.accessShare));
+    return share && areas == o.areas && widths == o.widths && aspectRatios == o.aspectRatios;
+  }
 };
 
 /// One block's run of a style.
