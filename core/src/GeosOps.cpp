@@ -266,6 +266,8 @@ std::optional<Polygon> unionIfOne(const Polygon& a, const Polygon& b) {
 
 std::vector<Polygon> validMultiPolygon(std::vector<Polygon> parts, bool& repaired, double minShare) {
   repaired = false;
+  // One ring proven simple with a margin is a valid polygon: GEOS is not asked.
+  if (parts.size() == 1 && parts.front().holes.empty() && isClearlySimple(parts.front().outer)) return parts;
   GEOSContextHandle_t ctx = context();
   std::vector<const Polygon*> pointers;
   for (const Polygon& p : parts) pointers.push_back(&p);

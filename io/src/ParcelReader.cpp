@@ -344,16 +344,11 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
   // Pass 1: read features, collapse exact duplicate geometries, find the extent.
   const GIntBig total = layer->GetFeatureCount(FALSE);
   std::vector<Feature> features;
-  // Features by the hash of their WKB; the bytes are compared again (exported
-  // anew) only when hashes meet, so no copy of every geometry is kept.
-  std::unordered_multimap<std::size_t, std::size_t> byHash;
   std::unordered_map<Key, std::int64_t> fieldKeyOwner;  // key field value -> first feature id
-  std::string wkb, earlier;
   auto exportWkb = [](const OGRGeometry& g, std::string& out) {
     out.resize(static_cast<std::size_t>(g.WkbSize()));
     g.exportToWkb(wkbNDR, reinterpret_cast<unsigned char*>(out.data()), wkbVariantIso);
   };
-  if (total > 0) byHash.reserve(static_cast<std::size_t>(total));
   Envelope env;
   // A read error stops the loop as if the layer had ended (SQLite's "database
   // disk image is malformed" after a few features of a corrupt GeoPackage), so
@@ -364,61 +359,6 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
     throw inputError(path + ": reading layer " + result.layerName +
                      (options.where.empty() ? "" : " with --where \"" + options.where + "\"") + " failed after " +
                      std::to_string(featuresRead) + " features (" + lastGdalMessage() + ")");
-  };
-  // One feature into `features` (or onto the stack of its copy), counted when owned.
-  auto take = [&](RawFeature raw) {
-    OGRGeometry* g = raw.geometry.get();
-    if (!g || g->IsEmpty()) {
-      if (ownedBy(nullptr)) {
-        ++report.features;
-        ++report.nullOrEmpty;
-      }
-      return;
-    }
-    OGREnvelope e;
-    g->getEnvelope(&e);
-    const bool owned = ownedBy(&e);
-    report.features += owned;
-    exportWkb(*g, wkb);
-    const Key key = raw.fieldKey ? *raw.fieldKey : hashBytes(wkb);
-    const std::size_t hash = std::hash<std::string_view>{}(wkb);
-    Feature* original = nullptr;
-    for (auto [it, end] = byHash.equal_range(hash); it != end && !original; ++it) {
-      exportWkb(*features[it->second].geometry, earlier);
-      if (earlier == wkb) original = &features[it->second];
-    }
-    if (original) {
-      if (owned) {
-        if (original->stackCount == 1) ++report.duplicateStacks;
-        ++report.duplicatesCollapsed;
-      }
-      ++original->stackCount;
-      // The stack's key is the least of its features' keys, whatever their order.
-      original->key = std::min(original->key, key);
-      return;
-    }
-    if (raw.fieldKey) {
-      // Another geometry with the same key field value: keys would collide.
-      const auto [seen, fresh] = fieldKeyOwner.emplace(*raw.fieldKey, raw.fid);
-      if (!fresh) {
-        throw inputError(path + ": features " + std::to_string(seen->second) + " and " + std::to_string(raw.fid) +
-                         " have the same value in --key-field " + options.keyField +
-                         " (a key names one parcel; give a field of unique values, or no --key-field)");
-      }
-    }
-    if (!coordinatesFinite(*g) || !std::isfinite(e.MinX) || !std::isfinite(e.MinY) || !std::isfinite(e.MaxX) ||
-        !std::isfinite(e.MaxY) || std::fabs(e.MinX) > 1e12 || std::fabs(e.MaxX) > 1e12 || std::fabs(e.MinY) > 1e12 ||
-        std::fabs(e.MaxY) > 1e12) {
-      report.nonFiniteSkipped += owned;  // NaN, infinite or absurd coordinates
-      return;
-    }
-    // The frame's sample: every feature, except in a filtered shard, which
-    // samples its own and exchanges.
-    if (!filtered || owned) env.merge(e);
-    const bool inWindow = !shard || (e.MinX <= shard->window.maxX && e.MaxX >= shard->window.minX &&
-                                     e.MinY <= shard->window.maxY && e.MaxY >= shard->window.minY);
-    byHash.emplace(hash, features.size());
-    features.push_back({raw.fid, std::move(raw.geometry), 1, std::move(raw.values), key, owned, e.MinX, inWindow});
   };
   auto rawOf = [&](OGRFeature& feature) {
     RawFeature raw;
@@ -459,7 +399,111 @@ ParcelLayer readParcels(const ReadOptions& options, const ProgressFn& progress) 
                        std::to_string(read[i].fid) + ", so it cannot be read in shards");
     }
   }
-  for (RawFeature& raw : read) take(std::move(raw));
+
+  // What each feature's geometry gives, in parallel: its envelope, its key
+  // (the hash of its WKB, unless a key field gave one), the hash that finds
+  // exact duplicates, and whether its coordinates are usable.
+  struct Digest {
+    bool present = false, usable = false;
+    OGREnvelope envelope;
+    Key key = 0;
+    std::size_t hash = 0;
+  };
+  std::vector<Digest> digests(read.size());
+  parallelFor(read.size(), [&](std::size_t i) {
+    const OGRGeometry* g = read[i].geometry.get();
+    Digest& d = digests[i];
+    if (!g || g->IsEmpty()) return;
+    d.present = true;
+    g->getEnvelope(&d.envelope);
+    thread_local std::string bytes;
+    exportWkb(*g, bytes);
+    d.key = read[i].fieldKey ? *read[i].fieldKey : hashBytes(bytes);
+    d.hash = std::hash<std::string_view>{}(bytes);
+    const OGREnvelope& e = d.envelope;
+    d.usable = coordinatesFinite(*g) && std::isfinite(e.MinX) && std::isfinite(e.MinY) && std::isfinite(e.MaxX) &&
+               std::isfinite(e.MaxY) && std::fabs(e.MinX) <= 1e12 && std::fabs(e.MaxX) <= 1e12 &&
+               std::fabs(e.MinY) <= 1e12 && std::fabs(e.MaxY) <= 1e12;  // not NaN, infinite or absurd
+  });
+  // Exact duplicates: a feature whose WKB equals that of an earlier feature
+  // kept (a usable one that is no duplicate itself) joins that feature's
+  // stack. Features meet by hash (sorted runs); bytes are compared (exported
+  // anew) only within a run, so no copy of every geometry is kept.
+  std::vector<std::int64_t> original(read.size(), -1);
+  {
+    std::vector<std::pair<std::size_t, std::size_t>> byHash;  // (hash, feature)
+    byHash.reserve(read.size());
+    for (std::size_t i = 0; i < read.size(); ++i) {
+      if (digests[i].present) byHash.emplace_back(digests[i].hash, i);
+    }
+    std::sort(byHash.begin(), byHash.end());
+    std::string wkb, earlier;
+    std::vector<std::size_t> kept;
+    for (std::size_t from = 0; from < byHash.size();) {
+      std::size_t to = from + 1;
+      while (to < byHash.size() && byHash[to].first == byHash[from].first) ++to;
+      kept.clear();
+      for (std::size_t k = from; to - from > 1 && k < to; ++k) {
+        const std::size_t i = byHash[k].second;
+        exportWkb(*read[i].geometry, wkb);
+        for (std::size_t m : kept) {
+          exportWkb(*read[m].geometry, earlier);
+          if (earlier == wkb) {
+            original[i] = static_cast<std::int64_t>(m);
+            break;
+          }
+        }
+        if (original[i] < 0 && digests[i].usable) kept.push_back(i);
+      }
+      from = to;
+    }
+  }
+  std::vector<std::size_t> featureOf(read.size(), 0);  // a kept feature's index in `features`
+  for (std::size_t i = 0; i < read.size(); ++i) {
+    RawFeature& raw = read[i];
+    const Digest& d = digests[i];
+    if (!d.present) {
+      if (ownedBy(nullptr)) {
+        ++report.features;
+        ++report.nullOrEmpty;
+      }
+      continue;
+    }
+    const OGREnvelope& e = d.envelope;
+    const bool owned = ownedBy(&e);
+    report.features += owned;
+    if (original[i] >= 0) {
+      Feature& first = features[featureOf[static_cast<std::size_t>(original[i])]];
+      if (owned) {
+        if (first.stackCount == 1) ++report.duplicateStacks;
+        ++report.duplicatesCollapsed;
+      }
+      ++first.stackCount;
+      // The stack's key is the least of its features' keys, whatever their order.
+      first.key = std::min(first.key, d.key);
+      continue;
+    }
+    if (raw.fieldKey) {
+      // Another geometry with the same key field value: keys would collide.
+      const auto [seen, fresh] = fieldKeyOwner.emplace(*raw.fieldKey, raw.fid);
+      if (!fresh) {
+        throw inputError(path + ": features " + std::to_string(seen->second) + " and " + std::to_string(raw.fid) +
+                         " have the same value in --key-field " + options.keyField +
+                         " (a key names one parcel; give a field of unique values, or no --key-field)");
+      }
+    }
+    if (!d.usable) {
+      report.nonFiniteSkipped += owned;  // NaN, infinite or absurd coordinates
+      continue;
+    }
+    // The frame's sample: every feature, except in a filtered shard, which
+    // samples its own and exchanges.
+    if (!filtered || owned) env.merge(e);
+    const bool inWindow = !shard || (e.MinX <= shard->window.maxX && e.MaxX >= shard->window.minX &&
+                                     e.MinY <= shard->window.maxY && e.MaxY >= shard->window.minY);
+    featureOf[i] = features.size();
+    features.push_back({raw.fid, std::move(raw.geometry), 1, std::move(raw.values), d.key, owned, e.MinX, inWindow});
+  }
   read = std::vector<RawFeature>();
   const std::string featuresText =
       std::to_string(report.features) + " features read" + (options.where.empty() ? "" : " with --where");

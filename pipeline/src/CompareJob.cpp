@@ -388,8 +388,16 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
                         const PreparedObserved* prepared) {
   const bool figures = value(request, "figures") != 0;
   const bool spatialIndex = value(request, "spatial-index") != 0;
-  const CompareResult r = prepared ? compare(request, prepared->data, scaledProgress(progress, 0.0, 0.8))
-                                   : compare(request, scaledProgress(progress, 0.0, 0.8));
+  // run.json's hash of the input, on a thread of its own while the input is
+  // read (0.4 s for a 150 MB file).
+  std::error_code ec;
+  const bool regular = std::filesystem::is_regular_file(request.input.path, ec);
+  std::future<std::string> inputHash = std::async(
+      std::launch::async, [&request, regular] { return regular ? io::sha256File(request.input.path) : std::string(); });
+  const auto result = std::make_shared<const CompareResult>(
+      prepared ? compare(request, prepared->data, scaledProgress(progress, 0.0, 0.8))
+               : compare(request, scaledProgress(progress, 0.0, 0.8)));
+  const CompareResult& r = *result;
   const analysis::ObservedAnalysis& a = r.observed->analysis;
 
   reportProgress(progress, 0.8, "writing");
@@ -472,8 +480,6 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
     run.set("streets",
             streetRecord(*r.observed->streets).set("lots_outside_street_blocks", r.observed->outsideStreetBlocks));
   }
-  std::error_code ec;
-  const bool regular = std::filesystem::is_regular_file(request.input.path, ec);
   run.set(
       "input_file",
       Json::object()
@@ -483,7 +489,7 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
           .set("crs_override", request.input.crsOverride)
           .set("bytes",
                regular ? Json(static_cast<std::int64_t>(std::filesystem::file_size(request.input.path, ec))) : Json())
-          .set("sha256", regular ? Json(io::sha256File(request.input.path)) : Json()));
+          .set("sha256", regular ? Json(inputHash.get()) : Json()));
   Json failures = Json::array();
   for (const auto& f : r.generated.failures) failures.push(f);
   run.set("generated", Json::object()
@@ -523,7 +529,7 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
                 r.city.observed.undesirableShare, r.city.generated.undesirableShare, secondsSince(started));
   std::string told = summarize(*r.observed) + line;
   if (r.generated.clampedBounds > 0) told += "\n  " + clampedBoundsNote(r.generated.clampedBounds);
-  return {run, told};
+  return {run, told, result};
 }
 
 }  // namespace

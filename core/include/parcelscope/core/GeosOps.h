@@ -33,7 +33,8 @@ std::vector<Polygon> validParts(const Polygon& polygon);
 std::optional<Polygon> unionIfOne(const Polygon& a, const Polygon& b);
 
 /// `parts` as one valid multipolygon, for a file: unchanged (and `repaired`
-/// false) when GEOS finds their multipolygon valid; otherwise GEOS make-valid
+/// false) when it is valid (one part of one ring that isClearlySimple proves
+/// simple, else as GEOS finds it); otherwise GEOS make-valid
 /// (structure method, collapsed parts dropped), whose polygons come back with
 /// `repaired` true. Parts of the repaired result below `minShare` of its area
 /// (the crumbs of a crossing a few nanometres wide) are dropped, unless that

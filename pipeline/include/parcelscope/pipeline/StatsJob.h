@@ -37,6 +37,9 @@ void addObservedRecord(Json& record, const ObservedData& data);
 struct JobOutcome {
   Json record;
   std::string summary;
+  /// What the job made (its result; may be null), handed to the caller: a
+  /// command line about to exit may keep it rather than free it piece by piece.
+  std::shared_ptr<const void> result;
 };
 
 /// One-paragraph summary of what was read, repaired, skipped and grouped.
