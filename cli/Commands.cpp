@@ -521,7 +521,7 @@ int compareOnRanks(const pipeline::CompareRequest& request, const std::string& o
   const std::string who = "parcelscope compare (rank " + std::to_string(rank) + " of " + std::to_string(size) + ")";
   if (rank == 0 && workerCount() < std::thread::hardware_concurrency() && !a.has("quiet")) {
     std::fprintf(stderr,
-                 "parcelscope compare: rank 0 may use %u of this machine's %u cores, and alone generates and "
+                 "parcelscope compare: rank 0 may use %u of this machine's %u cores, and alone merges and "
                  "writes; 'mpirun --bind-to none' (or more cores per rank) lets it use more\n",
                  workerCount(), std::thread::hardware_concurrency());
   }

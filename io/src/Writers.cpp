@@ -195,9 +195,32 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
       crs, spatialIndex);
 }
 
+namespace {
+// Mapped back, checked and repaired in the CRS written (fileGeometry).
+std::unique_ptr<OGRMultiPolygon> fileMultiPolygon(std::vector<Polygon> parts, const LocalFrame& frame, bool& repaired,
+                                                  bool& emptied) {
+  for (Polygon& p : parts) {
+    for (Point& q : p.outer) q = frame.toSource(q);
+    for (Ring& h : p.holes)
+      for (Point& q : h) q = frame.toSource(q);
+  }
+  parts = geos::validMultiPolygon(std::move(parts), repaired);
+  emptied = repaired && parts.empty();
+  return detail::toOgr(parts);
+}
+}  // namespace
+
+FileGeometry fileGeometry(std::vector<Polygon> parts, const LocalFrame& frame) {
+  FileGeometry g;
+  const auto multi = fileMultiPolygon(std::move(parts), frame, g.repaired, g.emptied);
+  g.wkb.resize(static_cast<std::size_t>(multi->WkbSize()));
+  multi->exportToWkb(wkbNDR, reinterpret_cast<unsigned char*>(g.wkb.data()), wkbVariantIso);
+  return g;
+}
+
 LayerWrite writePolygonLayer(const std::string& path, const std::string& layerName, const PolygonSource& geometries,
                              const RowSource& attributes, const LocalFrame& frame, const CrsInfo& crs,
-                             bool spatialIndex) {
+                             bool spatialIndex, const ReadyGeometry& ready) {
   detail::ensureGdalRegistered();
   detail::QuietErrors quiet;
   CPLErrorReset();
@@ -261,20 +284,24 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
     batch.reserve(to - from);
     std::vector<Polygon> parts;
     for (std::size_t i = from; i < to; ++i) {
+      if (const FileGeometry* made = ready ? ready(i) : nullptr) {
+        OGRGeometry* g = nullptr;
+        if (OGRGeometryFactory::createFromWkb(made->wkb.data(), nullptr, &g, made->wkb.size()) != OGRERR_NONE || !g ||
+            wkbFlatten(g->getGeometryType()) != wkbMultiPolygon) {
+          delete g;
+          throw std::logic_error("writePolygonLayer: feature " + std::to_string(i) + " came as no MultiPolygon");
+        }
+        report.repaired += made->repaired;
+        report.emptied += made->emptied;
+        batch.emplace_back(g->toMultiPolygon());
+        continue;
+      }
       parts.clear();
       geometries(i, parts);
-      for (Polygon& p : parts) {
-        for (Point& q : p.outer) q = frame.toSource(q);
-        for (Ring& h : p.holes)
-          for (Point& q : h) q = frame.toSource(q);
-      }
-      bool repaired = false;
-      parts = geos::validMultiPolygon(std::move(parts), repaired);
-      if (repaired) {
-        ++report.repaired;
-        report.emptied += parts.empty();
-      }
-      batch.push_back(detail::toOgr(parts));
+      bool repaired = false, emptied = false;
+      batch.push_back(fileMultiPolygon(std::move(parts), frame, repaired, emptied));
+      report.repaired += repaired;
+      report.emptied += emptied;
     }
     return batch;
   };

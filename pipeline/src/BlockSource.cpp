@@ -7,12 +7,12 @@
 
 namespace parcelscope::pipeline {
 
-std::shared_ptr<generation::ObservedSample> observedSample(const analysis::ObservedAnalysis& analysis,
-                                                           std::size_t block) {
+std::shared_ptr<generation::ObservedSample> observedSample(const std::vector<analysis::ParcelMetrics>& metrics,
+                                                           const Block& block) {
   auto sample = std::make_shared<generation::ObservedSample>();
   double with = 0;
-  for (int i : analysis.blocks[block].parcels) {
-    const analysis::ParcelMetrics& m = analysis.metrics[static_cast<std::size_t>(i)];
+  for (int i : block.parcels) {
+    const analysis::ParcelMetrics& m = metrics[static_cast<std::size_t>(i)];
     sample->areas.push_back(m.area);
     sample->widths.push_back(m.width);
     sample->aspectRatios.push_back(m.aspectRatio);
@@ -20,6 +20,27 @@ std::shared_ptr<generation::ObservedSample> observedSample(const analysis::Obser
   }
   if (!sample->areas.empty()) sample->accessShare = with / static_cast<double>(sample->areas.size());
   return sample;
+}
+
+std::shared_ptr<generation::ObservedSample> observedSample(const analysis::ObservedAnalysis& analysis,
+                                                           std::size_t block) {
+  return observedSample(analysis.metrics, analysis.blocks[block]);
+}
+
+void appendObservedEntries(BlockInputs& in, const std::vector<Block>& blocks,
+                           const std::vector<analysis::BlockStatistics>& statistics,
+                           const std::vector<analysis::ParcelMetrics>& metrics) {
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const auto& s = statistics[b];
+    const Block& block = blocks[b];
+    std::shared_ptr<const generation::ObservedSample> sample = observedSample(metrics, block);
+    double blockArea = 0;
+    for (const Polygon& part : block.parts) blockArea += area(part);
+    for (std::size_t part = 0; part < block.parts.size(); ++part) {
+      in.entries.push_back({block.id, block.parts[part], s.aMin, s.aMax, s.wMin, s.wMax, s.streetAccessShare, block.key,
+                            static_cast<int>(part), sample, blockArea > 0 ? area(block.parts[part]) / blockArea : 1.0});
+    }
+  }
 }
 
 namespace {
@@ -36,18 +57,7 @@ public:
     ObservedData loaded;
     if (!observed_) loaded = loadObserved(input_, parameters_, progress);
     const ObservedData& observed = observed_ ? *observed_ : loaded;
-    for (std::size_t b = 0; b < observed.analysis.blocks.size(); ++b) {
-      const auto& s = observed.analysis.statistics[b];
-      const Block& block = observed.analysis.blocks[b];
-      std::shared_ptr<const generation::ObservedSample> sample = observedSample(observed.analysis, b);
-      double blockArea = 0;
-      for (const Polygon& part : block.parts) blockArea += area(part);
-      for (std::size_t part = 0; part < block.parts.size(); ++part) {
-        in.entries.push_back({block.id, block.parts[part], s.aMin, s.aMax, s.wMin, s.wMax, s.streetAccessShare,
-                              block.key, static_cast<int>(part), sample,
-                              blockArea > 0 ? area(block.parts[part]) / blockArea : 1.0});
-      }
-    }
+    appendObservedEntries(in, observed.analysis.blocks, observed.analysis.statistics, observed.analysis.metrics);
     if (observed.streets) {
       // Street blocks know the width of each street they face.
       for (const analysis::StreetBlock& b : observed.streets->blocks.blocks) {

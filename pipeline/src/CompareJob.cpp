@@ -265,14 +265,15 @@ CompareResult compare(const CompareRequest& request, const ProgressFn& progress)
 }
 
 CompareResult compare(const CompareRequest& request, std::shared_ptr<const pipeline::ObservedData> observed,
-                      const ProgressFn& progress) {
+                      const ProgressFn& progress, std::vector<PremadeBlock>* premade) {
   detail::checkRequest(request);
   CompareResult r;
   r.observed = std::move(observed);
   const analysis::ObservedAnalysis& a = r.observed->analysis;
   detail::requireBlocks(request, *r.observed);
-  r.generated =
-      pipeline::generate(detail::generateRequest(request, r.observed.get()), scaledProgress(progress, 0.0, 0.85));
+  pipeline::GenerateRequest g = detail::generateRequest(request, r.observed.get());
+  g.premade = premade;
+  r.generated = pipeline::generate(g, scaledProgress(progress, 0.0, 0.85));
 
   // Both sets measured with the same metrics; compared block by block, in parallel.
   reportProgress(progress, 0.85, "comparing");
@@ -395,7 +396,7 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
   std::future<std::string> inputHash = std::async(
       std::launch::async, [&request, regular] { return regular ? io::sha256File(request.input.path) : std::string(); });
   const auto result = std::make_shared<const CompareResult>(
-      prepared ? compare(request, prepared->data, scaledProgress(progress, 0.0, 0.8))
+      prepared ? compare(request, prepared->data, scaledProgress(progress, 0.0, 0.8), prepared->premade.get())
                : compare(request, scaledProgress(progress, 0.0, 0.8)));
   const CompareResult& r = *result;
   const analysis::ObservedAnalysis& a = r.observed->analysis;
@@ -412,15 +413,26 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
   for (const Block& b : a.blocks) outlines.push_back(b.parts);
   const std::string blocksCsv = out.stage("blocks.csv"), blocksGpkg = out.stage("blocks.gpkg");
   std::future<io::LayerWrite> blockWriting = std::async(std::launch::async, [&] {
-    return io::writePolygonLayer(blocksGpkg, "blocks", outlines, blocks, r.observed->layer.frame, r.observed->layer.crs,
-                                 spatialIndex);
+    // Outlines made by the shards of the run come ready to write.
+    const std::vector<io::FileGeometry>& made = r.observed->blocksWritten;
+    if (outlines.size() != blocks.rows.size()) throw std::logic_error("compare: one outline per row of blocks.csv");
+    return io::writePolygonLayer(
+        blocksGpkg, "blocks", [&outlines](std::size_t b, std::vector<Polygon>& parts) { parts = outlines[b]; },
+        RowSource::of(blocks), r.observed->layer.frame, r.observed->layer.crs, spatialIndex,
+        [&made](std::size_t b) { return b < made.size() ? &made[b] : nullptr; });
   });
   std::vector<int> order;
   const RowSource generatedTable = generatedRowsOf(r, &order);
   const std::string parcelsGpkg = out.stage(parcelsFile);
   std::future<io::LayerWrite> parcelWriting = std::async(std::launch::async, [&] {
+    // Parcels made by the shards of the run come ready to write.
+    const io::ReadyGeometry ready = [&r, &order](std::size_t row) -> const io::FileGeometry* {
+      if (r.generated.written.empty()) return nullptr;
+      const io::FileGeometry& g = r.generated.written[static_cast<std::size_t>(order[row])];
+      return g.wkb.empty() ? nullptr : &g;
+    };
     return io::writePolygonLayer(parcelsGpkg, "parcels", generatedShapes(r, order), generatedTable,
-                                 r.observed->layer.frame, r.observed->layer.crs, spatialIndex);
+                                 r.observed->layer.frame, r.observed->layer.crs, spatialIndex, ready);
   });
   io::writeCsv(blocksCsv, blocks);
   io::writeCsv(out.stage("generated_parcels.csv"), generatedTable);
@@ -475,7 +487,11 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
                  .set("parameters_given", given)
                  .set("session", sessionJson(withAbsolutePaths(request)));  // read from its own folder
   addObservedRecord(run, *r.observed);
-  if (prepared) run.set("ranks", prepared->ranks).set("shards", prepared->shards);
+  if (prepared) {
+    run.set("ranks", prepared->ranks)
+        .set("shards", prepared->shards)
+        .set("block_entries_generated_in_shards", r.generated.premadeBlocks);
+  }
   if (r.observed->streets) {
     run.set("streets",
             streetRecord(*r.observed->streets).set("lots_outside_street_blocks", r.observed->outsideStreetBlocks));

@@ -291,6 +291,7 @@ GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<Bl
   out.blocks.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     if (!outcomes[k]->contextMeasured) out.contextPending.push_back(k);
+    if (!outcomes[k]->written.empty() && out.written.empty()) out.written.resize(first[n]);
   }
   parallelFor(n, [&](std::size_t k) {
     const BlockOutcome& o = *outcomes[k];
@@ -306,6 +307,13 @@ GeneratedParcels assembleParcels(const BlockInputs& inputs, const std::vector<Bl
       out.parcels[first[k] + i] = o.subdivision.parcels[i];
     }
     std::copy(o.metrics.begin(), o.metrics.end(), out.metrics.begin() + static_cast<std::ptrdiff_t>(first[k]));
+    if (!o.written.empty()) {
+      if (o.written.size() != o.subdivision.parcels.size()) {
+        throw std::logic_error("assembleParcels: block entry " + std::to_string(k) +
+                               " has not one file geometry a parcel");
+      }
+      std::copy(o.written.begin(), o.written.end(), out.written.begin() + static_cast<std::ptrdiff_t>(first[k]));
+    }
   });
   out.blockIds.reserve(n);
   out.blockKeys.reserve(n);
@@ -364,25 +372,40 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
     streetWidthsOf(inputs);
   }
   // Every block in parallel; each block's seed depends only on its position.
+  // Entries made elsewhere under the same plan are taken as they are.
   std::vector<BlockOutcome> outcomes(plans.size());
+  std::vector<std::size_t> todo;
+  std::int64_t premade = 0;
+  for (std::size_t k = 0; k < plans.size(); ++k) {
+    if (request.premade && k < request.premade->size() && (*request.premade)[k].made &&
+        (*request.premade)[k].plan == plans[k]) {
+      outcomes[k] = std::move((*request.premade)[k].outcome);
+      (*request.premade)[k] = PremadeBlock{};
+      ++premade;
+    } else {
+      todo.push_back(k);
+    }
+  }
   const ProgressFn sub = scaledProgress(progress, request.fromParcels ? 0.4 : 0.2, 0.9);
   const auto fraction = [&](std::size_t done) {
-    return static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(1, plans.size()));
+    return static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(1, todo.size()));
   };
   parallelFor(
-      plans.size(), [&](std::size_t k) { outcomes[k].subdivision = subdivideEntry(inputs, k, plans[k]); },
+      todo.size(),
+      [&](std::size_t t) { outcomes[todo[t]].subdivision = subdivideEntry(inputs, todo[t], plans[todo[t]]); },
       [&](std::size_t done) { reportProgress(sub, fraction(done), "subdividing"); });
   reportProgress(progress, 0.9, "measuring");
   timings.start("measure");
   const double minFrontage = obbParametersFrom(request.parameters).minFrontage;
-  parallelFor(plans.size(), [&](std::size_t k) {
-    outcomes[k].metrics = measureEntry(inputs, k, outcomes[k].subdivision, minFrontage);
+  parallelFor(todo.size(), [&](std::size_t t) {
+    outcomes[todo[t]].metrics = measureEntry(inputs, todo[t], outcomes[todo[t]].subdivision, minFrontage);
   });
   std::vector<const BlockOutcome*> pointers;
   for (const BlockOutcome& o : outcomes) pointers.push_back(&o);
   GeneratedParcels out = assembleParcels(inputs, plans, pointers, runSeed(request.parameters));
   timings.stop();
   out.clampedBounds = clamped;
+  out.premadeBlocks = premade;
   out.timings = timings;
   reportProgress(progress, 1.0, "measuring");
   return out;

@@ -1,6 +1,7 @@
 #include "parcelscope/pipeline/Shards.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -8,12 +9,16 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 #include <type_traits>
 
+#include "CompareStages.h"
 #include "parcelscope/core/Error.h"
+#include "parcelscope/core/Parallel.h"
 #include "parcelscope/io/OutputDirectory.h"
 #include "parcelscope/io/Writers.h"
+#include "parcelscope/pipeline/BlockSource.h"
 #include "parcelscope/pipeline/CompareSession.h"
 
 namespace parcelscope::pipeline {
@@ -101,6 +106,42 @@ public:
       pod(s);
     }
   }
+  void premade(const PremadeBlock& p) {
+    pod(static_cast<std::uint8_t>(p.made));
+    if (!p.made) return;
+    text(p.plan.style);
+    pod(static_cast<std::uint64_t>(p.plan.values.size()));
+    for (const auto& [name, v] : p.plan.values) {
+      text(name);
+      pod(v);
+    }
+    pod(p.plan.seed);
+    const Subdivision& d = p.outcome.subdivision;
+    pod(static_cast<std::uint64_t>(d.parcels.size()));
+    for (const Polygon& parcel : d.parcels) polygon(parcel);
+    pod(d.oversize);
+    pod(d.withoutAccess);
+    pod(static_cast<std::uint8_t>(d.failed));
+    text(d.failure);
+    pod(static_cast<std::uint8_t>(d.fallback));
+    text(d.fallbackReason);
+    pod(d.patioParcels);
+    pod(d.unassignedParcels);
+    pod(d.targetParcels);
+    text(d.variant);
+    pod(d.blockSimple);
+    pod(static_cast<std::uint8_t>(d.skeletonExact));
+    pods(p.outcome.metrics);
+    geometries(p.outcome.written);
+  }
+  void geometries(const std::vector<io::FileGeometry>& all) {
+    pod(static_cast<std::uint64_t>(all.size()));
+    for (const io::FileGeometry& g : all) {
+      text(g.wkb);
+      pod(static_cast<std::uint8_t>(g.repaired));
+      pod(static_cast<std::uint8_t>(g.emptied));
+    }
+  }
   std::string take() { return std::move(bytes_); }
 
 private:
@@ -158,6 +199,48 @@ public:
     }
     return t;
   }
+  PremadeBlock premade() {
+    PremadeBlock p;
+    p.made = flag();
+    if (!p.made) return p;
+    p.plan.style = text();
+    for (auto n = count(2 * sizeof(std::uint64_t)); n > 0; --n) {
+      std::string name = text();
+      p.plan.values[name] = pod<double>();
+    }
+    p.plan.seed = pod<std::uint64_t>();
+    Subdivision& d = p.outcome.subdivision;
+    d.parcels.resize(count(2 * sizeof(std::uint64_t)));
+    for (Polygon& parcel : d.parcels) parcel = polygon();
+    d.oversize = pod<int>();
+    d.withoutAccess = pod<int>();
+    d.failed = flag();
+    d.failure = text();
+    d.fallback = flag();
+    d.fallbackReason = text();
+    d.patioParcels = pod<int>();
+    d.unassignedParcels = pod<int>();
+    d.targetParcels = pod<int>();
+    d.variant = text();
+    d.blockSimple = pod<signed char>();
+    d.skeletonExact = flag();
+    p.outcome.metrics = pods<analysis::ParcelMetrics>();
+    p.outcome.written = geometries();
+    if (p.outcome.metrics.size() != d.parcels.size() ||
+        (!p.outcome.written.empty() && p.outcome.written.size() != d.parcels.size())) {
+      fail();
+    }
+    return p;
+  }
+  std::vector<io::FileGeometry> geometries() {
+    std::vector<io::FileGeometry> all(count(sizeof(std::uint64_t) + 2));
+    for (io::FileGeometry& g : all) {
+      g.wkb = text();
+      g.repaired = flag();
+      g.emptied = flag();
+    }
+    return all;
+  }
   bool done() const { return at_ == bytes_.size(); }
   [[noreturn]] void fail() const {
     throw inputError(what_ + ": not a shard of parcelscope " + version() + " (truncated or another version)");
@@ -172,7 +255,7 @@ private:
   std::size_t at_ = 0;
 };
 
-constexpr char kMagic[] = "parcelscope-shard-1";
+constexpr char kMagic[] = "parcelscope-shard-2";
 
 void addReport(io::CleaningReport& sum, const io::CleaningReport& r) {
   sum.features += r.features;
@@ -210,6 +293,48 @@ std::pair<int, int> parseShard(const std::string& text) {
   if (i < 0 || n < 1 || i >= n) throw usageError("--shard " + text + ": expected I/N with 0 <= I < N, e.g. 0/4");
   return {i, n};
 }
+
+namespace {
+
+// Subdivides and measures the part's block entries as the merged run would,
+// leaving to it those whose style reads street widths (measured from the
+// neighbouring blocks, some of them another shard's) and every entry when
+// overrides name blocks by id (ids are the merged run's).
+void generateInShard(const CompareRequest& request, ShardPart& part) {
+  if (!request.overridesById.empty() || part.blocks.empty()) return;
+  const auto started = std::chrono::steady_clock::now();
+  GenerateRequest g = detail::generateRequest(request, nullptr);
+  BlockInputs inputs;
+  appendObservedEntries(inputs, part.blocks, part.statistics, part.metrics);
+  // Overrides of this part's blocks only; the merged run checks the others.
+  std::set<Key> keys;
+  for (const Block& b : part.blocks) keys.insert(b.key);
+  for (auto it = g.overrides.begin(); it != g.overrides.end();) {
+    it = keys.count(it->first) ? std::next(it) : g.overrides.erase(it);
+  }
+  const std::vector<BlockPlan> plans = planBlocks(g, inputs);
+  const double minFrontage = generation::obbParametersFrom(request.parameters).minFrontage;
+  const io::LocalFrame frame = io::LocalFrame::fromState(part.frame);
+  part.generated.assign(plans.size(), PremadeBlock{});
+  std::atomic<std::int64_t> made{0};
+  parallelFor(plans.size(), [&](std::size_t k) {
+    if (generation::style(plans[k].style).usesStreetWidths()) return;
+    PremadeBlock& p = part.generated[k];
+    p.outcome = runBlock(inputs, k, plans[k], minFrontage);
+    // The parcels as parcels.gpkg holds them, made here rather than by the writer.
+    for (const Polygon& parcel : p.outcome.subdivision.parcels) {
+      p.outcome.written.push_back(io::fileGeometry({parcel}, frame));
+    }
+    p.plan = plans[k];
+    p.made = true;
+    ++made;
+  });
+  part.blocksGenerated = made;
+  part.generateSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  part.seconds += part.generateSeconds;
+}
+
+}  // namespace
 
 ShardPart analyseShard(const CompareRequest& request, int index, int count, const ShardReading& reading,
                        const ProgressFn& progress) {
@@ -317,6 +442,10 @@ ShardPart analyseShard(const CompareRequest& request, int index, int count, cons
       part.blocks.push_back(std::move(block));
       part.statistics.push_back(a.statistics[b]);
     }
+    // The outlines as blocks.gpkg holds them, made here rather than by the writer.
+    part.blockOutlines.resize(part.blocks.size());
+    parallelFor(part.blocks.size(),
+                [&](std::size_t b) { part.blockOutlines[b] = io::fileGeometry(part.blocks[b].parts, layer.frame); });
     part.path = layer.path;
     part.layerName = layer.layerName;
     part.frame = layer.frame.state();
@@ -327,10 +456,11 @@ ShardPart analyseShard(const CompareRequest& request, int index, int count, cons
     break;
   }
   part.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  generateInShard(request, part);
   return part;
 }
 
-ObservedData mergeShards(std::vector<ShardPart> parts) {
+ObservedData mergeShards(std::vector<ShardPart> parts, std::vector<PremadeBlock>* generated) {
   if (parts.empty()) throw inputError("merge: no shard given");
   const int count = parts.front().count;
   std::sort(parts.begin(), parts.end(), [](const ShardPart& a, const ShardPart& b) { return a.index < b.index; });
@@ -440,8 +570,26 @@ ObservedData mergeShards(std::vector<ShardPart> parts) {
     }
   }
   std::sort(blockRefs.begin(), blockRefs.end(), [](const BlockRef& x, const BlockRef& y) { return x.first < y.first; });
+  // Each part's first block entry of each of its blocks (entries are the blocks' parts in turn).
+  std::vector<std::vector<std::size_t>> firstEntry(parts.size());
+  for (std::size_t s = 0; s < parts.size(); ++s) {
+    std::size_t at = 0;
+    for (const Block& b : parts[s].blocks) {
+      firstEntry[s].push_back(at);
+      at += b.parts.size();
+    }
+  }
+  if (generated) generated->clear();
   a.blockOf.assign(layer.parcels.size(), -1);
   for (const BlockRef& r : blockRefs) {
+    if (generated) {
+      std::vector<PremadeBlock>& made = parts[r.shard].generated;
+      for (std::size_t k = 0; k < parts[r.shard].blocks[r.block].parts.size(); ++k) {
+        const std::size_t e = firstEntry[r.shard][r.block] + k;
+        generated->push_back(e < made.size() ? std::move(made[e]) : PremadeBlock{});
+      }
+    }
+    data.blocksWritten.push_back(std::move(parts[r.shard].blockOutlines[r.block]));
     Block block = std::move(parts[r.shard].blocks[r.block]);
     analysis::BlockStatistics s = parts[r.shard].statistics[r.block];
     block.id = s.blockId = static_cast<int>(a.blocks.size());
@@ -507,6 +655,11 @@ std::string encodeShard(const ShardPart& p) {
     w.pod(b.key);
   }
   w.pods(p.statistics);
+  w.geometries(p.blockOutlines);
+  w.pod(static_cast<std::uint64_t>(p.generated.size()));
+  for (const PremadeBlock& g : p.generated) w.premade(g);
+  w.pod(p.blocksGenerated);
+  w.pod(p.generateSeconds);
   w.timings(p.readTimings);
   w.timings(p.analysisTimings);
   w.pod(p.layerFeatures);
@@ -552,6 +705,11 @@ ShardPart decodeShard(std::string_view bytes, const std::string& what) {
     b.key = r.pod<Key>();
   }
   p.statistics = r.pods<analysis::BlockStatistics>();
+  p.blockOutlines = r.geometries();
+  p.generated.resize(r.count(1));
+  for (PremadeBlock& g : p.generated) g = r.premade();
+  p.blocksGenerated = r.pod<std::int64_t>();
+  p.generateSeconds = r.pod<double>();
   p.readTimings = r.timings();
   p.analysisTimings = r.timings();
   p.layerFeatures = r.pod<std::int64_t>();
@@ -561,13 +719,16 @@ ShardPart decodeShard(std::string_view bytes, const std::string& what) {
   constexpr int kMaxShards = 1 << 20;
   if (!r.done() || p.count < 1 || p.count > kMaxShards || p.index < 0 || p.index >= p.count ||
       p.metrics.size() != p.parcels.size() || p.rightOfWay.size() != p.parcels.size() ||
-      p.statistics.size() != p.blocks.size() || (!p.fields.empty() && p.fields.size() != p.parcels.size()) ||
-      (p.frame.size() != 4 && p.frame.size() != 6)) {
+      p.statistics.size() != p.blocks.size() || p.blockOutlines.size() != p.blocks.size() ||
+      (!p.fields.empty() && p.fields.size() != p.parcels.size()) || (p.frame.size() != 4 && p.frame.size() != 6)) {
     r.fail();
   }
   for (const auto& f : p.fields) {
     if (f.size() != p.fields.front().size()) r.fail();
   }
+  std::size_t entries = 0;
+  for (const Block& b : p.blocks) entries += b.parts.size();
+  if (!p.generated.empty() && p.generated.size() != entries) r.fail();
   // Each lot in exactly one block, each right-of-way parcel in none.
   std::vector<char> inBlock(p.parcels.size(), 0);
   for (const Block& b : p.blocks) {
@@ -595,6 +756,7 @@ Json shardRecord(const ShardPart& p) {
       .set("parcels", static_cast<std::int64_t>(p.parcels.size()))
       .set("parcels_read", p.parcelsRead)
       .set("windows_read", p.reads)
+      .set("block_entries_generated", p.blocksGenerated)
       .set("seconds", p.seconds);
 }
 }  // namespace
@@ -603,7 +765,8 @@ PreparedObserved prepareMerged(std::vector<ShardPart> parts, int ranks, const io
   Json shards = Json::array();
   for (const ShardPart& p : parts) shards.push(shardRecord(p));
   PreparedObserved prepared;
-  prepared.data = std::make_shared<const ObservedData>(mergeShards(std::move(parts)));
+  prepared.premade = std::make_shared<std::vector<PremadeBlock>>();
+  prepared.data = std::make_shared<const ObservedData>(mergeShards(std::move(parts), prepared.premade.get()));
   // A shard's window may hold nothing; the whole layer holding nothing usable
   // is told as one process tells it.
   if (prepared.data->layer.parcels.empty()) io::readParcels(input);
@@ -640,7 +803,8 @@ JobOutcome runShard(const CompareRequest& request, int index, int count, const s
     reportProgress(progress, 1.0, "writing");
     return {record, "shard " + std::to_string(index) + " of " + std::to_string(count) + ": " +
                         std::to_string(part.blocks.size()) + " blocks, " + std::to_string(part.parcels.size()) +
-                        " parcels (" + std::to_string(part.reads) + " windows read); merge the shards with " +
+                        " parcels (" + std::to_string(part.reads) + " windows read), " +
+                        std::to_string(part.blocksGenerated) + " block entries subdivided; merge the shards with " +
                         "'parcelscope merge'"};
   } catch (const Error& e) {
     throw out.explain(e);

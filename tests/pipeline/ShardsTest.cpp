@@ -83,6 +83,31 @@ void expectSameObserved(const ObservedData& one, const ObservedData& merged) {
   }
 }
 
+// The same generated parcels, metrics and per-entry record, to the bit.
+void expectSameGenerated(const GeneratedParcels& one, const GeneratedParcels& sharded) {
+  ASSERT_EQ(one.parcels.size(), sharded.parcels.size());
+  for (std::size_t i = 0; i < one.parcels.size(); ++i) expectSamePolygon(one.parcels[i], sharded.parcels[i]);
+  ASSERT_EQ(one.metrics.size(), sharded.metrics.size());
+  for (std::size_t i = 0; i < one.metrics.size(); ++i) {
+    const analysis::ParcelMetrics &p = one.metrics[i], &q = sharded.metrics[i];
+    const double a[] = {p.area,       p.perimeter,      p.width,  p.length, p.aspectRatio,
+                        p.elongation, p.rectangularity, p.pAngle, p.pArea,  p.frontage};
+    const double b[] = {q.area,       q.perimeter,      q.width,  q.length, q.aspectRatio,
+                        q.elongation, q.rectangularity, q.pAngle, q.pArea,  q.frontage};
+    EXPECT_EQ(0, std::memcmp(a, b, sizeof a)) << "metrics of parcel " << i;
+    EXPECT_EQ(p.neighbours, q.neighbours) << i;
+    EXPECT_EQ(p.streetAccess, q.streetAccess) << i;
+  }
+  EXPECT_EQ(one.blockKeys, sharded.blockKeys);
+  EXPECT_EQ(one.blockStyles, sharded.blockStyles);
+  EXPECT_EQ(one.failures, sharded.failures);
+  EXPECT_EQ(one.oversize, sharded.oversize);
+  EXPECT_EQ(one.withoutAccess, sharded.withoutAccess);
+  EXPECT_EQ(one.unassigned, sharded.unassigned);
+  EXPECT_EQ(one.blocksAtTarget, sharded.blocksAtTarget);
+  EXPECT_EQ(one.clampedBounds, sharded.clampedBounds);
+}
+
 // Shards running at once in threads, their frame samples exchanged as MPI
 // ranks exchange them (every shard waits for all, then takes the union).
 class Exchange {
@@ -163,6 +188,52 @@ CompareRequest sampleWithRightOfWay() {
   CompareRequest r = test::sampleCompareRequest("obb");
   r.input.where.clear();  // the right-of-way feature, a null geometry, duplicates, a multipart feature
   return r;
+}
+
+// The shards subdivide their blocks as one process does: with obb every
+// block entry is made in its shard; the skeleton reads street widths from the
+// neighbouring blocks, so its entries are left to the merged run; auto mixes
+// them. Each way, the generated parcels and metrics of one process.
+TEST(Shards, ShardsSubdivideTheirBlocksAsOneProcessDoes) {
+  for (const char* style : {"obb", "skeleton", "auto", "sexton"}) {
+    SCOPED_TRACE(style);
+    CompareRequest request = sampleWithRightOfWay();
+    request.style = style;
+    auto one = std::make_shared<const ObservedData>(loadObserved(request.input, request.parameters));
+    const CompareResult single = compare(request, one);
+    for (int count : {2, 3}) {
+      SCOPED_TRACE("shards: " + std::to_string(count));
+      const PreparedObserved merged = prepareMerged(analyseWhole(request, count), count, request.input);
+      const CompareResult sharded = compare(request, merged.data, {}, merged.premade.get());
+      std::int64_t widthStyle = 0;
+      for (const std::string& s : single.generated.blockStyles) widthStyle += s == "skeleton" || s == "offset";
+      const auto entries = static_cast<std::int64_t>(single.generated.blocks.size());
+      if (std::string(style) == "skeleton") {
+        EXPECT_EQ(sharded.generated.premadeBlocks, 0);
+      } else {
+        EXPECT_GT(sharded.generated.premadeBlocks, 0);
+        EXPECT_LE(sharded.generated.premadeBlocks, entries - widthStyle);
+      }
+      expectSameGenerated(single.generated, sharded.generated);
+    }
+  }
+}
+
+// A premade entry whose plan is not the run's (another seed) is subdivided
+// again: the parcels are the run's own.
+TEST(Shards, AnEntryMadeUnderAnotherPlanIsMadeAgain) {
+  const CompareRequest request = sampleWithRightOfWay();
+  auto one = std::make_shared<const ObservedData>(loadObserved(request.input, request.parameters));
+  const CompareResult single = compare(request, one);
+  PreparedObserved merged = prepareMerged(analyseWhole(request, 2), 2, request.input);
+  ASSERT_GT(merged.premade->size(), 2u);
+  std::vector<PremadeBlock>& made = *merged.premade;
+  ASSERT_TRUE(made[1].made);
+  made[1].plan.seed += 1;
+  made[1].outcome.subdivision.parcels.front().outer.front().x += 1.0;  // would show if taken
+  const CompareResult sharded = compare(request, merged.data, {}, merged.premade.get());
+  EXPECT_EQ(sharded.generated.premadeBlocks, static_cast<std::int64_t>(single.generated.blocks.size()) - 1);
+  expectSameGenerated(single.generated, sharded.generated);
 }
 
 TEST(Shards, MergedShardsGiveTheObservedDataOfOneProcess) {
@@ -447,8 +518,13 @@ TEST(SharedDatasetShards, CambridgeInThreeShardsGivesTheTablesOfOneProcess) {
   auto one = std::make_shared<const ObservedData>(loadObserved(request.input, request.parameters));
   const PreparedObserved merged = prepareMerged(analyseFiltered(request, 3), 3, request.input);
   expectSameObserved(*one, *merged.data);
-  const auto a = comparisonTables(compare(request, one));
-  const auto b = comparisonTables(compare(request, merged.data));
+  const CompareResult single = compare(request, one);
+  const CompareResult sharded = compare(request, merged.data, {}, merged.premade.get());
+  // Every block was subdivided in its shard.
+  EXPECT_EQ(sharded.generated.premadeBlocks, static_cast<std::int64_t>(sharded.generated.blocks.size()));
+  expectSameGenerated(single.generated, sharded.generated);
+  const auto a = comparisonTables(single);
+  const auto b = comparisonTables(sharded);
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t t = 0; t < a.size(); ++t) {
     EXPECT_EQ(a[t].second.rows, b[t].second.rows) << a[t].first;

@@ -61,10 +61,25 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
                              const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex = true);
 /// Feature i's polygons into `parts`, which comes empty; called from another thread.
 using PolygonSource = std::function<void(std::size_t i, std::vector<Polygon>& parts)>;
-/// The same with geometries too made feature by feature (attributes.rows features).
+/// A feature's geometry as writePolygonLayer writes it: mapped back with the
+/// frame, checked and repaired in the CRS written, as a MultiPolygon in ISO
+/// WKB (little-endian).
+struct FileGeometry {
+  std::string wkb;
+  bool repaired = false;  ///< invalid once mapped back, repaired
+  bool emptied = false;   ///< of those, collapsed entirely (an empty MultiPolygon)
+};
+/// `parts` (local metres) as writePolygonLayer writes them; made wherever the
+/// parts are (a shard of the run), then handed to the writer.
+FileGeometry fileGeometry(std::vector<Polygon> parts, const LocalFrame& frame);
+/// Feature i's geometry made already by fileGeometry with the layer's frame,
+/// or null: the writer makes it from the PolygonSource. Called from another thread.
+using ReadyGeometry = std::function<const FileGeometry*(std::size_t i)>;
+/// The same with geometries too made feature by feature (attributes.rows
+/// features), or taken from `ready` where it has them.
 LayerWrite writePolygonLayer(const std::string& path, const std::string& layerName, const PolygonSource& geometries,
                              const RowSource& attributes, const LocalFrame& frame, const CrsInfo& crs,
-                             bool spatialIndex = true);
+                             bool spatialIndex = true, const ReadyGeometry& ready = {});
 
 /// Writes a GeoPackage with a point layer `nodes` (one point per row of
 /// `nodeAttributes`) and a line layer `edges` (one line string per row of

@@ -29,6 +29,16 @@ public:
 /// The observed parcels of block `block` of `analysis`, as styles that fit them read them.
 std::shared_ptr<generation::ObservedSample> observedSample(const analysis::ObservedAnalysis& analysis,
                                                            std::size_t block);
+/// The same for a block whose parcels index `metrics`.
+std::shared_ptr<generation::ObservedSample> observedSample(const std::vector<analysis::ParcelMetrics>& metrics,
+                                                           const Block& block);
+
+/// Appends to `inputs` one entry per part of each block (its bounds and
+/// street access share from `statistics`, its observed parcels from
+/// `metrics`), as the blocks of observed parcels are listed for generation.
+void appendObservedEntries(BlockInputs& inputs, const std::vector<Block>& blocks,
+                           const std::vector<analysis::BlockStatistics>& statistics,
+                           const std::vector<analysis::ParcelMetrics>& metrics);
 
 /// Blocks grouped from observed parcels exactly as `stats` groups them, with
 /// bounds derived from their parcels (Vanegas et al. 2012, section 6); the

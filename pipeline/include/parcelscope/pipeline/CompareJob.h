@@ -118,8 +118,9 @@ void exportSession(const CompareRequest& request, const std::string& path);
 CompareResult compare(const CompareRequest& request, const ProgressFn& progress = {});
 /// The same with the observed data already read and analysed (as
 /// loadObservedInStreetBlocks gives it for `request`): only generates and compares.
+/// With `premade`, block entries made elsewhere (GenerateRequest::premade).
 CompareResult compare(const CompareRequest& request, std::shared_ptr<const pipeline::ObservedData> observed,
-                      const ProgressFn& progress = {});
+                      const ProgressFn& progress = {}, std::vector<PremadeBlock>* premade = nullptr);
 
 /// What draws the figures of runCompare; the rendering library supplies one
 /// (viz::compareFigureRenderer()), so that this library links no renderer.
@@ -152,6 +153,9 @@ struct FigureRenderer {
 /// shards of several processes), and what run.json records of them.
 struct PreparedObserved {
   std::shared_ptr<const ObservedData> data;
+  /// Block entries the shards subdivided and measured (GenerateRequest::premade):
+  /// the run takes them as its own where its plan agrees. Null: none.
+  std::shared_ptr<std::vector<PremadeBlock>> premade;
   int ranks = 1;  ///< run.json's "ranks"
   Json shards;    ///< run.json's "shards": each one's blocks, parcels and seconds
 };

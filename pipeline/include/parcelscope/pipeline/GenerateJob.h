@@ -18,6 +18,7 @@
 #include "parcelscope/generation/Styles.h"
 #include "parcelscope/io/ParcelReader.h"
 #include "parcelscope/io/StreetReader.h"
+#include "parcelscope/io/Writers.h"
 #include "parcelscope/pipeline/StatsJob.h"
 
 namespace parcelscope::pipeline {
@@ -44,6 +45,8 @@ using BlockOverrides = std::map<Key, BlockOverride>;
 /// of the input's features, so these are resolved against the blocks as read.
 using BlockOverridesById = std::map<std::int64_t, BlockOverride>;
 
+struct PremadeBlock;
+
 struct GenerateRequest {
   io::ReadOptions input;
   /// The input holds observed parcels: build blocks and per-block A_min, A_max,
@@ -68,6 +71,10 @@ struct GenerateRequest {
   /// observed parcels of `input` are assigned to them for per-block bounds;
   /// without, `input.path` may be empty and every block takes the run's values.
   std::optional<io::StreetReadOptions> streets;
+  /// Outcomes made elsewhere (by the shards of the run: pipeline/Shards.h),
+  /// one per block entry: an entry whose premade plan equals its own takes
+  /// that outcome (moved out) instead of being subdivided here. Null: none.
+  std::vector<PremadeBlock>* premade = nullptr;
 };
 
 struct GeneratedParcels {
@@ -87,6 +94,7 @@ struct GeneratedParcels {
   std::int64_t failedBlocks = 0, oversize = 0, withoutAccess = 0;
   std::int64_t clampedBounds = 0;   ///< per-block bounds moved into the parameter ranges
   std::int64_t fallbackBlocks = 0;  ///< skeleton blocks subdivided with OBB instead
+  std::int64_t premadeBlocks = 0;   ///< entries whose outcome was made elsewhere (GenerateRequest::premade)
   std::int64_t patioParcels = 0;    ///< parcels that are (parts of) patios
   /// Per parcel, 1 where it is land the style left unassigned (see
   /// Subdivision::unassignedParcels): written with role "unassigned", drawn
@@ -97,6 +105,9 @@ struct GeneratedParcels {
   /// blocks that reached it exactly.
   std::int64_t blocksWithTarget = 0, blocksAtTarget = 0;
   double unassignedArea = 0;  ///< m²
+  /// Per parcel, its geometry as a file holds it where it was made beside the
+  /// parcels (BlockOutcome::written; an empty wkb elsewhere). Empty when none was.
+  std::vector<io::FileGeometry> written;
   bool isUnassigned(std::size_t parcel) const { return !unassigned.empty() && unassigned[parcel]; }
   /// Indices of the parcels that are not unassigned land, of `parcels` (all
   /// parcels when empty).
@@ -185,7 +196,17 @@ struct BlockOutcome {
   /// Whether neighbours, frontage and street access are in `metrics` (false
   /// after a shapes-only run, until measureOutcomeContext).
   bool contextMeasured = true;
+  /// The parcels as a file holds them (io::fileGeometry), when made beside
+  /// them (by a shard of the run); empty otherwise.
+  std::vector<io::FileGeometry> written;
 };
+/// One block entry subdivided and measured elsewhere, and under what plan.
+struct PremadeBlock {
+  bool made = false;  ///< false: left to the run
+  BlockPlan plan;
+  BlockOutcome outcome;
+};
+
 /// What runBlock may reuse from the block's last run.
 struct BlockReuse {
   /// The entry's outcome under `previousPlan` (both null: nothing to reuse).

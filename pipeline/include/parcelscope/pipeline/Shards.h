@@ -38,6 +38,16 @@ struct ShardPart {
   std::vector<analysis::RightOfWay> rightOfWay;
   std::vector<Block> blocks;  ///< `parcels` index this part's parcels
   std::vector<analysis::BlockStatistics> statistics;
+  /// Per block, its outline as blocks.gpkg holds it (io::fileGeometry).
+  std::vector<io::FileGeometry> blockOutlines;
+  /// One per block entry (each block's parts in turn): the entry subdivided
+  /// and measured here, under the plan the whole run gives it, or left to the
+  /// merged run (`made` false: a style that reads street widths, which need
+  /// the neighbouring blocks; or overrides by block id, which name the merged
+  /// blocks). Empty: nothing generated here.
+  std::vector<PremadeBlock> generated;
+  std::int64_t blocksGenerated = 0;  ///< entries of `generated` made here
+  double generateSeconds = 0;        ///< subdividing and measuring them
   std::vector<std::pair<std::string, double>> readTimings, analysisTimings;
   /// Shard 0: the layer's features as GDAL counts them (the merge checks that
   /// the shards counted each once). -1 in the other shards.
@@ -63,8 +73,9 @@ ShardPart analyseShard(const CompareRequest& request, int index, int count, cons
 
 /// The ObservedData a single process reads, from every shard's part (any
 /// order). Throws Error(Input) when the parts are not one run's `count` shards
-/// or overlap.
-ObservedData mergeShards(std::vector<ShardPart> parts);
+/// or overlap. With `generated`, the parts' premade entries in the order of
+/// the merged data's block entries (ShardPart::generated).
+ObservedData mergeShards(std::vector<ShardPart> parts, std::vector<PremadeBlock>* generated = nullptr);
 
 /// A part as bytes and back (files of `compare --shard`, messages between ranks).
 std::string encodeShard(const ShardPart& part);

@@ -23,6 +23,9 @@ struct ObservedData {
   /// lots that lie in none of them. Null: blocks grouped from the parcels.
   std::shared_ptr<const StreetNetwork> streets;
   std::int64_t outsideStreetBlocks = 0;
+  /// Per block, its outline as a file holds it (io::fileGeometry), when made
+  /// beside the blocks (by the shards of the run); empty otherwise.
+  std::vector<io::FileGeometry> blocksWritten;
 };
 
 /// Reads `input` and analyses it with `parameters` (names of analysisParameters()).
