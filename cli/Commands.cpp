@@ -525,24 +525,25 @@ int compareOnRanks(const pipeline::CompareRequest& request, const std::string& o
                  "writes; 'mpirun --bind-to none' (or more cores per rank) lets it use more\n",
                  workerCount(), std::thread::hardware_concurrency());
   }
-  std::vector<std::string> parts;
+  // Rank 0 keeps its own part as it is and decodes each other rank's as it
+  // arrives; the others send theirs and are done.
+  std::vector<pipeline::ShardPart> decoded;
   try {
     const ProgressFn progress = rank == 0 ? terminalProgress(a.has("quiet")) : ProgressFn{};
-    std::string mine;
-    {  // the part itself is gone before the parts travel
-      const pipeline::ShardPart part =
-          pipeline::analyseShard(request, rank, size, rankReading(), scaledProgress(progress, 0.0, 0.5));
-      mine = pipeline::encodeShard(part);
+    pipeline::ShardPart part =
+        pipeline::analyseShard(request, rank, size, rankReading(), scaledProgress(progress, 0.0, 0.5));
+    if (rank != 0) {
+      const std::string bytes = pipeline::encodeShard(part);
+      part = pipeline::ShardPart{};
+      sendPart(bytes);
+      return 0;
     }
-    parts = gatherParts(std::move(mine));
+    decoded.push_back(std::move(part));
+    receiveParts([&](int r, std::string bytes) {
+      decoded.push_back(pipeline::decodeShard(bytes, "rank " + std::to_string(r)));
+    });
   } catch (const std::exception& e) {
     abortRanks(who + ": " + e.what() + "; every rank stopped, nothing was written");
-  }
-  if (rank != 0) return 0;
-  std::vector<pipeline::ShardPart> decoded;
-  for (std::size_t r = 0; r < parts.size(); ++r) {
-    decoded.push_back(pipeline::decodeShard(parts[r], "rank " + std::to_string(r)));
-    parts[r] = std::string();
   }
   const pipeline::PreparedObserved prepared = pipeline::prepareMerged(std::move(decoded), size, request.input);
   return reportOutcome(viz::runCompare(request, out, terminalProgress(a.has("quiet")), &prepared), a);

@@ -116,34 +116,34 @@ pipeline::ShardReading rankReading() {
   return reading;
 }
 
-std::vector<std::string> gatherParts(std::string mine) {
-  const int size = mpiSize(), rank = mpiRank();
-  auto transfer = [](char* data, std::size_t n, int peer, bool send) {
-    for (std::size_t at = 0; at < n; at += kChunk) {
-      const int count = static_cast<int>(std::min(kChunk, n - at));
-      if (send) {
-        MPI_Send(data + at, count, MPI_CHAR, peer, 1, MPI_COMM_WORLD);
-      } else {
-        MPI_Recv(data + at, count, MPI_CHAR, peer, 1, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-      }
+namespace {
+// `n` bytes to or from `peer`, in messages of at most kChunk bytes.
+void transfer(char* data, std::size_t n, int peer, bool send) {
+  for (std::size_t at = 0; at < n; at += kChunk) {
+    const int count = static_cast<int>(std::min(kChunk, n - at));
+    if (send) {
+      MPI_Send(data + at, count, MPI_CHAR, peer, 1, MPI_COMM_WORLD);
+    } else {
+      MPI_Recv(data + at, count, MPI_CHAR, peer, 1, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     }
-  };
-  std::vector<std::string> parts;
-  if (rank != 0) {
-    unsigned long long n = mine.size();
-    MPI_Send(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, 0, MPI_COMM_WORLD);
-    transfer(const_cast<char*>(mine.data()), mine.size(), 0, true);
-    return parts;
   }
-  parts.push_back(std::move(mine));
-  for (int r = 1; r < size; ++r) {
+}
+}  // namespace
+
+void sendPart(const std::string& bytes) {
+  unsigned long long n = bytes.size();
+  MPI_Send(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, 0, MPI_COMM_WORLD);
+  transfer(const_cast<char*>(bytes.data()), bytes.size(), 0, true);
+}
+
+void receiveParts(const std::function<void(int rank, std::string bytes)>& take) {
+  for (int r = 1, size = mpiSize(); r < size; ++r) {
     unsigned long long n = 0;
     MPI_Recv(&n, 1, MPI_UNSIGNED_LONG_LONG, r, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     std::string bytes(static_cast<std::size_t>(n), '\0');
     transfer(bytes.data(), bytes.size(), r, false);
-    parts.push_back(std::move(bytes));
+    take(r, std::move(bytes));
   }
-  return parts;
 }
 
 void abortRanks(const std::string& message) {
@@ -160,7 +160,8 @@ MpiSession::~MpiSession() = default;
 int mpiRank() { return 0; }
 int mpiSize() { return 1; }
 pipeline::ShardReading rankReading() { return {}; }
-std::vector<std::string> gatherParts(std::string mine) { return {std::move(mine)}; }
+void sendPart(const std::string&) {}
+void receiveParts(const std::function<void(int rank, std::string bytes)>&) {}
 void abortRanks(const std::string& message) {
   std::fprintf(stderr, "%s\n", message.c_str());
   std::exit(1);

@@ -3,6 +3,7 @@
 // run into N spatial shards (pipeline/Shards.h), one per rank; rank 0 merges
 // them and writes what a single process writes. A build without MPI, or a
 // program not started by mpirun, runs as one process.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -27,8 +28,12 @@ int mpiSize();
 /// The reading of a rank: its window only, the frame sample exchanged.
 pipeline::ShardReading rankReading();
 
-/// Every rank's encoded part, on rank 0 (empty elsewhere), in rank order.
-std::vector<std::string> gatherParts(std::string mine);
+/// Sends this rank's encoded part to rank 0 (a rank other than 0).
+void sendPart(const std::string& bytes);
+/// On rank 0: every other rank's encoded part, handed to `take` one at a
+/// time as it arrives, in rank order (each part's bytes are freed before the
+/// next arrives).
+void receiveParts(const std::function<void(int rank, std::string bytes)>& take);
 
 /// Stops every rank at once after printing `message` (a rank's failure).
 [[noreturn]] void abortRanks(const std::string& message);

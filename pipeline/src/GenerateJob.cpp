@@ -47,6 +47,15 @@ std::uint64_t runSeed(const ParameterValues& values) {
 
 }  // namespace
 
+Key planKey(const BlockPlan& plan) {
+  Key h = hashBytes(plan.style);
+  for (const auto& [name, v] : plan.values) {
+    h = hashBytes(name, mixKeys(h, name.size()));
+    h = hashBytes(std::string_view(reinterpret_cast<const char*>(&v), sizeof v), h);
+  }
+  return mixKeys(h, plan.seed);
+}
+
 bool BlockPlan::operator==(const BlockPlan& o) const {
   return style == o.style && seed == o.seed && values == o.values;
 }
@@ -378,7 +387,7 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
   std::int64_t premade = 0;
   for (std::size_t k = 0; k < plans.size(); ++k) {
     if (request.premade && k < request.premade->size() && (*request.premade)[k].made &&
-        (*request.premade)[k].plan == plans[k]) {
+        (*request.premade)[k].plan == planKey(plans[k])) {
       outcomes[k] = std::move((*request.premade)[k].outcome);
       (*request.premade)[k] = PremadeBlock{};
       ++premade;

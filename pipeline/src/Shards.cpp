@@ -109,13 +109,7 @@ public:
   void premade(const PremadeBlock& p) {
     pod(static_cast<std::uint8_t>(p.made));
     if (!p.made) return;
-    text(p.plan.style);
-    pod(static_cast<std::uint64_t>(p.plan.values.size()));
-    for (const auto& [name, v] : p.plan.values) {
-      text(name);
-      pod(v);
-    }
-    pod(p.plan.seed);
+    pod(p.plan);
     const Subdivision& d = p.outcome.subdivision;
     pod(static_cast<std::uint64_t>(d.parcels.size()));
     for (const Polygon& parcel : d.parcels) polygon(parcel);
@@ -203,12 +197,7 @@ public:
     PremadeBlock p;
     p.made = flag();
     if (!p.made) return p;
-    p.plan.style = text();
-    for (auto n = count(2 * sizeof(std::uint64_t)); n > 0; --n) {
-      std::string name = text();
-      p.plan.values[name] = pod<double>();
-    }
-    p.plan.seed = pod<std::uint64_t>();
+    p.plan = pod<Key>();
     Subdivision& d = p.outcome.subdivision;
     d.parcels.resize(count(2 * sizeof(std::uint64_t)));
     for (Polygon& parcel : d.parcels) parcel = polygon();
@@ -325,7 +314,7 @@ void generateInShard(const CompareRequest& request, ShardPart& part) {
     for (const Polygon& parcel : p.outcome.subdivision.parcels) {
       p.outcome.written.push_back(io::fileGeometry({parcel}, frame));
     }
-    p.plan = plans[k];
+    p.plan = planKey(plans[k]);
     p.made = true;
     ++made;
   });

@@ -6,6 +6,7 @@
 #include <gdal_utils.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <condition_variable>
 #include <cstring>
 #include <filesystem>
@@ -229,11 +230,37 @@ TEST(Shards, AnEntryMadeUnderAnotherPlanIsMadeAgain) {
   ASSERT_GT(merged.premade->size(), 2u);
   std::vector<PremadeBlock>& made = *merged.premade;
   ASSERT_TRUE(made[1].made);
-  made[1].plan.seed += 1;
+  made[1].plan ^= 1;
   made[1].outcome.subdivision.parcels.front().outer.front().x += 1.0;  // would show if taken
   const CompareResult sharded = compare(request, merged.data, {}, merged.premade.get());
   EXPECT_EQ(sharded.generated.premadeBlocks, static_cast<std::int64_t>(single.generated.blocks.size()) - 1);
   expectSameGenerated(single.generated, sharded.generated);
+}
+
+// The merge takes a shard's entry by its plan's key: any field of the plan
+// changes the key.
+TEST(Shards, PlanKeysTellPlansApart) {
+  BlockPlan a;
+  a.style = "obb";
+  a.values = {{"a-max", 500.0}, {"w-min", 8.0}};
+  a.seed = 7;
+  BlockPlan b = a;
+  EXPECT_EQ(planKey(a), planKey(b));
+  b.seed = 8;
+  EXPECT_NE(planKey(a), planKey(b));
+  b = a;
+  b.values["a-max"] = std::nextafter(500.0, 1e9);
+  EXPECT_NE(planKey(a), planKey(b));
+  b = a;
+  b.style = "sexton";
+  EXPECT_NE(planKey(a), planKey(b));
+  b = a;
+  b.values["a-min"] = 0.0;
+  EXPECT_NE(planKey(a), planKey(b));
+  b = a;  // a value under another name
+  b.values.erase("w-min");
+  b.values["w-max"] = 8.0;
+  EXPECT_NE(planKey(a), planKey(b));
 }
 
 TEST(Shards, MergedShardsGiveTheObservedDataOfOneProcess) {

@@ -200,10 +200,14 @@ struct BlockOutcome {
   /// them (by a shard of the run); empty otherwise.
   std::vector<io::FileGeometry> written;
 };
+/// A digest of every field of `plan` (its style, each value by name, its seed):
+/// plans with equal keys are taken as equal.
+Key planKey(const BlockPlan& plan);
+
 /// One block entry subdivided and measured elsewhere, and under what plan.
 struct PremadeBlock {
   bool made = false;  ///< false: left to the run
-  BlockPlan plan;
+  Key plan = 0;       ///< planKey of the plan it was made under
   BlockOutcome outcome;
 };
 
