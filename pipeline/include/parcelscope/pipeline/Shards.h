@@ -12,8 +12,13 @@
 // that is not whole widens the window and the shard reads again. The local
 // frame is the single process's too: its sample (the features' centres) is
 // exchanged between the shards, or, without exchange, read from every feature.
-// mergeShards then orders the parcels by feature id and part, numbers the
-// blocks by their first parcel, and gives the ObservedData one process reads.
+// The shard then subdivides and measures its blocks under the plan the whole
+// run gives them (each block's plan depends on the block and the request
+// only), except those whose style reads street widths (measured to the
+// neighbouring blocks), and maps its parcels and outlines back as the writer
+// would. mergeShards then orders the parcels by feature id and part, numbers
+// the blocks by their first parcel, and gives the ObservedData one process
+// reads, with the shards' outcomes in block-entry order for generate().
 #include <functional>
 #include <memory>
 #include <string>
