@@ -187,6 +187,11 @@ BlockStatistics blockStatistics(const std::vector<double>& areas, const std::vec
   return s;
 }
 
+bool hasRightOfWayShape(const ShapeMetrics& m) {
+  const double stripWidth = 2.0 * m.area / m.perimeter;
+  return !(m.width < kNetworkWidthRatio * stripWidth);
+}
+
 ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const AnalysisOptions& options,
                                 const ProgressFn& progress) {
   const std::size_t n = parcels.size();
@@ -245,8 +250,7 @@ ObservedAnalysis analyseParcels(const std::vector<Parcel>& parcels, const Analys
     }
     for (std::size_t i = 0; i < n; ++i) {
       const ParcelMetrics& m = out.metrics[i];
-      const double stripWidth = 2.0 * m.area / m.perimeter;
-      if (m.width < kNetworkWidthRatio * stripWidth) continue;
+      if (!hasRightOfWayShape(m)) continue;
       if (enclosing[i]) {
         out.rightOfWay[i] = RightOfWay::HolesHoldParcels;
       } else if (m.neighbours >= kNetworkMinNeighbours) {

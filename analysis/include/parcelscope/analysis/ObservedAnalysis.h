@@ -63,6 +63,11 @@ enum class RightOfWay : std::uint8_t {
   NetworkShape       ///< thin (as above) and at least 10 neighbours
 };
 
+/// Whether a parcel of these metrics has the shape of a right-of-way (thin:
+/// MBR width at least 6 strip widths 2A/P); whether it is one depends on the
+/// parcels around it (in its holes, or touching it).
+bool hasRightOfWayShape(const ShapeMetrics& metrics);
+
 struct BlockStatistics {
   int blockId = -1;
   int parcelCount = 0;

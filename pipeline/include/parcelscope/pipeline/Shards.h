@@ -9,7 +9,10 @@
 // it is whole: its box, grown by the contact distances, lies inside the window
 // read, so every parcel that touches it, and so its grouping, right-of-way
 // test, outline and metrics, are the single process's. A block of the strip
-// that is not whole widens the window and the shard reads again. The local
+// that is not whole widens the window and the shard reads again; so does a
+// block, not whole, that holds a parcel of right-of-way shape whose own
+// surroundings are not all read (a right-of-way seen as a lot joins blocks).
+// Parts end with a checksum of their bytes. The local
 // frame is the single process's too: its sample (the features' centres) is
 // exchanged between the shards, or, without exchange, read from every feature.
 // The shard then subdivides and measures its blocks under the plan the whole
