@@ -68,7 +68,7 @@ Box unite(const Box& a, const Box& b) {
 struct Extent {
   double anchor = std::numeric_limits<double>::infinity();
   bool startsInStrip = false;  // one of its parcels' envelopes starts in the shard's strip
-  bool mayBeJoined = false;    // holds a parcel that may be a right-of-way (Shards.cpp: uncertain)
+  bool mayBeJoined = false;    // holds a parcel that may be a right-of-way (`uncertain` in analyseShard)
   Box box{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(), std::numeric_limits<double>::lowest(),
           std::numeric_limits<double>::lowest()};
   void add(const Polygon& shape, double sourceMinX) {
@@ -248,7 +248,7 @@ private:
 
 constexpr char kMagic[] = "parcelscope-shard-2";
 
-// A checksum of `bytes`, eight bytes at a time (about 5 GB/s).
+// A checksum of `bytes`, eight bytes at a time.
 Key checksum(std::string_view bytes) {
   Key h = 0x9e3779b97f4a7c15ull ^ bytes.size();
   std::size_t i = 0;
