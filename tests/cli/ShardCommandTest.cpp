@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <regex>
 
 #include "CliRun.h"
 #include "OgrTestUtil.h"
@@ -135,6 +136,13 @@ TEST(ShardCommand, TwoMpiRanksWriteWhatOneProcessWrites) {
   expectSameRun(dir / "one", dir / "ranks");
   const std::string run = slurp((dir / "ranks" / "run.json").string());
   EXPECT_NE(run.find("\"ranks\": 2"), std::string::npos) << run.substr(0, 400);
+  // The ranks subdivided every block (obb reads no street widths).
+  auto number = [&](const std::string& key) {
+    std::smatch m;
+    return std::regex_search(run, m, std::regex("\"" + key + "\": ([0-9]+)")) ? std::stoll(m[1]) : -1LL;
+  };
+  EXPECT_GT(number("blocks_subdivided"), 0);
+  EXPECT_EQ(number("block_entries_generated_in_shards"), number("blocks_subdivided"));
 
   // A rank that fails stops them all, and nothing is written.
   const CliRun bad = runCli(
