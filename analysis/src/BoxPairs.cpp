@@ -57,9 +57,14 @@ std::vector<std::pair<int, int>> intersectingPairs(const std::vector<Box>& boxes
       if (slabs > 1 && slabOf(std::max(a.min_coord(0), b.min_coord(0))) != s) return;
       out.emplace_back(std::min(i, j), std::max(i, j));
     });
+    std::sort(out.begin(), out.end());  // each slab's pairs sorted on its own thread, then merged
   });
-  for (auto& f : found) pairs.insert(pairs.end(), f.begin(), f.end());
-  std::sort(pairs.begin(), pairs.end());
+  for (auto& f : found) {
+    const std::size_t before = pairs.size();
+    pairs.insert(pairs.end(), f.begin(), f.end());
+    std::inplace_merge(pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(before), pairs.end());
+    f = {};
+  }
   return pairs;
 }
 

@@ -195,7 +195,9 @@ void compareStage(CompareResult& r, const CompareRequest& request, const std::ve
   }
   if (!r.observedSides) {
     auto sides = std::make_shared<std::vector<analysis::PreparedSet>>(a.blocks.size() + 1);
-    parallelFor(sides->size(), [&](std::size_t b) {
+    // The city's side (the largest item, last in the vector) first.
+    parallelFor(sides->size(), [&](std::size_t t) {
+      const std::size_t b = t == 0 ? a.blocks.size() : t - 1;
       (*sides)[b] = analysis::prepareSet(b < a.blocks.size() ? pick(a.metrics, a.blocks[b].parcels) : r.observedLots);
     });
     r.observedSides = std::move(sides);
