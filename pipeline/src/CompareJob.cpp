@@ -411,15 +411,13 @@ JobOutcome writeCompare(io::OutputDirectory& out, const CompareRequest& request,
   // The two layers (SQLite inserts, one thread each) are written while this
   // thread formats and writes the tables.
   const Table blocks = analysis::blockComparisonTable(r.blocks);
-  std::vector<std::vector<Polygon>> outlines;
-  for (const Block& b : a.blocks) outlines.push_back(b.parts);
   const std::string blocksCsv = out.stage("blocks.csv"), blocksGpkg = out.stage("blocks.gpkg");
   std::future<io::LayerWrite> blockWriting = std::async(std::launch::async, [&] {
     // Outlines made by the shards of the run come ready to write.
     const std::vector<io::FileGeometry>& made = r.observed->blocksWritten;
-    if (outlines.size() != blocks.rows.size()) throw std::logic_error("compare: one outline per row of blocks.csv");
+    if (a.blocks.size() != blocks.rows.size()) throw std::logic_error("compare: one outline per row of blocks.csv");
     return io::writePolygonLayer(
-        blocksGpkg, "blocks", [&outlines](std::size_t b, std::vector<Polygon>& parts) { parts = outlines[b]; },
+        blocksGpkg, "blocks", [&a](std::size_t b, std::vector<Polygon>& parts) { parts = a.blocks[b].parts; },
         RowSource::of(blocks), r.observed->layer.frame, r.observed->layer.crs, spatialIndex,
         [&made](std::size_t b) { return b < made.size() ? &made[b] : nullptr; });
   });
