@@ -8,6 +8,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libvtk9-dev libvtk9-qt-dev qtbase5-dev libqt5opengl5-dev libfreetype-dev
   libopenmpi-dev openmpi-bin
+  libgoogle-perftools-dev
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev
   libgeographiclib-dev
   libgdal-dev gdal-bin libsqlite3-dev libssl-dev zlib1g-dev
