@@ -38,8 +38,5 @@ endfunction()
 function(parcelscope_use_allocator target)
   if(TARGET PkgConfig::TCMALLOC)
     target_link_libraries(${target} PRIVATE PkgConfig::TCMALLOC)
-    # GCC otherwise assumes malloc and free are the C library's.
-    target_compile_options(${target} PRIVATE -fno-builtin-malloc -fno-builtin-calloc -fno-builtin-realloc
-      -fno-builtin-free)
   endif()
 endfunction()
