@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -538,16 +539,24 @@ TEST(ManyFiles, AFolderOrAListOfFilesIsReadAsOneLayer) {
 const std::string kCambridge =
     std::string(PARCELSCOPE_SHARED_DATASETS) + "/cambridge_ma/ASSESSING_ParcelsFY2014.topojson";
 
+// The sample's obb request on a shared dataset (its path under
+// ../shared/datasets), without a filter; empty when the dataset is absent.
+std::optional<CompareRequest> obbRequestOn(const std::string& dataset) {
+  const std::string path = std::string(PARCELSCOPE_SHARED_DATASETS) + "/" + dataset;
+  if (!fs::exists(path)) return std::nullopt;
+  CompareRequest request = test::sampleCompareRequest("obb");
+  request.input.path = path;
+  request.input.where.clear();
+  return request;
+}
+
 // malibu_ca holds invalid multipolygons (feature 8419, for one) across the
 // edges of four strips' windows, which GDAL's spatial filter drops.
 TEST(SharedDatasetShards, MalibuInFourShardsGivesTheObservedDataOfOneProcess) {
-  const std::string malibu = std::string(PARCELSCOPE_SHARED_DATASETS) + "/malibu_ca/parcels.geojson";
-  if (!fs::exists(malibu)) GTEST_SKIP() << "shared dataset not found: " << malibu;
-  CompareRequest request = test::sampleCompareRequest("obb");
-  request.input.path = malibu;
-  request.input.where.clear();
-  const ObservedData one = loadObserved(request.input, request.parameters);
-  expectSameObserved(one, mergeShards(analyseFiltered(request, 4)));
+  const auto request = obbRequestOn("malibu_ca/parcels.geojson");
+  if (!request) GTEST_SKIP() << "shared dataset not found: malibu_ca/parcels.geojson";
+  const ObservedData one = loadObserved(request->input, request->parameters);
+  expectSameObserved(one, mergeShards(analyseFiltered(*request, 4)));
 }
 
 // seoul_jamsil's street net is stored as parcels, one of them thin and long
@@ -556,16 +565,13 @@ TEST(SharedDatasetShards, MalibuInFourShardsGivesTheObservedDataOfOneProcess) {
 // around it into one; the shard whose strip it starts in then took those
 // blocks for another shard's, and no shard kept it (with three shards).
 TEST(SharedDatasetShards, SeoulInThreeShardsGivesTheObservedDataOfOneProcess) {
-  const std::string seoul = std::string(PARCELSCOPE_SHARED_DATASETS) + "/seoul_jamsil/parcels.geojson";
-  if (!fs::exists(seoul)) GTEST_SKIP() << "shared dataset not found: " << seoul;
-  CompareRequest request = test::sampleCompareRequest("obb");
-  request.input.path = seoul;
-  request.input.where.clear();
-  const ObservedData one = loadObserved(request.input, request.parameters);
+  const auto request = obbRequestOn("seoul_jamsil/parcels.geojson");
+  if (!request) GTEST_SKIP() << "shared dataset not found: seoul_jamsil/parcels.geojson";
+  const ObservedData one = loadObserved(request->input, request->parameters);
   ASSERT_GT(one.analysis.rightOfWayCount, 0);
   for (int count : {3, 5}) {
     SCOPED_TRACE("shards: " + std::to_string(count));
-    expectSameObserved(one, mergeShards(analyseWhole(request, count)));
+    expectSameObserved(one, mergeShards(analyseWhole(*request, count)));
   }
 }
 
