@@ -31,6 +31,8 @@ unsigned workerCount() {
 }
 
 namespace {
+constexpr auto kTickInterval = std::chrono::milliseconds(5);
+
 // True on a thread running a parallelFor's body: a loop nested in it runs on
 // that thread alone (the outer loop already keeps every core busy; starting
 // threads per block would only cost).
@@ -61,8 +63,9 @@ void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
   // The ticking thread sleeps between ticks until the last item is done.
   std::mutex finishedMutex;
   std::condition_variable finished;
-  auto work = [&] {
+  auto work = [&](bool tickHere) {
     const InsideLoop inside;
+    auto lastTick = std::chrono::steady_clock::now();
     for (std::size_t i; !stop && (i = next.fetch_add(1)) < n;) {
       try {
         body(i);
@@ -73,28 +76,43 @@ void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
         std::lock_guard<std::mutex> lock(finishedMutex);
         finished.notify_all();
       }
+      if (tickHere && !stop && std::chrono::steady_clock::now() - lastTick >= kTickInterval) {
+        lastTick = std::chrono::steady_clock::now();
+        try {
+          tick(done.load());
+        } catch (...) {
+          fail(std::current_exception());
+        }
+      }
     }
   };
+  // Ticked once before any item and once after the last, so that a loop whose
+  // items all finish before the first poll still reports its start and end.
+  if (tick) tick(0);
   const unsigned threads = static_cast<unsigned>(std::min<std::size_t>(workerCount(), n));
   const bool ticking = tick && threads > 1;
   std::vector<std::thread> pool;
-  for (unsigned t = ticking ? 0 : 1; t < threads; ++t) pool.emplace_back(work);
+  for (unsigned t = ticking ? 0 : 1; t < threads; ++t) pool.emplace_back(work, false);
   if (ticking) {
     // The calling thread reports progress while the workers run.
     while (!stop && done.load() < n) {
+      std::unique_lock<std::mutex> lock(finishedMutex);
+      finished.wait_for(lock, kTickInterval, [&] { return stop || done.load() >= n; });
+      lock.unlock();
+      if (stop || done.load() >= n) break;
       try {
         tick(done.load());
       } catch (...) {
         fail(std::current_exception());
       }
-      std::unique_lock<std::mutex> lock(finishedMutex);
-      finished.wait_for(lock, std::chrono::milliseconds(5), [&] { return stop || done.load() >= n; });
     }
   } else {
-    work();
+    // One thread: it ticks between items itself.
+    work(static_cast<bool>(tick));
   }
   for (auto& t : pool) t.join();
   if (error) std::rethrow_exception(error);
+  if (tick) tick(n);
 }
 
 void runAtLowestPriority(const std::function<void()>& work) {

@@ -78,8 +78,6 @@ void measureDeferred(const pipeline::BlockInputs& inputs,
                      const std::vector<std::size_t>& entries, double minFrontage, const ProgressFn& progress,
                      std::set<std::int64_t>& stale) {
   for (std::size_t k : entries) stale.insert(inputs.entries[k].blockId);
-  // Asked once before any work: the loop's own ticks may all come after its last block.
-  reportProgress(progress, 0.0, "measuring context");
   parallelFor(
       entries.size(),
       [&](std::size_t t) { pipeline::measureOutcomeContext(inputs, entries[t], *outcomes[entries[t]], minFrontage); },

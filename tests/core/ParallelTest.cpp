@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <future>
 #include <memory>
 #include <stdexcept>
@@ -49,6 +50,37 @@ TEST(Parallel, NestedLoopsRunOnTheirWorkersThreadInOrder) {
   std::vector<int> hits(1000, 0);
   parallelFor(hits.size(), [&](std::size_t i) { hits[i] += 1; });
   for (int h : hits) ASSERT_EQ(h, 1);
+}
+
+// A loop whose items all finish before its first poll still reports its start
+// and its end (a progress bar showed no "subdividing" on a quick sample).
+TEST(Parallel, TicksAtTheStartAndAtTheEndEvenWhenItemsAreInstant) {
+  for (std::size_t n : {std::size_t{1}, std::size_t{2}, std::size_t{7}, std::size_t{5000}}) {
+    std::vector<std::size_t> ticks;
+    parallelFor(
+        n, [](std::size_t) {}, [&](std::size_t done) { ticks.push_back(done); });
+    ASSERT_GE(ticks.size(), 2u) << n;
+    EXPECT_EQ(ticks.front(), 0u) << n;
+    EXPECT_EQ(ticks.back(), n) << n;
+    for (std::size_t k = 1; k < ticks.size(); ++k) EXPECT_LE(ticks[k - 1], ticks[k]) << n;
+  }
+}
+
+// A tick that throws (a cancelled progress) stops the loop before every item runs.
+TEST(Parallel, ATickThatThrowsStopsTheLoop) {
+  std::atomic<std::size_t> ran{0};
+  int calls = 0;
+  EXPECT_THROW(parallelFor(
+                   100000,
+                   [&](std::size_t) {
+                     ran.fetch_add(1);
+                     std::this_thread::sleep_for(std::chrono::microseconds(50));
+                   },
+                   [&](std::size_t) {
+                     if (++calls == 2) throw std::runtime_error("cancelled");
+                   }),
+               std::runtime_error);
+  EXPECT_LT(ran.load(), 100000u);
 }
 
 TEST(Progress, CancellingThrowsCancelled) {

@@ -11,9 +11,11 @@ namespace parcelscope {
 /// (its CPU affinity: taskset, cgroups, Slurm, an MPI binding), at least 1.
 unsigned workerCount();
 
-/// Calls body(i) for every i in [0, n) on up to workerCount() threads. Between
-/// chunks the calling thread runs `tick(done)` (for progress; it may throw to
-/// stop the loop early). The first exception thrown by `body` or `tick` is
+/// Calls body(i) for every i in [0, n) on up to workerCount() threads. The
+/// calling thread runs `tick(done)` (for progress; it may throw to stop the
+/// loop early) before the first item, every few milliseconds while items run
+/// (between items when there is one thread) and, unless the loop failed, once
+/// with done == n after the last. The first exception thrown by `body` or `tick` is
 /// rethrown on the calling thread after all workers stop. Called from within a
 /// parallelFor's body, it runs the loop on the calling thread, in order.
 void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
