@@ -4,7 +4,10 @@
 
 #include "BoxPairs.h"
 
+#include "parcelscope/core/BoxIndex.h"
 #include "parcelscope/core/Parallel.h"
+
+#include <boost/iterator/function_output_iterator.hpp>
 
 #include <CGAL/box_intersection_d.h>
 
@@ -97,17 +100,33 @@ struct NearEdge {
 
 // Edges sorted by the left side of their boxes: those whose boxes meet a
 // query box are found among the edges starting at most the widest box's
-// width to its left, not by testing every edge.
+// width to its left, not by testing every edge. Many edges (a street network
+// stored as a parcel, thousands of edges kilometres across, some of them
+// long) go to an R-tree instead: an x-slab as wide as the longest edge would
+// hold a large share of them for every query.
 class EdgeIndex {
 public:
   // Below this many edges, testing every one costs less.
   static constexpr std::size_t kScanUpTo = 24;
+  // From this many edges, the R-tree.
+  static constexpr std::size_t kTreeFrom = 512;
 
   void build(const std::vector<NearEdge>& edges) {
     order_.clear();
     left_.clear();
+    tree_.clear();
     widest_ = 0;
     if (edges.size() <= kScanUpTo) return;
+    if (edges.size() >= kTreeFrom) {
+      std::vector<std::pair<IndexBox, std::size_t>> boxes;
+      boxes.reserve(edges.size());
+      for (std::size_t j = 0; j < edges.size(); ++j) {
+        boxes.emplace_back(
+            IndexBox(IndexPoint(edges[j].lo[0], edges[j].lo[1]), IndexPoint(edges[j].hi[0], edges[j].hi[1])), j);
+      }
+      tree_ = BoxTree<std::size_t>(boxes.begin(), boxes.end());  // packed (bulk loading)
+      return;
+    }
     // Sorted as (left side, edge) pairs; `meeting` sorts what it finds, so
     // the order of ties does not matter.
     thread_local std::vector<std::pair<double, std::size_t>> sorted;
@@ -134,6 +153,14 @@ public:
     auto meets = [&](const NearEdge& e) {
       return e.lo[0] <= box.maxX && box.minX <= e.hi[0] && e.lo[1] <= box.maxY && box.minY <= e.hi[1];
     };
+    if (!tree_.empty()) {
+      // Boost.Geometry's box intersection is closed, as `meets`.
+      tree_.query(boost::geometry::index::intersects(indexBox(box)),
+                  boost::iterators::make_function_output_iterator(
+                      [&](const std::pair<IndexBox, std::size_t>& v) { out.push_back(v.second); }));
+      std::sort(out.begin(), out.end());
+      return;
+    }
     if (order_.empty()) {
       for (std::size_t j = 0; j < edges.size(); ++j) {
         if (meets(edges[j])) out.push_back(j);
@@ -153,6 +180,7 @@ private:
   std::vector<std::size_t> order_;
   std::vector<double> left_;  // edges' lo[0], in order_
   double widest_ = 0;
+  BoxTree<std::size_t> tree_;
 };
 
 // coveredInterval(*e.p, *e.q, *f.p, *f.q, ...) with the lengths and directions
