@@ -387,6 +387,19 @@ TEST(CompareCommand, DrawsAProgressBarOnATerminal) {
   EXPECT_NE(r.output.find("subdividing"), std::string::npos) << r.output;
 }
 
+// On one core (a Slurm task with one CPU, here taskset) every stage is still
+// reported: parallel loops tick between items on the calling thread (they
+// did not tick at all, so a stage such as subdividing went unreported and
+// Ctrl-C waited for its end).
+TEST(CompareCommand, ReportsEveryStageOnOneCore) {
+  TempDir dir;
+  const CliRun r = runCli("compare " + kSampleArgs + " --figures 0 --out '" + dir.file("out") + "'", "taskset -c 0");
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* stage : {"cleaning ...", "blocks ...", "subdividing ...", "measuring ...", "writing ..."}) {
+    EXPECT_NE(r.output.find(stage), std::string::npos) << stage << " in:\n" << r.output;
+  }
+}
+
 TEST(CompareCommand, UnknownStyleIsAUsageErrorAndWritesNothing) {
   TempDir dir;
   const CliRun r = runCli("compare " + kSampleArgs + " --style voronoi --out '" + dir.file("x") + "' --quiet");
