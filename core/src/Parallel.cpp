@@ -51,6 +51,7 @@ void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
     for (std::size_t i = 0; i < n; ++i) body(i);
     return;
   }
+  if (n == 0) return;  // nothing to report either (callers divide by n)
   std::atomic<std::size_t> next{0}, done{0};
   std::atomic<bool> stop{false};
   std::exception_ptr error;

@@ -91,8 +91,10 @@ struct Cleaned {
 // holes are polygons that all meet the fixed shell and whose interiors are
 // disjoint (a valid multipolygon), that union adds nothing: the difference
 // with the holes as they are gives the same polygons, up to where each ring
-// starts and the order of rings. Returns nothing where that does not hold;
-// the caller then makes the whole polygon valid.
+// starts and the order of rings (which differ from GEOS's). Returns nothing
+// where that does not hold, or where the difference is not valid (GEOS's
+// difference may fall back to its older overlay where make-valid's robust
+// one fails); the caller then makes the whole polygon valid.
 constexpr int kManyHoles = 16;
 
 std::unique_ptr<OGRGeometry> validWithManyHoles(const OGRPolygon& polygon) {
@@ -123,38 +125,38 @@ std::unique_ptr<OGRGeometry> validWithManyHoles(const OGRPolygon& polygon) {
   };
   const Geom shell = fixedRing(*polygon.getExteriorRing());
   if (!shell || GEOSisEmpty_r(ctx, shell.get()) != 0) return nullptr;
-  const GEOSPreparedGeometry* prepared = GEOSPrepare_r(ctx, shell.get());
+  const std::unique_ptr<const GEOSPreparedGeometry, std::function<void(const GEOSPreparedGeometry*)>> prepared(
+      GEOSPrepare_r(ctx, shell.get()), [ctx](const GEOSPreparedGeometry* p) { GEOSPreparedGeom_destroy_r(ctx, p); });
   if (!prepared) return nullptr;
-  std::vector<GEOSGeometry*> holes;  // owned until the multipolygon takes them
-  bool fast = true;
-  for (int i = 0; fast && i < polygon.getNumInteriorRings(); ++i) {
+  std::vector<Geom> holes;
+  for (int i = 0; i < polygon.getNumInteriorRings(); ++i) {
     Geom hole = fixedRing(*polygon.getInteriorRing(i));
-    if (!hole) {
-      fast = false;
-    } else if (GEOSisEmpty_r(ctx, hole.get()) != 0) {
-      continue;  // a collapsed hole, which GEOS drops too
-    } else if (GEOSPreparedIntersects_r(ctx, prepared, hole.get()) != 1) {
-      fast = false;  // a hole outside its shell: GEOS makes it a shell of its own
-    } else if (GEOSGeomTypeId_r(ctx, hole.get()) == GEOS_POLYGON) {
-      holes.push_back(hole.release());
-    } else if (GEOSGeomTypeId_r(ctx, hole.get()) == GEOS_MULTIPOLYGON) {
+    if (!hole) return nullptr;
+    if (GEOSisEmpty_r(ctx, hole.get()) != 0) continue;  // a collapsed hole: GEOS unites it, empty, with the result
+    // A hole outside its shell: GEOS makes it a shell of its own.
+    if (GEOSPreparedIntersects_r(ctx, prepared.get(), hole.get()) != 1) return nullptr;
+    const int type = GEOSGeomTypeId_r(ctx, hole.get());
+    if (type == GEOS_POLYGON) {
+      holes.push_back(std::move(hole));
+    } else if (type == GEOS_MULTIPOLYGON) {
       for (int k = 0; k < GEOSGetNumGeometries_r(ctx, hole.get()); ++k) {
-        holes.push_back(GEOSGeom_clone_r(ctx, GEOSGetGeometryN_r(ctx, hole.get(), k)));
+        Geom part = own(GEOSGeom_clone_r(ctx, GEOSGetGeometryN_r(ctx, hole.get(), k)));
+        if (!part) return nullptr;
+        holes.push_back(std::move(part));
       }
     } else {
-      fast = false;
+      return nullptr;
     }
   }
-  GEOSPreparedGeom_destroy_r(ctx, prepared);
-  if (!fast) {
-    for (GEOSGeometry* g : holes) GEOSGeom_destroy_r(ctx, g);
-    return nullptr;
-  }
+  // The multipolygon takes the holes (also when it cannot be made).
+  std::vector<GEOSGeometry*> parts;
+  parts.reserve(holes.size());
+  for (Geom& h : holes) parts.push_back(h.release());
   const Geom multi =
-      own(GEOSGeom_createCollection_r(ctx, GEOS_MULTIPOLYGON, holes.data(), static_cast<unsigned>(holes.size())));
+      own(GEOSGeom_createCollection_r(ctx, GEOS_MULTIPOLYGON, parts.data(), static_cast<unsigned>(parts.size())));
   if (!multi || GEOSisValid_r(ctx, multi.get()) != 1) return nullptr;
   const Geom result = own(GEOSDifference_r(ctx, shell.get(), multi.get()));
-  if (!result) return nullptr;
+  if (!result || GEOSisValid_r(ctx, result.get()) != 1) return nullptr;
   return std::unique_ptr<OGRGeometry>(OGRGeometryFactory::createFromGEOS(ctx, result.get()));
 }
 

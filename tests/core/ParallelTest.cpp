@@ -64,6 +64,11 @@ TEST(Parallel, TicksAtTheStartAndAtTheEndEvenWhenItemsAreInstant) {
     EXPECT_EQ(ticks.back(), n) << n;
     for (std::size_t k = 1; k < ticks.size(); ++k) EXPECT_LE(ticks[k - 1], ticks[k]) << n;
   }
+  // No items, no ticks: callers report done / n.
+  int emptyTicks = 0;
+  parallelFor(
+      0, [](std::size_t) {}, [&](std::size_t) { ++emptyTicks; });
+  EXPECT_EQ(emptyTicks, 0);
 }
 
 // A tick that throws (a cancelled progress) stops the loop before every item runs.

@@ -15,7 +15,8 @@ unsigned workerCount();
 /// calling thread runs `tick(done)` (for progress; it may throw to stop the
 /// loop early) before the first item, every few milliseconds while items run
 /// (between items when there is one thread) and, unless the loop failed, once
-/// with done == n after the last. The first exception thrown by `body` or `tick` is
+/// with done == n after the last. A loop of no items, and a loop nested in
+/// another's body, do not tick. The first exception thrown by `body` or `tick` is
 /// rethrown on the calling thread after all workers stop. Called from within a
 /// parallelFor's body, it runs the loop on the calling thread, in order.
 void parallelFor(std::size_t n, const std::function<void(std::size_t)>& body,
