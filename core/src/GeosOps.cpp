@@ -253,6 +253,65 @@ std::vector<Polygon> validParts(const Polygon& polygon) {
   return out;
 }
 
+std::optional<std::vector<Polygon>> validWithManyHoles(const Polygon& polygon) {
+  if (polygon.holes.size() < kManyHoles) return std::nullopt;
+  GEOSContextHandle_t ctx = context();
+  const std::unique_ptr<GEOSMakeValidParams, void (*)(GEOSMakeValidParams*)> params(
+      GEOSMakeValidParams_create_r(ctx), [](GEOSMakeValidParams* p) { GEOSMakeValidParams_destroy_r(context(), p); });
+  if (!params || !GEOSMakeValidParams_setMethod_r(ctx, params.get(), GEOS_MAKE_VALID_STRUCTURE) ||
+      !GEOSMakeValidParams_setKeepCollapsed_r(ctx, params.get(), 0)) {
+    return std::nullopt;
+  }
+  // One ring as a polygon of its own, made valid as GEOS fixes a ring (a
+  // closing vertex given is dropped: toGeos closes the ring).
+  const auto fixedRing = [&](const Ring& ring) {
+    Polygon alone{ring, {}};
+    if (alone.outer.size() > 1 && alone.outer.front().x == alone.outer.back().x &&
+        alone.outer.front().y == alone.outer.back().y) {
+      alone.outer.pop_back();
+    }
+    const Geom g = toGeos(alone);
+    return g ? Geom(GEOSMakeValidWithParams_r(ctx, g.get(), params.get())) : Geom();
+  };
+  const Geom shell = fixedRing(polygon.outer);
+  if (!shell || GEOSisEmpty_r(ctx, shell.get()) != 0) return std::nullopt;
+  const std::unique_ptr<const GEOSPreparedGeometry, void (*)(const GEOSPreparedGeometry*)> prepared(
+      GEOSPrepare_r(ctx, shell.get()), [](const GEOSPreparedGeometry* p) { GEOSPreparedGeom_destroy_r(context(), p); });
+  if (!prepared) return std::nullopt;
+  std::vector<Geom> holes;
+  for (const Ring& ring : polygon.holes) {
+    Geom hole = fixedRing(ring);
+    if (!hole) return std::nullopt;
+    if (GEOSisEmpty_r(ctx, hole.get()) != 0) continue;  // a collapsed hole: GEOS unites it, empty, with the result
+    // A hole outside its shell: GEOS makes it a shell of its own.
+    if (GEOSPreparedIntersects_r(ctx, prepared.get(), hole.get()) != 1) return std::nullopt;
+    const int type = GEOSGeomTypeId_r(ctx, hole.get());
+    if (type == GEOS_POLYGON) {
+      holes.push_back(std::move(hole));
+    } else if (type == GEOS_MULTIPOLYGON) {
+      for (int k = 0; k < GEOSGetNumGeometries_r(ctx, hole.get()); ++k) {
+        Geom part(GEOSGeom_clone_r(ctx, GEOSGetGeometryN_r(ctx, hole.get(), k)));
+        if (!part) return std::nullopt;
+        holes.push_back(std::move(part));
+      }
+    } else {
+      return std::nullopt;
+    }
+  }
+  // The multipolygon takes the holes (also when it cannot be made).
+  std::vector<GEOSGeometry*> parts;
+  parts.reserve(holes.size());
+  for (Geom& h : holes) parts.push_back(h.release());
+  const Geom multi(
+      GEOSGeom_createCollection_r(ctx, GEOS_MULTIPOLYGON, parts.data(), static_cast<unsigned>(parts.size())));
+  if (!valid(multi.get())) return std::nullopt;
+  const Geom result(GEOSDifference_r(ctx, shell.get(), multi.get()));
+  if (!valid(result.get())) return std::nullopt;
+  std::vector<Polygon> out;
+  collectPolygons(result.get(), out);
+  return out;
+}
+
 std::optional<Polygon> unionIfOne(const Polygon& a, const Polygon& b) {
   Geom ga = toGeos(a), gb = toGeos(b);
   if (!ga || !gb) return std::nullopt;

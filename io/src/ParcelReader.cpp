@@ -5,12 +5,9 @@
 #include <ogr_spatialref.h>
 #include <ogrsf_frmts.h>
 
-#include <geos_c.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -22,6 +19,7 @@
 #include "OgrConvert.h"
 #include "VectorInput.h"
 #include "parcelscope/core/Error.h"
+#include "parcelscope/core/GeosOps.h"
 #include "parcelscope/core/Parallel.h"
 
 namespace parcelscope::io {
@@ -84,82 +82,6 @@ struct Cleaned {
   int degenerate = 0;
 };
 
-// GEOS's make-valid (structure method) of a polygon with many holes (a
-// street network stored as a parcel: the blocks are its holes) fixes its
-// shell and each hole, then takes the shell minus the union of the holes. The
-// union, a cascade of overlays, costs several times the rest. Where the fixed
-// holes are polygons that all meet the fixed shell and whose interiors are
-// disjoint (a valid multipolygon), that union adds nothing: the difference
-// with the holes as they are gives the same polygons, up to where each ring
-// starts and the order of rings (which differ from GEOS's). Returns nothing
-// where that does not hold, or where the difference is not valid (GEOS's
-// difference may fall back to its older overlay where make-valid's robust
-// one fails); the caller then makes the whole polygon valid.
-constexpr int kManyHoles = 16;
-
-std::unique_ptr<OGRGeometry> validWithManyHoles(const OGRPolygon& polygon) {
-  if (polygon.getNumInteriorRings() < kManyHoles) return nullptr;
-  const GEOSContextHandle_t ctx = OGRGeometry::createGEOSContext();
-  struct Finish {
-    GEOSContextHandle_t ctx;
-    ~Finish() { OGRGeometry::freeGEOSContext(ctx); }
-  } finish{ctx};
-  struct Destroy {
-    GEOSContextHandle_t ctx;
-    void operator()(GEOSGeometry* g) const { GEOSGeom_destroy_r(ctx, g); }
-  };
-  using Geom = std::unique_ptr<GEOSGeometry, Destroy>;
-  const auto own = [&](GEOSGeometry* g) { return Geom(g, Destroy{ctx}); };
-  std::unique_ptr<GEOSMakeValidParams, std::function<void(GEOSMakeValidParams*)>> params(
-      GEOSMakeValidParams_create_r(ctx), [ctx](GEOSMakeValidParams* p) { GEOSMakeValidParams_destroy_r(ctx, p); });
-  if (!params || !GEOSMakeValidParams_setMethod_r(ctx, params.get(), GEOS_MAKE_VALID_STRUCTURE) ||
-      !GEOSMakeValidParams_setKeepCollapsed_r(ctx, params.get(), 0)) {
-    return nullptr;
-  }
-  // One ring as a polygon of its own, made valid as GEOS fixes a ring.
-  const auto fixedRing = [&](const OGRLinearRing& ring) {
-    OGRPolygon alone;
-    alone.addRingDirectly(ring.clone());
-    const Geom g = own(alone.exportToGEOS(ctx));
-    return g ? own(GEOSMakeValidWithParams_r(ctx, g.get(), params.get())) : own(nullptr);
-  };
-  const Geom shell = fixedRing(*polygon.getExteriorRing());
-  if (!shell || GEOSisEmpty_r(ctx, shell.get()) != 0) return nullptr;
-  const std::unique_ptr<const GEOSPreparedGeometry, std::function<void(const GEOSPreparedGeometry*)>> prepared(
-      GEOSPrepare_r(ctx, shell.get()), [ctx](const GEOSPreparedGeometry* p) { GEOSPreparedGeom_destroy_r(ctx, p); });
-  if (!prepared) return nullptr;
-  std::vector<Geom> holes;
-  for (int i = 0; i < polygon.getNumInteriorRings(); ++i) {
-    Geom hole = fixedRing(*polygon.getInteriorRing(i));
-    if (!hole) return nullptr;
-    if (GEOSisEmpty_r(ctx, hole.get()) != 0) continue;  // a collapsed hole: GEOS unites it, empty, with the result
-    // A hole outside its shell: GEOS makes it a shell of its own.
-    if (GEOSPreparedIntersects_r(ctx, prepared.get(), hole.get()) != 1) return nullptr;
-    const int type = GEOSGeomTypeId_r(ctx, hole.get());
-    if (type == GEOS_POLYGON) {
-      holes.push_back(std::move(hole));
-    } else if (type == GEOS_MULTIPOLYGON) {
-      for (int k = 0; k < GEOSGetNumGeometries_r(ctx, hole.get()); ++k) {
-        Geom part = own(GEOSGeom_clone_r(ctx, GEOSGetGeometryN_r(ctx, hole.get(), k)));
-        if (!part) return nullptr;
-        holes.push_back(std::move(part));
-      }
-    } else {
-      return nullptr;
-    }
-  }
-  // The multipolygon takes the holes (also when it cannot be made).
-  std::vector<GEOSGeometry*> parts;
-  parts.reserve(holes.size());
-  for (Geom& h : holes) parts.push_back(h.release());
-  const Geom multi =
-      own(GEOSGeom_createCollection_r(ctx, GEOS_MULTIPOLYGON, parts.data(), static_cast<unsigned>(parts.size())));
-  if (!multi || GEOSisValid_r(ctx, multi.get()) != 1) return nullptr;
-  const Geom result = own(GEOSDifference_r(ctx, shell.get(), multi.get()));
-  if (!result || GEOSisValid_r(ctx, result.get()) != 1) return nullptr;
-  return std::unique_ptr<OGRGeometry>(OGRGeometryFactory::createFromGEOS(ctx, result.get()));
-}
-
 Cleaned cleanFeature(const Feature& f, const LocalFrame& frame) {
   QuietErrors quiet;  // error handlers are per thread
   Cleaned c;
@@ -198,25 +120,37 @@ Cleaned cleanFeature(const Feature& f, const LocalFrame& frame) {
     whole = std::move(multi);
   }
   polygons.clear();
+  std::vector<Polygon> shapes;
   if (!whole->IsValid()) {
-    std::unique_ptr<OGRGeometry> fixed;
-    if (wkbFlatten(whole->getGeometryType()) == wkbPolygon) fixed = validWithManyHoles(*whole->toPolygon());
-    if (!fixed) {
-      const char* const makeValidOptions[] = {"METHOD=STRUCTURE", nullptr};
-      fixed.reset(whole->MakeValid(makeValidOptions));
+    // A street network stored as a parcel, its blocks the holes: see validWithManyHoles.
+    std::optional<std::vector<Polygon>> quick;
+    if (wkbFlatten(whole->getGeometryType()) == wkbPolygon &&
+        static_cast<std::size_t>(whole->toPolygon()->getNumInteriorRings()) >= geos::kManyHoles) {
+      quick = geos::validWithManyHoles(detail::fromOgr(*whole->toPolygon()));
     }
-    if (!fixed || fixed->IsEmpty()) {
+    if (quick) {
+      shapes = std::move(*quick);
+    } else {
+      const char* const makeValidOptions[] = {"METHOD=STRUCTURE", nullptr};
+      std::unique_ptr<OGRGeometry> fixed(whole->MakeValid(makeValidOptions));
+      if (fixed) {
+        detail::collectPolygons(*fixed, polygons);
+        for (auto& p : polygons) shapes.push_back(detail::fromOgr(*p));
+      }
+    }
+    if (shapes.empty()) {
       c.repairFailed = true;
       return c;
     }
-    whole = std::move(fixed);
     c.repaired = true;
+  } else {
+    detail::collectPolygons(*whole, polygons);
+    for (auto& p : polygons) shapes.push_back(detail::fromOgr(*p));
   }
-  detail::collectPolygons(*whole, polygons);
   int part = 0;
-  for (auto& p : polygons) {
+  for (Polygon& shape : shapes) {
     Parcel parcel;
-    parcel.shape = detail::fromOgr(*p);
+    parcel.shape = std::move(shape);
     if (!normalise(parcel.shape) || area(parcel.shape) < kMinPartArea) {
       ++c.degenerate;
       continue;

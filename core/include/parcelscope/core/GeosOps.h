@@ -2,6 +2,7 @@
 // Robust polygon operations through the GEOS C API, on ParcelScope's plain
 // types. A target of its own (parcelscope_geos) so that the algorithms
 // (analysis/, generation/) reach GEOS without linking GDAL.
+#include <cstddef>
 #include <optional>
 #include <vector>
 
@@ -27,6 +28,20 @@ bool isValid(const Polygon& polygon);
 /// that pinch or fold split into their parts; zero-width corridors vanish).
 /// A valid polygon comes back as it is. Parts are normalised.
 std::vector<Polygon> validParts(const Polygon& polygon);
+
+/// GEOS make-valid (structure method) of an invalid polygon with many holes
+/// (a street network stored as a parcel: the blocks are its holes), without
+/// GEOS's cascaded union of the holes. GEOS fixes the shell and each hole,
+/// then takes the shell minus the union of the holes; where the fixed holes
+/// all meet the fixed shell and form a valid multipolygon, that union adds
+/// nothing, and the shell minus the holes as they are gives the same polygons
+/// (their rings may start elsewhere and come in another order). Nothing where
+/// that does not hold, where the polygon has fewer than `kManyHoles` holes,
+/// or where the result is not valid (GEOS's difference may take its older
+/// overlay where make-valid's robust one fails): make it valid with GEOS then.
+/// Rings may be given closed or open. Parts are normalised.
+constexpr std::size_t kManyHoles = 16;
+std::optional<std::vector<Polygon>> validWithManyHoles(const Polygon& polygon);
 
 /// The union of two polygons (GEOS overlay) when it is one valid polygon;
 /// nothing when it is not (they touch at a point or not at all) or GEOS fails.
