@@ -236,19 +236,31 @@ std::vector<Polygon> unionAndClose(const std::vector<const Polygon*>& polygons, 
   return parts;
 }
 
+namespace {
+// GEOS make-valid, structure method, collapsed parts dropped (as OGR's
+// MakeValid with METHOD=STRUCTURE); null when GEOS fails.
+Geom madeValid(const GEOSGeometry* g) {
+  GEOSContextHandle_t ctx = context();
+  GEOSMakeValidParams* params = GEOSMakeValidParams_create_r(ctx);
+  if (!params) return nullptr;
+  Geom fixed;
+  if (GEOSMakeValidParams_setMethod_r(ctx, params, GEOS_MAKE_VALID_STRUCTURE) &&
+      GEOSMakeValidParams_setKeepCollapsed_r(ctx, params, 0)) {
+    fixed.reset(GEOSMakeValidWithParams_r(ctx, g, params));
+  }
+  GEOSMakeValidParams_destroy_r(ctx, params);
+  return fixed;
+}
+}  // namespace
+
 bool isValid(const Polygon& polygon) { return valid(toGeos(polygon).get()); }
 
 std::vector<Polygon> validParts(const Polygon& polygon) {
-  GEOSContextHandle_t ctx = context();
   Geom geometry = toGeos(polygon);
   if (valid(geometry.get())) return {polygon};
   std::vector<Polygon> out;
   if (!geometry) return out;
-  GEOSMakeValidParams* params = GEOSMakeValidParams_create_r(ctx);
-  GEOSMakeValidParams_setMethod_r(ctx, params, GEOS_MAKE_VALID_STRUCTURE);
-  GEOSMakeValidParams_setKeepCollapsed_r(ctx, params, 0);
-  Geom fixed(GEOSMakeValidWithParams_r(ctx, geometry.get(), params));
-  GEOSMakeValidParams_destroy_r(ctx, params);
+  Geom fixed = madeValid(geometry.get());
   if (fixed) collectPolygons(fixed.get(), out);
   return out;
 }
@@ -256,12 +268,6 @@ std::vector<Polygon> validParts(const Polygon& polygon) {
 std::optional<std::vector<Polygon>> validWithManyHoles(const Polygon& polygon) {
   if (polygon.holes.size() < kManyHoles) return std::nullopt;
   GEOSContextHandle_t ctx = context();
-  const std::unique_ptr<GEOSMakeValidParams, void (*)(GEOSMakeValidParams*)> params(
-      GEOSMakeValidParams_create_r(ctx), [](GEOSMakeValidParams* p) { GEOSMakeValidParams_destroy_r(context(), p); });
-  if (!params || !GEOSMakeValidParams_setMethod_r(ctx, params.get(), GEOS_MAKE_VALID_STRUCTURE) ||
-      !GEOSMakeValidParams_setKeepCollapsed_r(ctx, params.get(), 0)) {
-    return std::nullopt;
-  }
   // One ring as a polygon of its own, made valid as GEOS fixes a ring (a
   // closing vertex given is dropped: toGeos closes the ring).
   const auto fixedRing = [&](const Ring& ring) {
@@ -271,7 +277,7 @@ std::optional<std::vector<Polygon>> validWithManyHoles(const Polygon& polygon) {
       alone.outer.pop_back();
     }
     const Geom g = toGeos(alone);
-    return g ? Geom(GEOSMakeValidWithParams_r(ctx, g.get(), params.get())) : Geom();
+    return g ? madeValid(g.get()) : Geom();
   };
   const Geom shell = fixedRing(polygon.outer);
   if (!shell || GEOSisEmpty_r(ctx, shell.get()) != 0) return std::nullopt;
@@ -327,7 +333,6 @@ std::vector<Polygon> validMultiPolygon(std::vector<Polygon> parts, bool& repaire
   repaired = false;
   // One ring proven simple with a margin is a valid polygon: GEOS is not asked.
   if (parts.size() == 1 && parts.front().holes.empty() && isClearlySimple(parts.front().outer)) return parts;
-  GEOSContextHandle_t ctx = context();
   std::vector<const Polygon*> pointers;
   for (const Polygon& p : parts) pointers.push_back(&p);
   Geom geometry = parts.size() == 1 ? toGeos(parts.front()) : toGeos(pointers);
@@ -335,11 +340,7 @@ std::vector<Polygon> validMultiPolygon(std::vector<Polygon> parts, bool& repaire
   repaired = true;
   std::vector<Polygon> out;
   if (!geometry) return out;
-  GEOSMakeValidParams* params = GEOSMakeValidParams_create_r(ctx);
-  GEOSMakeValidParams_setMethod_r(ctx, params, GEOS_MAKE_VALID_STRUCTURE);
-  GEOSMakeValidParams_setKeepCollapsed_r(ctx, params, 0);
-  Geom fixed(GEOSMakeValidWithParams_r(ctx, geometry.get(), params));
-  GEOSMakeValidParams_destroy_r(ctx, params);
+  Geom fixed = madeValid(geometry.get());
   if (fixed) collectPolygons(fixed.get(), out);
   double total = 0;
   for (const Polygon& p : out) total += area(p);
