@@ -284,6 +284,7 @@ public:
       if (!lengths.empty()) {
         std::nth_element(lengths.begin(), lengths.begin() + static_cast<long>(lengths.size() / 2), lengths.end());
         depth_ = lengths[lengths.size() / 2];
+        observedAreas_ = observed->areas;
         interiorShare_ = std::clamp(1 - observed->accessShare, 0.0, 1.0);
       }
     }
@@ -310,11 +311,15 @@ public:
       road.push_back(roadSides(q));
     }
     int relaxed = 0;  // once a level is needed, the rest of this subdivision keeps it
-    // Parcel `pick` replaced by the pieces of its split.
+    // Parcel `pick` replaced by the pieces of its split. The interior
+    // allowance pays for each interior parcel made: a piece without street
+    // access, less the parcel split when it had none itself.
     auto apply = [&](std::size_t pick, std::vector<Polygon>& pieces) {
-      for (const Polygon& q : pieces) {
-        if (interiorLeft_ > 0 && !outlineEdges_->sharesAtLeast(q, frontage_)) --interiorLeft_;
-      }
+      std::size_t made = road[pick].empty() && !outlineEdges_->sharesAtLeast(parcels[pick], frontage_) ? 0 : 1;
+      std::size_t without = 0;
+      for (const Polygon& q : pieces) without += !outlineEdges_->sharesAtLeast(q, frontage_);
+      made = without + made > 1 ? without + made - 1 : 0;
+      interiorLeft_ -= std::min(interiorLeft_, made);
       parcels[pick] = std::move(pieces[0]);
       areas[pick] = area(parcels[pick]);
       road[pick] = roadSides(parcels[pick]);
@@ -370,13 +375,28 @@ private:
   // nothing when it breaks one of the paper's constraints.
   std::vector<Polygon> trySplit(const Polygon& parcel, double parcelArea, const std::vector<Side>& road,
                                 std::size_t maxPieces, Relax relax, detail::Rng& rng) {
-    if (road.empty()) return {};
+    if (road.empty()) {
+      // An interior parcel, split again while the block's interior allowance
+      // lasts, as the paper splits a parcel but across any of its sides, into
+      // pieces that may all lack street access.
+      if (interiorLeft_ == 0 || observedAreas_.empty() || outlineEdges_->sharesAtLeast(parcel, frontage_)) return {};
+      const std::vector<Side> sides = detail::sidesOf(parcel.outer);
+      if (sides.empty()) return {};
+      const Side& s = sides[static_cast<std::size_t>(rng.uniform() * static_cast<double>(sides.size()))];
+      // The piece cut off: the area of one of the block's observed parcels, drawn at random.
+      const double drawn =
+          observedAreas_[static_cast<std::size_t>(rng.uniform() * static_cast<double>(observedAreas_.size()))];
+      double f = std::clamp(drawn / parcelArea, 0.05, 0.95);
+      if (rng.uniform() < 0.5) f = 1 - f;
+      const SplitLine line{{s.a.x + f * (s.b.x - s.a.x), s.a.y + f * (s.b.y - s.a.y)}, {-s.dir.y, s.dir.x}};
+      return cutAlong(parcel, parcelArea, line, maxPieces, relax, Access::Interior);
+    }
     const Side& s = road[static_cast<std::size_t>(rng.uniform() * static_cast<double>(road.size()))];
     if (interiorLeft_ > 0 && depth_ > 0 && rng.uniform() < interiorShare_) {
       // Along the street, at the observed depth: the back piece an interior parcel.
       const Point mid{0.5 * (s.a.x + s.b.x), 0.5 * (s.a.y + s.b.y)}, inward{-s.dir.y, s.dir.x};
       const SplitLine line{{mid.x + depth_ * inward.x, mid.y + depth_ * inward.y}, s.dir};
-      std::vector<Polygon> pieces = cutAlong(parcel, parcelArea, line, maxPieces, relax, true);
+      std::vector<Polygon> pieces = cutAlong(parcel, parcelArea, line, maxPieces, relax, Access::Back);
       if (!pieces.empty()) return pieces;
     }
     const double f = std::clamp(0.5 + kPositionSd * rng.normal(), 0.05, 0.95);
@@ -411,13 +431,18 @@ private:
   std::vector<Polygon> splitAt(const Polygon& parcel, double parcelArea, const Side& s, double f, std::size_t maxPieces,
                                Relax relax) {
     const SplitLine line{{s.a.x + f * (s.b.x - s.a.x), s.a.y + f * (s.b.y - s.a.y)}, {-s.dir.y, s.dir.x}};
-    return cutAlong(parcel, parcelArea, line, maxPieces, relax, false);
+    return cutAlong(parcel, parcelArea, line, maxPieces, relax, Access::All);
   }
 
-  // The split of `parcel` by `line`, when admissible; with `interior`, one
-  // piece may lack road access (an interior parcel, of the block's budget).
+  // Which pieces of a split must have road access: all (the paper's
+  // splits); all but one, of two (the back piece of a cut along the street);
+  // none, of an interior parcel's split, as many lacking it as the block's
+  // interior allowance pays for.
+  enum class Access { All, Back, Interior };
+
+  // The split of `parcel` by `line`, when admissible.
   std::vector<Polygon> cutAlong(const Polygon& parcel, double parcelArea, const SplitLine& line, std::size_t maxPieces,
-                                Relax relax, bool interior) {
+                                Relax relax, Access access) {
     work_ += parcel.outer.size();
     if (work_ > kMaxSplitWork)
       throw detail::WorkBudgetExceeded("work budget: more than 4e8 vertices visited by split lines");
@@ -429,8 +454,10 @@ private:
       if (pieces.size() < 2 || pieces.size() > (relax == Relax::None ? 2 : maxPieces)) return false;
       for (const Polygon& q : pieces) {
         const double a = area(q);
-        if (a < kMinAreaShare * p_.aMin) return false;                                  // minimum size
-        if (relax < Relax::Variation && a < kMinPieceShare * parcelArea) return false;  // limited variation
+        if (a < kMinAreaShare * p_.aMin) return false;  // minimum size
+        if (relax < Relax::Variation && access != Access::Interior && a < kMinPieceShare * parcelArea) {
+          return false;  // limited variation
+        }
       }
       for (const Polygon& q : pieces) {
         const double aspect = aspectOf(q);
@@ -442,7 +469,15 @@ private:
       }
       std::size_t without = 0;
       for (const Polygon& q : pieces) without += !outlineEdges_->sharesAtLeast(q, frontage_);  // road access
-      return interior ? without == 1 && pieces.size() == 2 : without == 0;
+      switch (access) {
+        case Access::All:
+          return without == 0;
+        case Access::Back:
+          return without == 1 && pieces.size() == 2;
+        case Access::Interior:
+          return without <= interiorLeft_ + 1;
+      }
+      return false;
     };
     // Random lines are many: one the floating-point split cannot make (it meets
     // a hole) is dropped rather than made exactly, except on parcels without
@@ -484,9 +519,10 @@ private:
   const Polygon outline_;
   SextonParameters p_;
   double leastAspect_ = kSliverAspect;
-  double interiorShare_ = 0;      // observed share of parcels without street access
-  double depth_ = 0;              // observed median parcel length
-  std::size_t interiorLeft_ = 0;  // interior parcels this try may still make
+  double interiorShare_ = 0;           // observed share of parcels without street access
+  double depth_ = 0;                   // observed median parcel length
+  std::vector<double> observedAreas_;  // with interior parcels: the observed parcels' areas
+  std::size_t interiorLeft_ = 0;       // interior parcels this try may still make
   double tolerance_ = 1e-6;
   double frontage_ = 1;
   std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;

@@ -297,19 +297,29 @@ int main(int argc, char** argv) {
         first[b + 1] = pipeline::generatedMetrics(c.board, prefix).size();
       }
       std::map<std::string, std::array<std::size_t, 3>> byStyle;  // blocks, parcels, above
+      // Per style: aspect ratios of its generated parcels, and of the observed ones in its blocks.
+      std::map<std::string, std::array<std::vector<double>, 2>> aspects;
       for (std::size_t b = 0; b < out.size(); ++b) {
-        auto& t = byStyle[c.board.entries[out[b]].style];
+        const std::string& style = c.board.entries[out[b]].style;
+        auto& t = byStyle[style];
         ++t[0];
         for (std::size_t i = first[b]; i < first[b + 1]; ++i) {
           ++t[1];
           t[2] += metrics[i].aspectRatio > tail;
+          aspects[style][0].push_back(metrics[i].aspectRatio);
         }
+        const auto s = pipeline::observedSample(c.board.observed->analysis, b);
+        aspects[style][1].insert(aspects[style][1].end(), s->aspectRatios.begin(), s->aspectRatios.end());
       }
       std::printf("  %s (observed p90 aspect ratio %.2f), left out, per style: blocks / parcels / share above it:",
                   r.city->name, tail);
       for (const auto& [style, t] : byStyle) {
         std::printf(" %s %zu / %zu / %.2f;", style.c_str(), t[0], t[1],
                     t[1] ? static_cast<double>(t[2]) / static_cast<double>(t[1]) : 0.0);
+      }
+      std::printf("\n  aspect ratio p10 / p50 / p90 per style, generated | observed in its blocks:");
+      for (const auto& [style, v] : aspects) {
+        std::printf(" %s %s | %s;", style.c_str(), pct(v[0]).c_str(), pct(v[1]).c_str());
       }
       std::printf("\n");
     }

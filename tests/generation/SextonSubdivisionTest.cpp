@@ -152,6 +152,52 @@ TEST(Sexton, InteriorParcelsFollowTheObservedShareWithoutStreetAccess) {
               p.parcels.size(), p.withoutAccess);
 }
 
+// A block whose observed parcels are mostly interior (three in four) gets
+// them: an interior parcel is split again, across any of its sides, at the
+// area of an observed parcel, while the block's allowance lasts. Cut off only
+// behind the street parcels, a 200 m square of 40 parcels had at most one
+// interior parcel behind each street parcel.
+TEST(Sexton, InteriorParcelsAreSplitAgainUpToTheObservedShare) {
+  const Polygon block = test::rect(0, 0, 300, 300);
+  ObservedSample observed = sampleOf(100, 900, 30, 1);
+  observed.accessShare = 0.36;
+  const ParameterValues values{{"a-min", 300}, {"w-min", 4}, {"tries", 10}};
+  const Subdivision s = sexton(block, values, 5, &observed);
+  EXPECT_TILES(block, s.parcels, "300 x 300");
+  EXPECT_EQ(s.parcels.size(), 100u);
+  EXPECT_LE(s.withoutAccess, 64);  // the allowance: floor(0.64 * 100)
+  EXPECT_GE(s.withoutAccess, 25);  // 16, of 80 parcels, when interior parcels were not split again
+  EXPECT_EQ(test::measuredWithoutAccess(block, s.parcels, 2.0), s.withoutAccess);
+  std::printf("%zu parcels, %d without street access\n", s.parcels.size(), s.withoutAccess);
+}
+
+// Random shapes with observed parcels partly interior: a tiling, valid and
+// reproducible, with no more interior parcels than the observed share allows.
+TEST(Sexton, RandomShapesWithInteriorParcelsTile) {
+  std::mt19937_64 rng(20261129);
+  for (int i = 0; i < 40 / test::kSanitizerDivisor; ++i) {
+    const Polygon block = test::randomShape(rng, i % test::kShapeKinds);
+    const double a = area(block);
+    const auto n = static_cast<std::size_t>(4 + rng() % 30);
+    ObservedSample observed = sampleOf(n, a / static_cast<double>(n), std::sqrt(a / static_cast<double>(n) / 1.5), 1.5);
+    for (double& o : observed.areas) o *= 0.3 + 1.4 * static_cast<double>(rng() % 1000) / 1000.0;
+    observed.accessShare = 0.2 + 0.6 * static_cast<double>(rng() % 1000) / 1000.0;
+    const std::uint64_t seed = rng();
+    const ParameterValues values = {{"a-min", 0.2 * a / static_cast<double>(n)}, {"w-min", 1}, {"tries", 3}};
+    const Subdivision s = sexton(block, values, seed, &observed);
+    const std::string what = "shape " + std::to_string(i) + " kind " + std::to_string(i % test::kShapeKinds);
+    ASSERT_FALSE(s.failed) << what << ": " << s.failure;
+    EXPECT_TILES(block, s.parcels, what);
+    EXPECT_LE(s.withoutAccess, static_cast<int>(std::floor((1 - observed.accessShare) * static_cast<double>(n))))
+        << what;
+    const Subdivision again = sexton(block, values, seed, &observed);
+    ASSERT_EQ(again.parcels.size(), s.parcels.size()) << what;
+    for (std::size_t k = 0; k < s.parcels.size(); ++k) {
+      EXPECT_TRUE(sameVertices(again.parcels[k], s.parcels[k])) << what << " parcel " << k;
+    }
+  }
+}
+
 // Random shapes: a tiling, valid, reproducible, every parcel with access
 // where the block was split, and the target reached on nearly all.
 TEST(Sexton, RandomShapesTileAndMostReachTheirTarget) {
