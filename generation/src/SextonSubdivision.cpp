@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "BlockFailure.h"
@@ -129,10 +130,18 @@ constexpr std::uint64_t kMaxSplitWork = 400000000;
 enum class Relax { None = 0, Variation = 1, Rectangularity = 2 };
 constexpr int kRelaxLevels = 3;
 
-double aspectOf(const Polygon& p) {
-  const OrientedBox b = minimumAreaBox(p.outer);
-  return b.length > 0 ? b.width / b.length : 0;
-}
+double aspectOf(const OrientedBox& b) { return b.length > 0 ? b.width / b.length : 0; }
+
+// Parcels with what the constraints measure of them, each once: the pieces
+// of a split, or a subdivision.
+struct Lots {
+  std::vector<Polygon> polygons;
+  std::vector<double> areas;
+  std::vector<OrientedBox> boxes;  // minimum-area boxes
+  std::vector<char> onRoad;        // sharing at least the least frontage with the block's contour
+  bool empty() const { return polygons.empty(); }
+  std::size_t size() const { return polygons.size(); }
+};
 
 // The longest path of the inner skeleton (a tree for a ring without holes):
 // the farthest node from any node, then the farthest from it.
@@ -301,32 +310,43 @@ public:
   }
 
   // One randomized subdivision from `start`, towards `target` parcels.
-  std::vector<Polygon> subdivide(const std::vector<Polygon>& start, std::size_t target, detail::Rng rng) {
-    std::vector<Polygon> parcels = start;
+  Lots subdivide(const std::vector<Polygon>& start, std::size_t target, detail::Rng rng) {
+    Lots lots;
     interiorLeft_ = static_cast<std::size_t>(std::floor(interiorShare_ * static_cast<double>(target)));
-    std::vector<double> areas;
     std::vector<std::vector<Side>> road;  // each parcel's road-facing sides
-    for (const Polygon& q : parcels) {
-      areas.push_back(area(q));
+    for (const Polygon& q : start) {
+      lots.polygons.push_back(q);
+      lots.areas.push_back(area(q));
+      lots.boxes.push_back(minimumAreaBox(q.outer));
+      lots.onRoad.push_back(outlineEdges_->sharesAtLeast(q, frontage_));
       road.push_back(roadSides(q));
     }
+    const std::vector<Polygon>& parcels = lots.polygons;
+    const std::vector<double>& areas = lots.areas;
     int relaxed = 0;  // once a level is needed, the rest of this subdivision keeps it
     // Parcel `pick` replaced by the pieces of its split. The interior
     // allowance pays for each interior parcel made: a piece without street
     // access, less the parcel split when it had none itself.
-    auto apply = [&](std::size_t pick, std::vector<Polygon>& pieces) {
-      std::size_t made = road[pick].empty() && !outlineEdges_->sharesAtLeast(parcels[pick], frontage_) ? 0 : 1;
+    auto apply = [&](std::size_t pick, Lots& pieces) {
+      std::size_t made = road[pick].empty() && !lots.onRoad[pick] ? 0 : 1;
       std::size_t without = 0;
-      for (const Polygon& q : pieces) without += !outlineEdges_->sharesAtLeast(q, frontage_);
+      for (char on : pieces.onRoad) without += !on;
       made = without + made > 1 ? without + made - 1 : 0;
       interiorLeft_ -= std::min(interiorLeft_, made);
-      parcels[pick] = std::move(pieces[0]);
-      areas[pick] = area(parcels[pick]);
-      road[pick] = roadSides(parcels[pick]);
-      for (std::size_t k = 1; k < pieces.size(); ++k) {
-        areas.push_back(area(pieces[k]));
-        road.push_back(roadSides(pieces[k]));
-        parcels.push_back(std::move(pieces[k]));
+      for (std::size_t k = 0; k < pieces.size(); ++k) {
+        const std::size_t at = k == 0 ? pick : lots.size();
+        if (k > 0) {
+          lots.polygons.emplace_back();
+          lots.areas.push_back(0);
+          lots.boxes.emplace_back();
+          lots.onRoad.push_back(0);
+          road.emplace_back();
+        }
+        lots.polygons[at] = std::move(pieces.polygons[k]);
+        lots.areas[at] = pieces.areas[k];
+        lots.boxes[at] = pieces.boxes[k];
+        lots.onRoad[at] = pieces.onRoad[k];
+        road[at] = roadSides(lots.polygons[at]);
       }
     };
     while (parcels.size() < target) {
@@ -339,10 +359,10 @@ public:
         const bool first = round % (kAttempts + 1) == 0;
         const std::size_t pick =
             first ? largest : static_cast<std::size_t>(rng.uniform() * static_cast<double>(parcels.size()));
-        std::vector<Polygon> pieces;
+        Lots pieces;
         for (int attempt = 0; attempt < (first ? kAttempts : 1) && pieces.empty(); ++attempt) {
-          pieces = trySplit(parcels[pick], areas[pick], road[pick], target + 1 - parcels.size(),
-                            static_cast<Relax>(level), rng);
+          pieces = trySplit(parcels[pick], areas[pick], aspectOf(lots.boxes[pick]), road[pick],
+                            target + 1 - parcels.size(), static_cast<Relax>(level), rng);
         }
         if (pieces.empty()) continue;
         relaxed = level;
@@ -355,14 +375,14 @@ public:
         // A block's scans are bounded (scansLeft_): a try without any left stops short.
         if (scansLeft_ == 0) break;
         --scansLeft_;
-        auto [pick, pieces] = scanSplit(parcels, areas, road, target + 1 - parcels.size());
+        auto [pick, pieces] = scanSplit(lots, road, target + 1 - parcels.size());
         if (pieces.empty()) break;  // no parcel takes an admissible split
         relaxed = kRelaxLevels - 1;
         apply(pick, pieces);
       }
       if (parcels.size() > kMaxLots) throw detail::WorkBudgetExceeded("work budget: more than 200000 parcels");
     }
-    return parcels;
+    return lots;
   }
 
   bool hasAccess(const Polygon& p) const { return outlineEdges_->sharesAtLeast(p, p_.minFrontage); }
@@ -373,8 +393,9 @@ public:
 private:
   // A random split of `parcel` across one of its road-facing sides, or
   // nothing when it breaks one of the paper's constraints.
-  std::vector<Polygon> trySplit(const Polygon& parcel, double parcelArea, const std::vector<Side>& road,
-                                std::size_t maxPieces, Relax relax, detail::Rng& rng) {
+  // `aspect`: the parcel's (box width / length).
+  Lots trySplit(const Polygon& parcel, double parcelArea, double aspect, const std::vector<Side>& road,
+                std::size_t maxPieces, Relax relax, detail::Rng& rng) {
     if (road.empty()) {
       // An interior parcel, split again while the block's interior allowance
       // lasts, as the paper splits a parcel but across any of its sides, into
@@ -389,27 +410,27 @@ private:
       double f = std::clamp(drawn / parcelArea, 0.05, 0.95);
       if (rng.uniform() < 0.5) f = 1 - f;
       const SplitLine line{{s.a.x + f * (s.b.x - s.a.x), s.a.y + f * (s.b.y - s.a.y)}, {-s.dir.y, s.dir.x}};
-      return cutAlong(parcel, parcelArea, line, maxPieces, relax, Access::Interior);
+      return cutAlong(parcel, parcelArea, aspect, line, maxPieces, relax, Access::Interior);
     }
     const Side& s = road[static_cast<std::size_t>(rng.uniform() * static_cast<double>(road.size()))];
     if (interiorLeft_ > 0 && depth_ > 0 && rng.uniform() < interiorShare_) {
       // Along the street, at the observed depth: the back piece an interior parcel.
       const Point mid{0.5 * (s.a.x + s.b.x), 0.5 * (s.a.y + s.b.y)}, inward{-s.dir.y, s.dir.x};
       const SplitLine line{{mid.x + depth_ * inward.x, mid.y + depth_ * inward.y}, s.dir};
-      std::vector<Polygon> pieces = cutAlong(parcel, parcelArea, line, maxPieces, relax, Access::Back);
+      Lots pieces = cutAlong(parcel, parcelArea, aspect, line, maxPieces, relax, Access::Back);
       if (!pieces.empty()) return pieces;
     }
     const double f = std::clamp(0.5 + kPositionSd * rng.normal(), 0.05, 0.95);
-    return splitAt(parcel, parcelArea, s, f, maxPieces, relax);
+    return splitAt(parcel, parcelArea, aspect, s, f, maxPieces, relax);
   }
 
   // The first admissible split, at the most relaxed level, of the
   // kScanParcels largest parcels (largest first) at the positions kScanAt
   // along each of their road sides: the parcel's index and its pieces.
-  std::pair<std::size_t, std::vector<Polygon>> scanSplit(const std::vector<Polygon>& parcels,
-                                                         const std::vector<double>& areas,
-                                                         const std::vector<std::vector<Side>>& road,
-                                                         std::size_t maxPieces) {
+  std::pair<std::size_t, Lots> scanSplit(const Lots& lots, const std::vector<std::vector<Side>>& road,
+                                         std::size_t maxPieces) {
+    const std::vector<Polygon>& parcels = lots.polygons;
+    const std::vector<double>& areas = lots.areas;
     std::vector<std::size_t> order(parcels.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
     const std::size_t n = std::min(order.size(), kScanParcels);
@@ -419,7 +440,7 @@ private:
       const std::size_t i = order[k];
       for (const Side& s : road[i]) {
         for (double f : kScanAt) {
-          std::vector<Polygon> pieces = splitAt(parcels[i], areas[i], s, f, maxPieces, Relax::Rectangularity);
+          Lots pieces = splitAt(parcels[i], areas[i], aspectOf(lots.boxes[i]), s, f, maxPieces, Relax::Rectangularity);
           if (!pieces.empty()) return {i, std::move(pieces)};
         }
       }
@@ -428,10 +449,10 @@ private:
   }
 
   // The split of `parcel` at right angles to road side `s`, at fraction `f` along it.
-  std::vector<Polygon> splitAt(const Polygon& parcel, double parcelArea, const Side& s, double f, std::size_t maxPieces,
-                               Relax relax) {
+  Lots splitAt(const Polygon& parcel, double parcelArea, double aspect, const Side& s, double f, std::size_t maxPieces,
+               Relax relax) {
     const SplitLine line{{s.a.x + f * (s.b.x - s.a.x), s.a.y + f * (s.b.y - s.a.y)}, {-s.dir.y, s.dir.x}};
-    return cutAlong(parcel, parcelArea, line, maxPieces, relax, Access::All);
+    return cutAlong(parcel, parcelArea, aspect, line, maxPieces, relax, Access::All);
   }
 
   // Which pieces of a split must have road access: all (the paper's
@@ -440,27 +461,32 @@ private:
   // interior allowance pays for.
   enum class Access { All, Back, Interior };
 
-  // The split of `parcel` by `line`, when admissible.
-  std::vector<Polygon> cutAlong(const Polygon& parcel, double parcelArea, const SplitLine& line, std::size_t maxPieces,
-                                Relax relax, Access access) {
+  // The split of `parcel` (aspect `before`) by `line`, when admissible.
+  Lots cutAlong(const Polygon& parcel, double parcelArea, double before, const SplitLine& line, std::size_t maxPieces,
+                Relax relax, Access access) {
     work_ += parcel.outer.size();
     if (work_ > kMaxSplitWork)
       throw detail::WorkBudgetExceeded("work budget: more than 4e8 vertices visited by split lines");
-    const double before = aspectOf(parcel);
+    Lots measured;  // of the pieces last found admissible
     auto admissible = [&](const std::vector<Polygon>& pieces) {
       // Two pieces, as the paper's splits make; more, once the constraints
       // are relaxed, where a concave parcel leaves no line that makes two
       // (never beyond the target count).
       if (pieces.size() < 2 || pieces.size() > (relax == Relax::None ? 2 : maxPieces)) return false;
+      measured.areas.clear();
+      measured.boxes.clear();
+      measured.onRoad.clear();
       for (const Polygon& q : pieces) {
         const double a = area(q);
         if (a < kMinAreaShare * p_.aMin) return false;  // minimum size
         if (relax < Relax::Variation && access != Access::Interior && a < kMinPieceShare * parcelArea) {
           return false;  // limited variation
         }
+        measured.areas.push_back(a);
       }
       for (const Polygon& q : pieces) {
-        const double aspect = aspectOf(q);
+        measured.boxes.push_back(minimumAreaBox(q.outer));
+        const double aspect = aspectOf(measured.boxes.back());
         if (relax < Relax::Rectangularity) {  // limited rectangularity
           if (before > kSquareEnough ? aspect < kSquareEnough : aspect <= before) return false;
         } else if (aspect < leastAspect_ && aspect < before) {
@@ -468,7 +494,10 @@ private:
         }
       }
       std::size_t without = 0;
-      for (const Polygon& q : pieces) without += !outlineEdges_->sharesAtLeast(q, frontage_);  // road access
+      for (const Polygon& q : pieces) {
+        measured.onRoad.push_back(outlineEdges_->sharesAtLeast(q, frontage_));  // road access
+        without += !measured.onRoad.back();
+      }
       switch (access) {
         case Access::All:
           return without == 0;
@@ -484,8 +513,9 @@ private:
     // holes, where that happens only for a line through a vertex, and once the
     // constraints are relaxed as far as they go.
     const bool exact = parcel.holes.empty() || relax == Relax::Rectangularity;
-    std::vector<Polygon> pieces = detail::splitLot(parcel, parcelArea, line, exact, admissible);
-    return pieces;
+    measured.polygons = detail::splitLot(parcel, parcelArea, line, exact, admissible);
+    if (measured.polygons.empty()) return {};
+    return measured;
   }
 
   // The sides of `parcel` every edge of which lies on the block's outer
@@ -534,20 +564,20 @@ private:
 // How far a subdivision is from the block's observed parcels: the KS of area,
 // of width and of aspect ratio (MBR sides, as the metrics measure them) plus
 // the relative count error; the count error alone without observed parcels.
-double distanceTo(const std::vector<Polygon>& parcels, const ObservedSample* observed, std::size_t target) {
+double distanceTo(const Lots& parcels, const ObservedSample* observed, std::size_t target) {
   const double countError =
       std::fabs(static_cast<double>(parcels.size()) / static_cast<double>(std::max<std::size_t>(1, target)) - 1);
   if (!observed || observed->areas.empty()) return countError;
-  std::vector<double> areas, widths, aspects;
-  for (const Polygon& p : parcels) {
-    areas.push_back(area(p));
-    const OrientedBox box = minimumAreaBox(p.outer);
+  std::vector<double> widths, aspects;
+  for (const OrientedBox& box : parcels.boxes) {
     widths.push_back(box.width);
     aspects.push_back(box.width > 0 ? box.length / box.width : 0);
   }
+  const std::vector<double>& areas = parcels.areas;
   double d = countError;
-  for (const auto& [made, seen] : {std::pair{&areas, &observed->areas}, std::pair{&widths, &observed->widths},
-                                   std::pair{&aspects, &observed->aspectRatios}}) {
+  for (const auto& [made, seen] :
+       {std::pair{&areas, &observed->areas}, std::pair{&std::as_const(widths), &observed->widths},
+        std::pair{&std::as_const(aspects), &observed->aspectRatios}}) {
     if (!seen->empty()) d += analysis::ksStatistic(*made, *seen);
   }
   return d;
@@ -580,12 +610,12 @@ Subdivision subdivideSexton(const StyleRun& r) {
         // target count (when none did, among all).
         std::pair<bool, double> best{true, std::numeric_limits<double>::infinity()};
         for (int t = 0; t < std::max(1, p.tries); ++t) {
-          std::vector<Polygon> parcels = subdivider.subdivide(
+          Lots parcels = subdivider.subdivide(
               start, wanted, detail::Rng{detail::splitmix64(r.seed ^ (0x5E7701ULL + static_cast<std::uint64_t>(t)))});
           const std::pair<bool, double> d{parcels.size() != wanted, distanceTo(parcels, r.observed, wanted)};
           if (d < best) {
             best = d;
-            out.parcels = std::move(parcels);
+            out.parcels = std::move(parcels.polygons);
           }
         }
         out.targetParcels = static_cast<int>(wanted);

@@ -297,8 +297,9 @@ int main(int argc, char** argv) {
         first[b + 1] = pipeline::generatedMetrics(c.board, prefix).size();
       }
       std::map<std::string, std::array<std::size_t, 3>> byStyle;  // blocks, parcels, above
-      // Per style: aspect ratios of its generated parcels, and of the observed ones in its blocks.
-      std::map<std::string, std::array<std::vector<double>, 2>> aspects;
+      // Per style: aspect ratios and widths of its generated parcels, and of
+      // the observed ones in its blocks.
+      std::map<std::string, std::array<std::vector<double>, 2>> aspects, widths;
       for (std::size_t b = 0; b < out.size(); ++b) {
         const std::string& style = c.board.entries[out[b]].style;
         auto& t = byStyle[style];
@@ -307,9 +308,11 @@ int main(int argc, char** argv) {
           ++t[1];
           t[2] += metrics[i].aspectRatio > tail;
           aspects[style][0].push_back(metrics[i].aspectRatio);
+          widths[style][0].push_back(metrics[i].width);
         }
         const auto s = pipeline::observedSample(c.board.observed->analysis, b);
         aspects[style][1].insert(aspects[style][1].end(), s->aspectRatios.begin(), s->aspectRatios.end());
+        widths[style][1].insert(widths[style][1].end(), s->widths.begin(), s->widths.end());
       }
       std::printf("  %s (observed p90 aspect ratio %.2f), left out, per style: blocks / parcels / share above it:",
                   r.city->name, tail);
@@ -319,6 +322,10 @@ int main(int argc, char** argv) {
       }
       std::printf("\n  aspect ratio p10 / p50 / p90 per style, generated | observed in its blocks:");
       for (const auto& [style, v] : aspects) {
+        std::printf(" %s %s | %s;", style.c_str(), pct(v[0]).c_str(), pct(v[1]).c_str());
+      }
+      std::printf("\n  width p10 / p50 / p90 (m) per style, generated | observed in its blocks:");
+      for (const auto& [style, v] : widths) {
         std::printf(" %s %s | %s;", style.c_str(), pct(v[0]).c_str(), pct(v[1]).c_str());
       }
       std::printf("\n");
