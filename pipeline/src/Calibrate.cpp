@@ -1,8 +1,11 @@
 #include "parcelscope/pipeline/Calibrate.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <functional>
 #include <numeric>
@@ -100,6 +103,7 @@ public:
       }
     }
     for (auto& v : pooled_) std::sort(v.begin(), v.end());
+    for (std::size_t m = 0; m < 3; ++m) swappedKs_[m] = detail::SwappedKs(observed_[m], pooled_[m]);
   }
 
   /// The measures of the current choice with block `b` made by entry `e`
@@ -110,7 +114,7 @@ public:
     FitMeasures f = fit(nullptr, std::move(errors));
     double* ks[3] = {&f.ksArea, &f.ksWidth, &f.ksAspectRatio};
     for (std::size_t m = 0; m < 3; ++m) {
-      *ks[m] = ksSwapped(observed_[m], pooled_[m], values_[choice_[b]][b][m], values_[e][b][m]);
+      *ks[m] = swappedKs_[m](values_[choice_[b]][b][m], values_[e][b][m]);
     }
     return f;
   }
@@ -118,7 +122,10 @@ public:
 
   /// Makes block `b`'s entry `e`.
   void set(std::size_t b, std::size_t e) {
-    for (std::size_t m = 0; m < 3; ++m) pooled_[m] = swapped(pooled_[m], values_[choice_[b]][b][m], values_[e][b][m]);
+    for (std::size_t m = 0; m < 3; ++m) {
+      pooled_[m] = swapped(pooled_[m], values_[choice_[b]][b][m], values_[e][b][m]);
+      swappedKs_[m] = detail::SwappedKs(observed_[m], pooled_[m]);
+    }
     countError_[position_[b]] = countError(e, b);
     choice_[b] = e;
   }
@@ -135,42 +142,6 @@ private:
   static void sortFinite(std::vector<double>& v) {
     v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
     std::sort(v.begin(), v.end());
-  }
-  // analysis::ksStatistic(a, swapped(pooled, out, in)) in one walk, without
-  // making the swapped sample: the same counts at the same distinct values,
-  // so the same number. All sorted and finite, `out` within `pooled`.
-  static double ksSwapped(const std::vector<double>& a, const std::vector<double>& pooled,
-                          const std::vector<double>& out, const std::vector<double>& in) {
-    const std::size_t size = pooled.size() - out.size() + in.size();
-    if (a.empty() || size == 0) return NAN;
-    const double na = static_cast<double>(a.size()), nb = static_cast<double>(size);
-    std::size_t i = 0, p = 0, o = 0, n = 0, j = 0;  // j: swapped values counted so far
-    auto skipOut = [&] {
-      while (p < pooled.size() && o < out.size() && out[o] == pooled[p]) {
-        ++o;
-        ++p;
-      }
-    };
-    skipOut();
-    double ks = 0;
-    while (i < a.size() || j < size) {
-      double x = i < a.size() ? a[i] : HUGE_VAL;
-      if (p < pooled.size()) x = std::min(x, pooled[p]);
-      if (n < in.size()) x = std::min(x, in[n]);
-      if (x == HUGE_VAL) break;  // `out` not within `pooled`: nothing left to count
-      while (i < a.size() && a[i] <= x) ++i;
-      while (p < pooled.size() && pooled[p] <= x) {
-        ++p;
-        ++j;
-        skipOut();
-      }
-      while (n < in.size() && in[n] <= x) {
-        ++n;
-        ++j;
-      }
-      ks = std::max(ks, std::fabs(static_cast<double>(i) / na - static_cast<double>(j) / nb));
-    }
-    return ks;
   }
   // `pooled` (sorted) without the values `out` and with the values `in` (both sorted, `out` within `pooled`).
   static std::vector<double> swapped(const std::vector<double>& pooled, const std::vector<double>& out,
@@ -219,7 +190,8 @@ private:
   std::vector<std::size_t> position_;         // of each board block in blocks_ (kNone: not measured)
   std::vector<std::vector<Samples>> values_;  // [entry][block], sorted, finite
   Samples observed_, pooled_;
-  std::vector<double> countError_;  // per position in blocks_
+  std::array<detail::SwappedKs, 3> swappedKs_;  // of each measure's observed and pooled samples
+  std::vector<double> countError_;              // per position in blocks_
 };
 
 // The measures over the blocks `blocks`, block b's parcels made by entry `entryOf[b]`.
@@ -295,6 +267,68 @@ Refined refineChoice(const Leaderboard& board, const std::vector<std::vector<std
 }
 
 }  // namespace
+
+namespace detail {
+
+// The two empirical distributions change only at the grid's values (the
+// distinct values of both samples) and at the values of `in`; between the
+// values of `out` and `in`, the swapped sample's count at a grid value is the
+// pooled count plus a constant, so the walk goes over the grid in runs. The
+// largest difference is found on exact integers, |A nb - J na| (A, J: the
+// observed and the swapped sample's counts at or below a value), and reported
+// as ksStatistic computes it, |A / na - J / nb|: distinct integers differ by
+// at least 1 / (na nb) in the quotient, far above its rounding, and of equal
+// ones the larger quotient is kept.
+SwappedKs::SwappedKs(const std::vector<double>& observed, const std::vector<double>& pooled) {
+  const std::vector<double>& a = observed;
+  std::size_t i = 0, p = 0;
+  while (i < a.size() || p < pooled.size()) {
+    const double x = i == a.size() ? pooled[p] : p == pooled.size() ? a[i] : std::min(a[i], pooled[p]);
+    while (i < a.size() && a[i] <= x) ++i;
+    while (p < pooled.size() && pooled[p] <= x) ++p;
+    value_.push_back(x);
+    observedUpTo_.push_back(static_cast<std::int64_t>(i));
+    pooledUpTo_.push_back(static_cast<std::int64_t>(p));
+  }
+}
+
+double SwappedKs::operator()(const std::vector<double>& out, const std::vector<double>& in) const {
+  const std::int64_t ina = observedUpTo_.empty() ? 0 : observedUpTo_.back();
+  const std::int64_t inb = (pooledUpTo_.empty() ? 0 : pooledUpTo_.back()) - static_cast<std::int64_t>(out.size()) +
+                           static_cast<std::int64_t>(in.size());
+  if (ina == 0 || inb <= 0) return NAN;
+  const double na = static_cast<double>(ina), nb = static_cast<double>(inb);
+  std::int64_t most = -1;
+  double ks = 0;
+  auto consider = [&](std::int64_t a, std::int64_t j) {
+    const std::int64_t d = std::llabs(a * inb - j * ina);
+    if (d < most) return;
+    const double q = std::fabs(static_cast<double>(a) / na - static_cast<double>(j) / nb);
+    ks = d > most ? q : std::max(ks, q);
+    most = d;
+  };
+  std::size_t k = 0, o = 0, n = 0;
+  auto run = [&](std::size_t end) {
+    const auto shift = static_cast<std::int64_t>(n) - static_cast<std::int64_t>(o);
+    for (; k < end; ++k) consider(observedUpTo_[k], pooledUpTo_[k] + shift);
+  };
+  while (o < out.size() || n < in.size()) {
+    const double x = o == out.size() ? in[n] : n == in.size() ? out[o] : std::min(out[o], in[n]);
+    run(static_cast<std::size_t>(std::lower_bound(value_.begin() + static_cast<long>(k), value_.end(), x) -
+                                 value_.begin()));
+    while (o < out.size() && out[o] <= x) ++o;
+    while (n < in.size() && in[n] <= x) ++n;
+    if (k == value_.size() || value_[k] != x) {
+      // A value of `in` alone: both samples' counts below it, and the swapped sample's at it.
+      const std::int64_t a = k ? observedUpTo_[k - 1] : 0, p = k ? pooledUpTo_[k - 1] : 0;
+      consider(a, p - static_cast<std::int64_t>(o) + static_cast<std::int64_t>(n));
+    }
+  }
+  run(value_.size());
+  return ks;
+}
+
+}  // namespace detail
 
 std::vector<analysis::ParcelMetrics> generatedMetrics(const Leaderboard& board,
                                                       const std::vector<std::size_t>& entryOf) {

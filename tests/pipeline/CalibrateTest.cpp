@@ -6,11 +6,14 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iterator>
 #include <numeric>
+#include <random>
 #include <set>
 
 #include "SampleRequest.h"
 #include "TestUtil.h"
+#include "parcelscope/analysis/Comparison.h"
 #include "parcelscope/generation/Styles.h"
 #include "parcelscope/pipeline/Calibrate.h"
 #include "parcelscope/pipeline/CompareSession.h"
@@ -108,6 +111,42 @@ TEST(Calibrate, CalibratedStylesLowerTheCityObjectiveAndTheSessionReproducesThem
   EXPECT_NEAR(r.city.width.ks, c.after.ksWidth, 1e-12);
   EXPECT_NEAR(r.city.aspectRatio.ks, c.after.ksAspectRatio, 1e-12);
   EXPECT_EQ(calibrationTable(c).rows.size(), n);
+}
+
+// The search's KS of a swap is ksStatistic of the swapped sample, to the
+// bit: random samples on a coarse grid of values (many ties, within and
+// across the samples), values swapped out and in, and swaps that empty the
+// pooled sample.
+TEST(Calibrate, TheSearchsSwappedKsIsTheKsOfTheSwappedSample) {
+  std::mt19937_64 rng(20261128);
+  int compared = 0;
+  for (int t = 0; t < 400; ++t) {
+    const int levels = 2 + static_cast<int>(rng() % 40);
+    auto draw = [&](std::size_t n) {
+      std::vector<double> v(n);
+      for (double& x : v) x = 0.25 * static_cast<double>(rng() % static_cast<unsigned>(levels));
+      std::sort(v.begin(), v.end());
+      return v;
+    };
+    const std::vector<double> observed = draw(rng() % 60), pooled = draw(1 + rng() % 80);
+    std::vector<double> out, in = draw(rng() % 12);
+    for (double x : pooled) {
+      if (rng() % 4 == 0 || t % 50 == 0) out.push_back(x);  // every 50th: all swapped out
+    }
+    std::vector<double> swapped;
+    std::set_difference(pooled.begin(), pooled.end(), out.begin(), out.end(), std::back_inserter(swapped));
+    swapped.insert(swapped.end(), in.begin(), in.end());
+    std::sort(swapped.begin(), swapped.end());
+    const double expected = observed.empty() || swapped.empty() ? NAN : analysis::ksStatistic(observed, swapped);
+    const double got = detail::SwappedKs(observed, pooled)(out, in);
+    if (std::isnan(expected)) {
+      EXPECT_TRUE(std::isnan(got)) << "case " << t;
+    } else {
+      EXPECT_EQ(got, expected) << "case " << t;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 300);
 }
 
 TEST(Calibrate, TheCrossValidatedRuleIsMeasuredOnTheHalfItWasNotFittedOn) {

@@ -6,6 +6,7 @@
 // fitted on half of the city's blocks (nearest neighbours in block features)
 // measured on the other half, beside the paper's rule (style auto, k as given).
 #include <array>
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -118,5 +119,27 @@ using CalibrationRenderer =
 /// (none when null or figures = 0).
 JobOutcome runCalibrate(const CompareRequest& request, const std::string& outDir, const ProgressFn& progress = {},
                         const CalibrationRenderer& draw = {});
+
+namespace detail {
+
+/// The KS statistic (analysis::ksStatistic) between a fixed sample and a
+/// pooled one with a few values swapped, without making the swapped sample:
+/// what calibrate's search measures for each change of one block's style.
+class SwappedKs {
+public:
+  SwappedKs() = default;
+  /// Both sorted and finite.
+  SwappedKs(const std::vector<double>& observed, const std::vector<double>& pooled);
+  /// ksStatistic(observed, pooled without `out` and with `in`), the same
+  /// number: `out` and `in` sorted and finite, `out` within the pooled
+  /// sample. NaN when a side is empty.
+  double operator()(const std::vector<double>& out, const std::vector<double>& in) const;
+
+private:
+  std::vector<double> value_;                            // the distinct values of both samples
+  std::vector<std::int64_t> observedUpTo_, pooledUpTo_;  // each sample's count at or below each value
+};
+
+}  // namespace detail
 
 }  // namespace parcelscope::pipeline
