@@ -267,7 +267,8 @@ CompareResult compare(const CompareRequest& request, const ProgressFn& progress)
 }
 
 CompareResult compare(const CompareRequest& request, std::shared_ptr<const pipeline::ObservedData> observed,
-                      const ProgressFn& progress, std::vector<PremadeBlock>* premade) {
+                      const ProgressFn& progress, std::vector<PremadeBlock>* premade, const OutcomeLibrary* reusable,
+                      OutcomeLibrary* keep) {
   detail::checkRequest(request);
   CompareResult r;
   r.observed = std::move(observed);
@@ -275,6 +276,8 @@ CompareResult compare(const CompareRequest& request, std::shared_ptr<const pipel
   detail::requireBlocks(request, *r.observed);
   pipeline::GenerateRequest g = detail::generateRequest(request, r.observed.get());
   g.premade = premade;
+  g.reusable = reusable;
+  g.keep = keep;
   r.generated = pipeline::generate(g, scaledProgress(progress, 0.0, 0.85));
 
   // Both sets measured with the same metrics; compared block by block, in parallel.

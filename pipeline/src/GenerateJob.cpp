@@ -384,16 +384,25 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
   // Entries made elsewhere under the same plan are taken as they are.
   std::vector<BlockOutcome> outcomes(plans.size());
   std::vector<std::size_t> todo;
-  std::int64_t premade = 0;
+  std::int64_t premade = 0, reused = 0;
   for (std::size_t k = 0; k < plans.size(); ++k) {
     if (request.premade && k < request.premade->size() && (*request.premade)[k].made &&
         (*request.premade)[k].plan == planKey(plans[k])) {
       outcomes[k] = std::move((*request.premade)[k].outcome);
       (*request.premade)[k] = PremadeBlock{};
       ++premade;
-    } else {
-      todo.push_back(k);
+      continue;
     }
+    if (request.reusable && k < request.reusable->byEntry.size()) {
+      const auto& made = request.reusable->byEntry[k];
+      const auto it = made.find(planKey(plans[k]));
+      if (it != made.end()) {
+        outcomes[k] = it->second;
+        ++reused;
+        continue;
+      }
+    }
+    todo.push_back(k);
   }
   const ProgressFn sub = scaledProgress(progress, request.fromParcels ? 0.4 : 0.2, 0.9);
   const auto fraction = [&](std::size_t done) {
@@ -412,9 +421,16 @@ GeneratedParcels generate(const GenerateRequest& request, const ProgressFn& prog
   std::vector<const BlockOutcome*> pointers;
   for (const BlockOutcome& o : outcomes) pointers.push_back(&o);
   GeneratedParcels out = assembleParcels(inputs, plans, pointers, runSeed(request.parameters));
+  if (request.keep) {
+    request.keep->byEntry.resize(std::max(request.keep->byEntry.size(), plans.size()));
+    for (std::size_t k = 0; k < plans.size(); ++k) {
+      request.keep->byEntry[k].emplace(planKey(plans[k]), std::move(outcomes[k]));
+    }
+  }
   timings.stop();
   out.clampedBounds = clamped;
   out.premadeBlocks = premade;
+  out.reusedBlocks = reused;
   out.timings = timings;
   reportProgress(progress, 1.0, "measuring");
   return out;

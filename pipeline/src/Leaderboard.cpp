@@ -33,6 +33,9 @@ Leaderboard leaderboard(const CompareRequest& request, const ProgressFn& progres
       loadObservedInStreetBlocks(request.input, request.streets ? &*request.streets : nullptr, request.parameters,
                                  scaledProgress(progress, 0.0, 0.2)));
   const std::vector<std::string> names = leaderboardStyles();
+  // The styles that choose per block (access, auto) take the outcome of the
+  // concrete style's entry wherever their plan is the same.
+  OutcomeLibrary made;
   for (std::size_t i = 0; i < names.size(); ++i) {
     CompareRequest one = request;
     one.style = names[i];
@@ -41,7 +44,9 @@ Leaderboard leaderboard(const CompareRequest& request, const ProgressFn& progres
     const double to = 0.2 + 0.8 * static_cast<double>(i + 1) / static_cast<double>(names.size());
     LeaderboardEntry entry;
     entry.style = names[i];
-    entry.result = compare(one, board.observed, scaledProgress(progress, from, to));
+    const bool perBlock = generation::choosesPerBlock(generation::style(names[i]));
+    entry.result = compare(one, board.observed, scaledProgress(progress, from, to), nullptr, perBlock ? &made : nullptr,
+                           perBlock ? nullptr : &made);
     entry.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     board.entries.push_back(std::move(entry));
   }

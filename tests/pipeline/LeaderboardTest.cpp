@@ -27,6 +27,18 @@ TEST(Leaderboard, EachStyleIsWhatItsOwnCompareGivesAndEachBlockGetsItsBestFit) {
     ASSERT_EQ(e.result.generated.parcels.size(), fresh.generated.parcels.size()) << e.style;
     for (std::size_t i = 0; i < fresh.generated.parcels.size(); ++i) {
       ASSERT_TRUE(sameVertices(e.result.generated.parcels[i], fresh.generated.parcels[i])) << e.style << " " << i;
+      const analysis::ParcelMetrics &m = e.result.generated.metrics[i], &f = fresh.generated.metrics[i];
+      EXPECT_TRUE(m.area == f.area && m.width == f.width && m.aspectRatio == f.aspectRatio &&
+                  m.frontage == f.frontage && m.neighbours == f.neighbours && m.streetAccess == f.streetAccess)
+          << e.style << " " << i;
+    }
+    // The styles that choose per block take the concrete styles' outcomes
+    // where their plans are the same: auto's plans are theirs on every block.
+    EXPECT_EQ(fresh.generated.reusedBlocks, 0) << e.style;
+    if (e.style == "auto") {
+      EXPECT_EQ(e.result.generated.reusedBlocks, static_cast<std::int64_t>(e.result.generated.blocks.size()));
+    } else if (!generation::choosesPerBlock(generation::style(e.style))) {
+      EXPECT_EQ(e.result.generated.reusedBlocks, 0) << e.style;
     }
     EXPECT_EQ(e.result.city.area.ks, fresh.city.area.ks) << e.style;
     EXPECT_EQ(fitScore(e.result.city), fresh.city.area.ks + fresh.city.width.ks + fresh.city.aspectRatio.ks) << e.style;

@@ -118,9 +118,12 @@ void exportSession(const CompareRequest& request, const std::string& path);
 CompareResult compare(const CompareRequest& request, const ProgressFn& progress = {});
 /// The same with the observed data already read and analysed (as
 /// loadObservedInStreetBlocks gives it for `request`): only generates and compares.
-/// With `premade`, block entries made elsewhere (GenerateRequest::premade).
+/// With `premade`, block entries made elsewhere (GenerateRequest::premade);
+/// with `reusable` and `keep`, outcomes of earlier runs on the same blocks
+/// (GenerateRequest::reusable, ::keep).
 CompareResult compare(const CompareRequest& request, std::shared_ptr<const pipeline::ObservedData> observed,
-                      const ProgressFn& progress = {}, std::vector<PremadeBlock>* premade = nullptr);
+                      const ProgressFn& progress = {}, std::vector<PremadeBlock>* premade = nullptr,
+                      const OutcomeLibrary* reusable = nullptr, OutcomeLibrary* keep = nullptr);
 
 /// What draws the figures of runCompare; the rendering library supplies one
 /// (viz::compareFigureRenderer()), so that this library links no renderer.

@@ -47,6 +47,8 @@ using BlockOverridesById = std::map<std::int64_t, BlockOverride>;
 
 struct PremadeBlock;
 
+struct OutcomeLibrary;  // below
+
 struct GenerateRequest {
   io::ReadOptions input;
   /// The input holds observed parcels: build blocks and per-block A_min, A_max,
@@ -71,6 +73,12 @@ struct GenerateRequest {
   /// observed parcels of `input` are assigned to them for per-block bounds;
   /// without, `input.path` may be empty and every block takes the run's values.
   std::optional<io::StreetReadOptions> streets;
+  /// Outcomes of earlier runs on the same blocks (a leaderboard's styles
+  /// before `auto` and `access`): an entry whose plan is among its block's
+  /// there takes a copy of that outcome instead of being subdivided. Null: none.
+  const OutcomeLibrary* reusable = nullptr;
+  /// Where the run leaves its outcomes, by plan, for later runs (null: nowhere).
+  OutcomeLibrary* keep = nullptr;
   /// Outcomes made elsewhere (by the shards of the run: pipeline/Shards.h),
   /// one per block entry: an entry whose premade plan equals its own takes
   /// that outcome (moved out) instead of being subdivided here. Null: none.
@@ -95,6 +103,7 @@ struct GeneratedParcels {
   std::int64_t clampedBounds = 0;   ///< per-block bounds moved into the parameter ranges
   std::int64_t fallbackBlocks = 0;  ///< skeleton blocks subdivided with OBB instead
   std::int64_t premadeBlocks = 0;   ///< entries whose outcome was made elsewhere (GenerateRequest::premade)
+  std::int64_t reusedBlocks = 0;    ///< entries whose outcome an earlier run had made (GenerateRequest::reusable)
   std::int64_t patioParcels = 0;    ///< parcels that are (parts of) patios
   /// Per parcel, 1 where it is land the style left unassigned (see
   /// Subdivision::unassignedParcels): written with role "unassigned", drawn
@@ -209,6 +218,12 @@ struct PremadeBlock {
   bool made = false;  ///< false: left to the run
   Key plan = 0;       ///< planKey of the plan it was made under
   BlockOutcome outcome;
+};
+
+/// Outcomes of runs on the same blocks, per block entry, by the planKey of
+/// the plan each was made under (equal plans give equal outcomes).
+struct OutcomeLibrary {
+  std::vector<std::map<Key, BlockOutcome>> byEntry;
 };
 
 /// What runBlock may reuse from the block's last run.
