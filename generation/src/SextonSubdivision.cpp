@@ -328,7 +328,7 @@ public:
     // allowance pays for each interior parcel made: a piece without street
     // access, less the parcel split when it had none itself.
     auto apply = [&](std::size_t pick, Lots& pieces) {
-      std::size_t made = road[pick].empty() && !lots.onRoad[pick] ? 0 : 1;
+      std::size_t made = lots.onRoad[pick] ? 1 : 0;
       std::size_t without = 0;
       for (char on : pieces.onRoad) without += !on;
       made = without + made > 1 ? without + made - 1 : 0;
@@ -361,7 +361,7 @@ public:
             first ? largest : static_cast<std::size_t>(rng.uniform() * static_cast<double>(parcels.size()));
         Lots pieces;
         for (int attempt = 0; attempt < (first ? kAttempts : 1) && pieces.empty(); ++attempt) {
-          pieces = trySplit(parcels[pick], areas[pick], aspectOf(lots.boxes[pick]), road[pick],
+          pieces = trySplit(parcels[pick], areas[pick], aspectOf(lots.boxes[pick]), lots.onRoad[pick], road[pick],
                             target + 1 - parcels.size(), static_cast<Relax>(level), rng);
         }
         if (pieces.empty()) continue;
@@ -391,16 +391,23 @@ public:
   void setScanBudget(std::size_t scans) { scansLeft_ = scans; }
 
 private:
+  // Which pieces of a split must have road access: all (the paper's
+  // splits); all but one, of two (the back piece of a cut along the street);
+  // none, of an interior parcel's split, as many lacking it as the block's
+  // interior allowance pays for.
+  enum class Access { All, Back, Interior };
+
   // A random split of `parcel` across one of its road-facing sides, or
-  // nothing when it breaks one of the paper's constraints.
-  // `aspect`: the parcel's (box width / length).
-  Lots trySplit(const Polygon& parcel, double parcelArea, double aspect, const std::vector<Side>& road,
+  // nothing when it breaks one of the paper's constraints. `aspect`: the
+  // parcel's (box width / length); `onRoad`: whether it has the least
+  // frontage (else it is an interior parcel, even with a short road side).
+  Lots trySplit(const Polygon& parcel, double parcelArea, double aspect, bool onRoad, const std::vector<Side>& road,
                 std::size_t maxPieces, Relax relax, detail::Rng& rng) {
-    if (road.empty()) {
+    if (!onRoad) {
       // An interior parcel, split again while the block's interior allowance
       // lasts, as the paper splits a parcel but across any of its sides, into
       // pieces that may all lack street access.
-      if (interiorLeft_ == 0 || observedAreas_.empty() || outlineEdges_->sharesAtLeast(parcel, frontage_)) return {};
+      if (interiorLeft_ == 0 || observedAreas_.empty()) return {};
       const std::vector<Side> sides = detail::sidesOf(parcel.outer);
       if (sides.empty()) return {};
       const Side& s = sides[static_cast<std::size_t>(rng.uniform() * static_cast<double>(sides.size()))];
@@ -409,9 +416,9 @@ private:
           observedAreas_[static_cast<std::size_t>(rng.uniform() * static_cast<double>(observedAreas_.size()))];
       double f = std::clamp(drawn / parcelArea, 0.05, 0.95);
       if (rng.uniform() < 0.5) f = 1 - f;
-      const SplitLine line{{s.a.x + f * (s.b.x - s.a.x), s.a.y + f * (s.b.y - s.a.y)}, {-s.dir.y, s.dir.x}};
-      return cutAlong(parcel, parcelArea, aspect, line, maxPieces, relax, Access::Interior);
+      return splitAt(parcel, parcelArea, aspect, s, f, maxPieces, relax, Access::Interior);
     }
+    if (road.empty()) return {};  // frontage along edges, but no side wholly on the street
     const Side& s = road[static_cast<std::size_t>(rng.uniform() * static_cast<double>(road.size()))];
     if (interiorLeft_ > 0 && depth_ > 0 && rng.uniform() < interiorShare_) {
       // Along the street, at the observed depth: the back piece an interior parcel.
@@ -450,16 +457,10 @@ private:
 
   // The split of `parcel` at right angles to road side `s`, at fraction `f` along it.
   Lots splitAt(const Polygon& parcel, double parcelArea, double aspect, const Side& s, double f, std::size_t maxPieces,
-               Relax relax) {
+               Relax relax, Access access = Access::All) {
     const SplitLine line{{s.a.x + f * (s.b.x - s.a.x), s.a.y + f * (s.b.y - s.a.y)}, {-s.dir.y, s.dir.x}};
-    return cutAlong(parcel, parcelArea, aspect, line, maxPieces, relax, Access::All);
+    return cutAlong(parcel, parcelArea, aspect, line, maxPieces, relax, access);
   }
-
-  // Which pieces of a split must have road access: all (the paper's
-  // splits); all but one, of two (the back piece of a cut along the street);
-  // none, of an interior parcel's split, as many lacking it as the block's
-  // interior allowance pays for.
-  enum class Access { All, Back, Interior };
 
   // The split of `parcel` (aspect `before`) by `line`, when admissible.
   Lots cutAlong(const Polygon& parcel, double parcelArea, double before, const SplitLine& line, std::size_t maxPieces,
