@@ -17,7 +17,8 @@
 // --labels: then, training labels (calibrated, or each block's own best
 // style) and choices (the vote, or one of the nearest drawn at random).
 // --quantiles: then, percentiles of area, width and aspect ratio, observed,
-// the paper's rule and the rule with the city left out.
+// the paper's rule and the rule with the city left out; per style the left-out
+// rule picks, its parcels' aspect ratios and widths beside the observed ones.
 #include <algorithm>
 #include <array>
 #include <cmath>
