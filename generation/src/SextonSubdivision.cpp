@@ -328,11 +328,10 @@ public:
     // allowance pays for each interior parcel made: a piece without street
     // access, less the parcel split when it had none itself.
     auto apply = [&](std::size_t pick, Lots& pieces) {
-      std::size_t made = lots.onRoad[pick] ? 1 : 0;
+      const std::size_t replaced = lots.onRoad[pick] ? 0 : 1;  // interior parcels the split replaces
       std::size_t without = 0;
       for (char on : pieces.onRoad) without += !on;
-      made = without + made > 1 ? without + made - 1 : 0;
-      interiorLeft_ -= std::min(interiorLeft_, made);
+      interiorLeft_ -= std::min(interiorLeft_, without > replaced ? without - replaced : 0);
       for (std::size_t k = 0; k < pieces.size(); ++k) {
         const std::size_t at = k == 0 ? pick : lots.size();
         if (k > 0) {
