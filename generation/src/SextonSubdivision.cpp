@@ -84,7 +84,8 @@ SextonParameters sextonParametersFrom(const ParameterValues& v) {
 constexpr double kOblong = 0.5;                    // blocks narrower than 1:2 (box width / length) get a spine
 constexpr double kSpineTurn = 20.0 * kPi / 180.0;  // spine simplification: summed turning before a new vertex
 constexpr double kMinAreaShare = 0.75;             // of a-min, the smallest parcel a split may make
-constexpr double kSquareEnough = 0.25;             // aspect (width / length) limit of the rectangularity rule
+constexpr double kSmallestQuantile = 0.05;  // of the observed areas: the block's smallest parcel (smallestObserved)
+constexpr double kSquareEnough = 0.25;      // aspect (width / length) limit of the rectangularity rule
 // Aspect (width / length) no piece goes below, even with the constraints
 // relaxed, in a block without observed parcels (see leastAspect).
 constexpr double kSliverAspect = 0.1;
@@ -106,6 +107,18 @@ double leastAspect(const ObservedSample* observed) {
   std::nth_element(ratios.begin(), at, ratios.end());
   return std::min(kSquareEnough, 1.0 / *at);
 }
+// The paper's smallest parcel of the block, robustly: the block's observed
+// parcels' 5th percentile of area (infinite without observed parcels). The
+// derived a-min (mean - k sd) is floored at a tenth of the mean, far above the
+// small parcels of a block of heavy-tailed areas.
+double smallestObserved(const ObservedSample* observed) {
+  if (!observed || observed->areas.empty()) return std::numeric_limits<double>::infinity();
+  std::vector<double> a = observed->areas;
+  const auto at = a.begin() + static_cast<long>(kSmallestQuantile * static_cast<double>(a.size() - 1));
+  std::nth_element(a.begin(), at, a.end());
+  return *at;
+}
+constexpr double kHoleShift = 0.1;      // of a box's length: how far an interior cut moves to miss a hole
 constexpr double kMinPieceShare = 0.3;  // of the parcel split, each piece's least area
 constexpr double kPositionSd = 0.15;    // of the side's length: spread of the split position about its middle
 constexpr int kAttempts = 10;           // random splits tried on one parcel
@@ -139,7 +152,11 @@ struct Lots {
   std::vector<double> areas;
   std::vector<OrientedBox> boxes;  // minimum-area boxes
   std::vector<char> onRoad;        // sharing at least the least frontage with the block's contour
+  // Of an interior parcel, the observed areas drawn for the parcels it is to
+  // become (empty: none drawn yet; one: it is one of them, and done).
+  std::vector<std::vector<double>> wanted;
   bool empty() const { return polygons.empty(); }
+  bool done(std::size_t i) const { return !onRoad[i] && wanted[i].size() == 1; }
   std::size_t size() const { return polygons.size(); }
 };
 
@@ -297,6 +314,7 @@ public:
         interiorShare_ = std::clamp(1 - observed->accessShare, 0.0, 1.0);
       }
     }
+    minArea_ = kMinAreaShare * std::min(p.aMin, smallestObserved(observed));
     const Box b = bounds(block);
     tolerance_ = std::max(1e-6, 1e-9 * (b.width() + b.height()));
     outlineEdges_ = std::make_unique<analysis::PreparedBoundary>(outline_, tolerance_);
@@ -319,6 +337,7 @@ public:
       lots.areas.push_back(area(q));
       lots.boxes.push_back(minimumAreaBox(q.outer));
       lots.onRoad.push_back(outlineEdges_->sharesAtLeast(q, frontage_));
+      lots.wanted.emplace_back();
       road.push_back(roadSides(q));
     }
     const std::vector<Polygon>& parcels = lots.polygons;
@@ -339,19 +358,25 @@ public:
           lots.areas.push_back(0);
           lots.boxes.emplace_back();
           lots.onRoad.push_back(0);
+          lots.wanted.emplace_back();
           road.emplace_back();
         }
         lots.polygons[at] = std::move(pieces.polygons[k]);
         lots.areas[at] = pieces.areas[k];
         lots.boxes[at] = pieces.boxes[k];
         lots.onRoad[at] = pieces.onRoad[k];
+        lots.wanted[at] = k < pieces.wanted.size() ? std::move(pieces.wanted[k]) : std::vector<double>{};
         road[at] = roadSides(lots.polygons[at]);
       }
     };
     while (parcels.size() < target) {
-      // The largest parcel first; when it takes no split, random ones; when
-      // none does, again with the constraints relaxed one by one (see Relax).
-      const auto largest = static_cast<std::size_t>(std::max_element(areas.begin(), areas.end()) - areas.begin());
+      // The largest parcel not done first; when it takes no split, random
+      // ones; when none does, again with the constraints relaxed one by one
+      // (see Relax).
+      std::size_t largest = 0;
+      for (std::size_t i = 1; i < parcels.size(); ++i) {
+        if (lots.done(largest) || (!lots.done(i) && areas[i] > areas[largest])) largest = i;
+      }
       bool done = false;
       for (int round = relaxed * (kAttempts + 1); round < kRelaxLevels * (kAttempts + 1) && !done; ++round) {
         const int level = round / (kAttempts + 1);
@@ -360,8 +385,8 @@ public:
             first ? largest : static_cast<std::size_t>(rng.uniform() * static_cast<double>(parcels.size()));
         Lots pieces;
         for (int attempt = 0; attempt < (first ? kAttempts : 1) && pieces.empty(); ++attempt) {
-          pieces = trySplit(parcels[pick], areas[pick], aspectOf(lots.boxes[pick]), lots.onRoad[pick], road[pick],
-                            target + 1 - parcels.size(), static_cast<Relax>(level), rng);
+          pieces = trySplit(parcels[pick], areas[pick], lots.boxes[pick], lots.onRoad[pick], road[pick],
+                            lots.wanted[pick], target + 1 - parcels.size(), static_cast<Relax>(level), rng);
         }
         if (pieces.empty()) continue;
         relaxed = level;
@@ -374,7 +399,9 @@ public:
         // A block's scans are bounded (scansLeft_): a try without any left stops short.
         if (scansLeft_ == 0) break;
         --scansLeft_;
+        scanning_ = true;
         auto [pick, pieces] = scanSplit(lots, road, target + 1 - parcels.size());
+        scanning_ = false;
         if (pieces.empty()) break;  // no parcel takes an admissible split
         relaxed = kRelaxLevels - 1;
         apply(pick, pieces);
@@ -396,27 +423,31 @@ private:
   // interior allowance pays for.
   enum class Access { All, Back, Interior };
 
-  // A random split of `parcel` across one of its road-facing sides, or
-  // nothing when it breaks one of the paper's constraints. `aspect`: the
-  // parcel's (box width / length); `onRoad`: whether it has the least
-  // frontage (else it is an interior parcel, even with a short road side).
-  Lots trySplit(const Polygon& parcel, double parcelArea, double aspect, bool onRoad, const std::vector<Side>& road,
-                std::size_t maxPieces, Relax relax, detail::Rng& rng) {
-    if (!onRoad) {
-      // An interior parcel, split again while the block's interior allowance
-      // lasts, as the paper splits a parcel but across any of its sides, into
-      // pieces that may all lack street access.
-      if (interiorLeft_ == 0 || observedAreas_.empty()) return {};
-      const std::vector<Side> sides = detail::sidesOf(parcel.outer);
-      if (sides.empty()) return {};
-      const Side& s = sides[static_cast<std::size_t>(rng.uniform() * static_cast<double>(sides.size()))];
-      // The piece cut off: the area of one of the block's observed parcels, drawn at random.
-      const double drawn =
-          observedAreas_[static_cast<std::size_t>(rng.uniform() * static_cast<double>(observedAreas_.size()))];
-      double f = std::clamp(drawn / parcelArea, 0.05, 0.95);
-      if (rng.uniform() < 0.5) f = 1 - f;
-      return splitAt(parcel, parcelArea, aspect, s, f, maxPieces, relax, Access::Interior);
+  // The areas of observed parcels, drawn at random, that an interior parcel
+  // of area `parcelArea` is to become: drawn until they sum to about its
+  // area (the last one kept when that brings the sum closer), at most `most`.
+  std::vector<double> drawAreas(double parcelArea, std::size_t most, detail::Rng& rng) const {
+    std::vector<double> drawn;
+    double sum = 0;
+    while (sum < parcelArea && drawn.size() < std::max<std::size_t>(1, most)) {
+      drawn.push_back(
+          observedAreas_[static_cast<std::size_t>(rng.uniform() * static_cast<double>(observedAreas_.size()))]);
+      sum += drawn.back();
     }
+    if (drawn.size() > 1 && sum - parcelArea > parcelArea - (sum - drawn.back())) drawn.pop_back();
+    return drawn;
+  }
+
+  // A random split of `parcel` across one of its road-facing sides, or
+  // nothing when it breaks one of the paper's constraints. `box`: the
+  // parcel's minimum-area box; `onRoad`: whether it has the least frontage
+  // (else it is an interior parcel, even with a short road side); `wanted`:
+  // an interior parcel's drawn areas (see Lots).
+  Lots trySplit(const Polygon& parcel, double parcelArea, const OrientedBox& box, bool onRoad,
+                const std::vector<Side>& road, std::vector<double>& wanted, std::size_t maxPieces, Relax relax,
+                detail::Rng& rng) {
+    const double aspect = aspectOf(box);
+    if (!onRoad) return splitInterior(parcel, parcelArea, box, wanted, maxPieces, relax, rng);
     if (road.empty()) return {};  // frontage along edges, but no side wholly on the street
     const Side& s = road[static_cast<std::size_t>(rng.uniform() * static_cast<double>(road.size()))];
     if (interiorLeft_ > 0 && depth_ > 0 && rng.uniform() < interiorShare_) {
@@ -428,6 +459,55 @@ private:
     }
     const double f = std::clamp(0.5 + kPositionSd * rng.normal(), 0.05, 0.95);
     return splitAt(parcel, parcelArea, aspect, s, f, maxPieces, relax);
+  }
+
+  // An interior parcel, split again while the block's interior allowance
+  // lasts into pieces that may all lack street access: the observed areas it
+  // is to become (`wanted`, drawn when none are) are shuffled into two groups,
+  // and the parcel is cut across its box's long axis where the first group's
+  // share of their sum falls; each piece takes its group. A parcel to become
+  // one drawn area is done; a list that gives no admissible cut is drawn again
+  // at the next attempt.
+  Lots splitInterior(const Polygon& parcel, double parcelArea, const OrientedBox& box, std::vector<double>& wanted,
+                     std::size_t maxPieces, Relax relax, detail::Rng& rng) {
+    if (interiorLeft_ == 0 || observedAreas_.empty() || !(box.length > 0)) return {};
+    if (wanted.empty()) wanted = drawAreas(parcelArea, maxPieces, rng);
+    if (wanted.size() < 2) return {};
+    // Two groups of about equal sums, largest area first, each to the lighter
+    // group, on a random side of the line.
+    std::sort(wanted.begin(), wanted.end(), std::greater<>());
+    std::vector<double> group[2];
+    double sum[2] = {0, 0};
+    for (double a : wanted) {
+      const int g = sum[1] < sum[0] ? 1 : 0;
+      group[g].push_back(a);
+      sum[g] += a;
+    }
+    if (rng.uniform() < 0.5) {
+      std::swap(group[0], group[1]);
+      std::swap(sum[0], sum[1]);
+    }
+    const double at = (sum[0] / (sum[0] + sum[1]) - 0.5) * box.length;  // from the box's centre
+    const SplitLine line{{box.center.x + at * box.u.x, box.center.y + at * box.u.y}, {-box.u.y, box.u.x}};
+    Lots pieces = cutAlong(parcel, parcelArea, aspectOf(box), line, maxPieces, relax, Access::Interior);
+    if (pieces.empty()) {
+      // No admissible cut: the smallest area drawn joins the largest, the
+      // parcel is to become one parcel fewer.
+      wanted.front() += wanted.back();
+      wanted.pop_back();
+      return {};
+    }
+    if (pieces.size() == 2) {
+      // The piece before the line along the box's axis takes the first group.
+      auto along = [&](const OrientedBox& b) {
+        return (b.center.x - box.center.x) * box.u.x + (b.center.y - box.center.y) * box.u.y;
+      };
+      const bool swapped = along(pieces.boxes[0]) > along(pieces.boxes[1]);
+      pieces.wanted.assign(2, {});
+      pieces.wanted[swapped ? 1 : 0] = std::move(group[0]);
+      pieces.wanted[swapped ? 0 : 1] = std::move(group[1]);
+    }
+    return pieces;
   }
 
   // The first admissible split, at the most relaxed level, of the
@@ -478,7 +558,7 @@ private:
       measured.onRoad.clear();
       for (const Polygon& q : pieces) {
         const double a = area(q);
-        if (a < kMinAreaShare * p_.aMin) return false;  // minimum size
+        if (a < minArea_) return false;  // minimum size
         if (relax < Relax::Variation && access != Access::Interior && a < kMinPieceShare * parcelArea) {
           return false;  // limited variation
         }
@@ -510,9 +590,11 @@ private:
     };
     // Random lines are many: one the floating-point split cannot make (it meets
     // a hole) is dropped rather than made exactly, except on parcels without
-    // holes, where that happens only for a line through a vertex, and once the
-    // constraints are relaxed as far as they go.
-    const bool exact = parcel.holes.empty() || relax == Relax::Rectangularity;
+    // holes, where that happens only for a line through a vertex. Only the
+    // scan's lines (scanSplit) meeting a hole are made exactly: random ones
+    // at every level took seoul_jamsil's holed block about ten times as long,
+    // for parcels no closer to the observed ones.
+    const bool exact = parcel.holes.empty() || scanning_;
     measured.polygons = detail::splitLot(parcel, parcelArea, line, exact, admissible);
     if (measured.polygons.empty()) return {};
     return measured;
@@ -554,10 +636,12 @@ private:
   std::vector<double> observedAreas_;  // with interior parcels: the observed parcels' areas
   std::size_t interiorLeft_ = 0;       // interior parcels this try may still make
   double tolerance_ = 1e-6;
+  double minArea_ = 0;  // the least area of a piece
   double frontage_ = 1;
   std::unique_ptr<analysis::PreparedBoundary> outlineEdges_;
   BoxTree<std::size_t> outlineTree_;  // the outer contour's edges, by index
   std::size_t scansLeft_ = 0;
+  bool scanning_ = false;  // in scanSplit: lines meeting a hole are made with the exact split
   std::uint64_t work_ = 0;
 };
 
