@@ -90,6 +90,13 @@ constexpr double kSquareEnough = 0.25;      // aspect (width / length) limit of 
 // relaxed, in a block without observed parcels (see leastAspect).
 constexpr double kSliverAspect = 0.1;
 
+// The value at quantile `q` of `values` (rank q (n - 1), rounded down); `values` non-empty.
+double quantileOf(std::vector<double> values, double q) {
+  const auto at = values.begin() + static_cast<long>(q * static_cast<double>(values.size() - 1));
+  std::nth_element(values.begin(), at, values.end());
+  return *at;
+}
+
 // The least aspect (width / length) a piece may have with the constraints
 // relaxed: that of the block's observed parcels at their 90th percentile of
 // aspect ratio (length / width), at most kSquareEnough; kSliverAspect without
@@ -103,9 +110,7 @@ double leastAspect(const ObservedSample* observed) {
     }
   }
   if (ratios.empty()) return kSliverAspect;
-  const auto at = ratios.begin() + static_cast<long>(0.9 * static_cast<double>(ratios.size() - 1));
-  std::nth_element(ratios.begin(), at, ratios.end());
-  return std::min(kSquareEnough, 1.0 / *at);
+  return std::min(kSquareEnough, 1.0 / quantileOf(std::move(ratios), 0.9));
 }
 // The paper's smallest parcel of the block, robustly: the block's observed
 // parcels' 5th percentile of area (infinite without observed parcels). The
@@ -113,12 +118,8 @@ double leastAspect(const ObservedSample* observed) {
 // small parcels of a block of heavy-tailed areas.
 double smallestObserved(const ObservedSample* observed) {
   if (!observed || observed->areas.empty()) return std::numeric_limits<double>::infinity();
-  std::vector<double> a = observed->areas;
-  const auto at = a.begin() + static_cast<long>(kSmallestQuantile * static_cast<double>(a.size() - 1));
-  std::nth_element(a.begin(), at, a.end());
-  return *at;
+  return quantileOf(observed->areas, kSmallestQuantile);
 }
-constexpr double kHoleShift = 0.1;      // of a box's length: how far an interior cut moves to miss a hole
 constexpr double kMinPieceShare = 0.3;  // of the parcel split, each piece's least area
 constexpr double kPositionSd = 0.15;    // of the side's length: spread of the split position about its middle
 constexpr int kAttempts = 10;           // random splits tried on one parcel
