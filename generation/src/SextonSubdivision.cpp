@@ -52,7 +52,7 @@ const std::vector<ParameterDescription>& sextonParameterDescriptions() {
     all.push_back(enumParameter(
         "interior-parcels",
         "sexton: none, every parcel on a street (the paper); observed, as many parcels without street access as "
-        "the block's observed share, cut off along the street at the observed parcels' median length",
+        "the block's observed share, behind a street front as deep as its observed street parcels are long",
         {"none", "observed"}, "observed", "Subdivision"));
     return all;
   }();
@@ -156,8 +156,11 @@ struct Lots {
   // Of an interior parcel, the observed areas drawn for the parcels it is to
   // become (empty: none drawn yet; one: it is one of them, and done).
   std::vector<std::vector<double>> wanted;
+  // Of a road parcel, once the block has its observed share of them: no cut
+  // along the street left it an interior piece, so it is not split again.
+  std::vector<char> closed;
   bool empty() const { return polygons.empty(); }
-  bool done(std::size_t i) const { return !onRoad[i] && wanted[i].size() == 1; }
+  bool done(std::size_t i) const { return closed[i] || (!onRoad[i] && wanted[i].size() == 1); }
   std::size_t size() const { return polygons.size(); }
 };
 
@@ -300,18 +303,28 @@ class SextonSubdivider {
 public:
   SextonSubdivider(const Polygon& block, const SextonParameters& p, const ObservedSample* observed)
       : block_(block), outline_{block.outer, {}}, p_(p), leastAspect_(leastAspect(observed)) {
-    // Interior parcels: the block's observed share without street access, at
-    // the observed parcels' median length from the street.
+    // Interior parcels: the block's observed share without street access,
+    // behind a street front as deep as its observed street parcels are long
+    // (their median length), split into the areas of its observed interior
+    // parcels. Where access per parcel is unknown, or one kind is missing,
+    // all the observed parcels stand for both.
     if (p.interior && observed && std::isfinite(observed->accessShare)) {
-      std::vector<double> lengths;
+      const bool byAccess = observed->access.size() == observed->areas.size();
+      auto front = [&](std::size_t i) { return !byAccess || observed->access[i] != 0; };
+      std::vector<double> lengths, all;
       for (std::size_t i = 0; i < observed->widths.size() && i < observed->aspectRatios.size(); ++i) {
         const double l = observed->widths[i] * observed->aspectRatios[i];
-        if (std::isfinite(l) && l > 0) lengths.push_back(l);
+        if (!std::isfinite(l) || !(l > 0)) continue;
+        all.push_back(l);
+        if (front(i)) lengths.push_back(l);
       }
+      if (lengths.empty()) lengths = std::move(all);
       if (!lengths.empty()) {
-        std::nth_element(lengths.begin(), lengths.begin() + static_cast<long>(lengths.size() / 2), lengths.end());
-        depth_ = lengths[lengths.size() / 2];
-        observedAreas_ = observed->areas;
+        depth_ = quantileOf(std::move(lengths), 0.5);
+        for (std::size_t i = 0; i < observed->areas.size(); ++i) {
+          if (!byAccess || observed->access[i] == 0) observedAreas_.push_back(observed->areas[i]);
+        }
+        if (observedAreas_.empty()) observedAreas_ = observed->areas;
         interiorShare_ = std::clamp(1 - observed->accessShare, 0.0, 1.0);
       }
     }
@@ -332,6 +345,10 @@ public:
   Lots subdivide(const std::vector<Polygon>& start, std::size_t target, detail::Rng rng) {
     Lots lots;
     interiorLeft_ = static_cast<std::size_t>(std::floor(interiorShare_ * static_cast<double>(target)));
+    // Road parcels the block is to have; once there are as many, a road
+    // parcel is only cut along the street (its back piece interior).
+    const std::size_t roadWanted = target - std::min(target, interiorLeft_);
+    std::size_t roadMade = 0;
     std::vector<std::vector<Side>> road;  // each parcel's road-facing sides
     for (const Polygon& q : start) {
       lots.polygons.push_back(q);
@@ -339,7 +356,9 @@ public:
       lots.boxes.push_back(minimumAreaBox(q.outer));
       lots.onRoad.push_back(outlineEdges_->sharesAtLeast(q, frontage_));
       lots.wanted.emplace_back();
+      lots.closed.push_back(0);
       road.push_back(roadSides(q));
+      roadMade += lots.onRoad.back() ? 1 : 0;
     }
     const std::vector<Polygon>& parcels = lots.polygons;
     const std::vector<double>& areas = lots.areas;
@@ -352,6 +371,8 @@ public:
       std::size_t without = 0;
       for (char on : pieces.onRoad) without += !on;
       interiorLeft_ -= std::min(interiorLeft_, without > replaced ? without - replaced : 0);
+      roadMade += pieces.size() - without;
+      roadMade -= lots.onRoad[pick] ? 1 : 0;
       for (std::size_t k = 0; k < pieces.size(); ++k) {
         const std::size_t at = k == 0 ? pick : lots.size();
         if (k > 0) {
@@ -360,6 +381,7 @@ public:
           lots.boxes.emplace_back();
           lots.onRoad.push_back(0);
           lots.wanted.emplace_back();
+          lots.closed.push_back(0);
           road.emplace_back();
         }
         lots.polygons[at] = std::move(pieces.polygons[k]);
@@ -367,6 +389,7 @@ public:
         lots.boxes[at] = pieces.boxes[k];
         lots.onRoad[at] = pieces.onRoad[k];
         lots.wanted[at] = k < pieces.wanted.size() ? std::move(pieces.wanted[k]) : std::vector<double>{};
+        lots.closed[at] = 0;
         road[at] = roadSides(lots.polygons[at]);
       }
     };
@@ -385,9 +408,17 @@ public:
         const std::size_t pick =
             first ? largest : static_cast<std::size_t>(rng.uniform() * static_cast<double>(parcels.size()));
         Lots pieces;
+        roadOnly_ = roadMade >= roadWanted && interiorLeft_ > 0;
         for (int attempt = 0; attempt < (first ? kAttempts : 1) && pieces.empty(); ++attempt) {
           pieces = trySplit(parcels[pick], areas[pick], lots.boxes[pick], lots.onRoad[pick], road[pick],
                             lots.wanted[pick], target + 1 - parcels.size(), static_cast<Relax>(level), rng);
+        }
+        if (pieces.empty() && first && roadOnly_ && lots.onRoad[pick] && !lots.done(pick)) {
+          // A road parcel too shallow for a cut along the street, once the
+          // block has its road parcels: closed, and the next largest is split.
+          lots.closed[pick] = 1;
+          done = true;
+          break;
         }
         if (pieces.empty()) continue;
         relaxed = level;
@@ -451,12 +482,12 @@ private:
     if (!onRoad) return splitInterior(parcel, parcelArea, box, wanted, maxPieces, relax, rng);
     if (road.empty()) return {};  // frontage along edges, but no side wholly on the street
     const Side& s = road[static_cast<std::size_t>(rng.uniform() * static_cast<double>(road.size()))];
-    if (interiorLeft_ > 0 && depth_ > 0 && rng.uniform() < interiorShare_) {
+    if (interiorLeft_ > 0 && depth_ > 0 && (roadOnly_ || rng.uniform() < interiorShare_)) {
       // Along the street, at the observed depth: the back piece an interior parcel.
       const Point mid{0.5 * (s.a.x + s.b.x), 0.5 * (s.a.y + s.b.y)}, inward{-s.dir.y, s.dir.x};
       const SplitLine line{{mid.x + depth_ * inward.x, mid.y + depth_ * inward.y}, s.dir};
       Lots pieces = cutAlong(parcel, parcelArea, aspect, line, maxPieces, relax, Access::Back);
-      if (!pieces.empty()) return pieces;
+      if (!pieces.empty() || roadOnly_) return pieces;
     }
     const double f = std::clamp(0.5 + kPositionSd * rng.normal(), 0.05, 0.95);
     return splitAt(parcel, parcelArea, aspect, s, f, maxPieces, relax);
@@ -633,9 +664,10 @@ private:
   SextonParameters p_;
   double leastAspect_ = kSliverAspect;
   double interiorShare_ = 0;           // observed share of parcels without street access
-  double depth_ = 0;                   // observed median parcel length
-  std::vector<double> observedAreas_;  // with interior parcels: the observed parcels' areas
+  double depth_ = 0;                   // the observed street parcels' median length
+  std::vector<double> observedAreas_;  // with interior parcels: the observed interior parcels' areas
   std::size_t interiorLeft_ = 0;       // interior parcels this try may still make
+  bool roadOnly_ = false;              // the block has its road parcels: road parcels only cut along the street
   double tolerance_ = 1e-6;
   double minArea_ = 0;  // the least area of a piece
   double frontage_ = 1;

@@ -201,6 +201,46 @@ TEST(Sexton, InteriorParcelsTakeTheObservedMixtureOfAreas) {
               s.withoutAccess);
 }
 
+// A block of a few large street parcels around many interior houses (as
+// seoul_jamsil's largest block: 52 road parcels of median 8,532 m², 804
+// interior ones of median 314 m²): its street front is as deep as the
+// observed street parcels are long, its interior parcels take the observed
+// interior areas, and once it has its road parcels, a road parcel is only
+// cut along the street.
+TEST(Sexton, TheStreetFrontTakesTheObservedRoadParcels) {
+  const Polygon block = test::rect(0, 0, 500, 500);
+  ObservedSample observed = sampleOf(264, 300, 12, 2.1);  // interior houses
+  observed.access.assign(264, 0);
+  for (int i = 0; i < 16; ++i) {  // street parcels, 100 m deep
+    observed.areas.push_back(5000);
+    observed.widths.push_back(50);
+    observed.aspectRatios.push_back(2);
+    observed.access.push_back(1);
+  }
+  observed.accessShare = 16.0 / 280.0;
+  const ParameterValues values{{"a-min", 57}, {"w-min", 4}, {"tries", 10}};
+  const Subdivision s = sexton(block, values, 1, &observed);
+  EXPECT_TILES(block, s.parcels, "500 x 500");
+  const int road = static_cast<int>(s.parcels.size()) - s.withoutAccess;
+  int houses = 0;
+  double roadArea = 0;
+  const analysis::PreparedBoundary outline(block, 1e-6);
+  for (const Polygon& p : s.parcels) {
+    houses += area(p) <= 600;
+    if (outline.sharesAtLeast(p, 2.0)) roadArea += area(p);
+  }
+  EXPECT_EQ(test::measuredWithoutAccess(block, s.parcels, 2.0), s.withoutAccess);
+  EXPECT_GE(s.parcels.size(), 250u);
+  // Without the closing of road parcels: 60 on the road, 195 houses (checked).
+  EXPECT_LE(road, 32);  // twice the observed
+  EXPECT_GE(houses, 200);
+  // A front 100 m deep is 64 % of the block. Cut at all the observed
+  // parcels' median length (25 m), the road parcels made 58 % (checked).
+  EXPECT_GE(roadArea, 0.62 * area(block));
+  std::printf("%zu parcels: %d on the road (%.0f %% of the area), %d houses\n", s.parcels.size(), road,
+              100 * roadArea / area(block), houses);
+}
+
 // The least piece is 75 % of the smaller of a-min and the observed 5th
 // percentile of area (the paper: the block's smallest parcel).
 TEST(Sexton, TheLeastPieceFollowsTheObservedSmallParcels) {
