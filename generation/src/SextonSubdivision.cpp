@@ -600,7 +600,7 @@ private:
         measured.boxes.push_back(minimumAreaBox(q.outer));
         const double aspect = aspectOf(measured.boxes.back());
         if (relax < Relax::Rectangularity) {  // limited rectangularity
-          if (before > kSquareEnough ? aspect < kSquareEnough : aspect <= before) return false;
+          if (before > leastAspect_ ? aspect < leastAspect_ : aspect <= before) return false;
         } else if (aspect < leastAspect_ && aspect < before) {
           return false;  // no sliver thinner than the observed ones, where the parcel split was none
         }

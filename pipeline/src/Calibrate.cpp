@@ -81,6 +81,10 @@ public:
       position_[b] = k;
       for (int i : a.blocks[b].parcels) add(observed_, a.metrics[static_cast<std::size_t>(i)]);
       countError_.push_back(countError(choice_[b], b));
+      if (!a.blocks[b].parcels.empty()) {
+        observedTotal_ += a.blocks[b].parcels.size();
+        generatedTotal_ += parcels_[choice_[b]][b].size();
+      }
     }
     for (auto& v : observed_) sortFinite(v);
     std::vector<std::size_t> entries = candidates;
@@ -111,14 +115,14 @@ public:
   FitMeasures with(std::size_t b, std::size_t e) const {
     std::vector<double> errors = countError_;
     errors[position_[b]] = countError(e, b);
-    FitMeasures f = fit(nullptr, std::move(errors));
+    FitMeasures f = fit(nullptr, std::move(errors), generatedTotal_ - counted(choice_[b], b) + counted(e, b));
     double* ks[3] = {&f.ksArea, &f.ksWidth, &f.ksAspectRatio};
     for (std::size_t m = 0; m < 3; ++m) {
       *ks[m] = swappedKs_[m](values_[choice_[b]][b][m], values_[e][b][m]);
     }
     return f;
   }
-  FitMeasures current() const { return fit(&pooled_, countError_); }
+  FitMeasures current() const { return fit(&pooled_, countError_, generatedTotal_); }
 
   /// Makes block `b`'s entry `e`.
   void set(std::size_t b, std::size_t e) {
@@ -127,6 +131,7 @@ public:
       swappedKs_[m] = detail::SwappedKs(observed_[m], pooled_[m]);
     }
     countError_[position_[b]] = countError(e, b);
+    generatedTotal_ = generatedTotal_ - counted(choice_[b], b) + counted(e, b);
     choice_[b] = e;
   }
 
@@ -166,9 +171,17 @@ private:
     if (observed == 0) return NAN;
     return std::fabs(static_cast<double>(parcels_[e][b].size()) / static_cast<double>(observed) - 1);
   }
-  // The measures of `pooled` (null: the KS left NaN, for the caller) and the per-block count errors.
-  FitMeasures fit(const Samples* pooled, std::vector<double> errors) const {
+  // Entry e's parcels in block b, where the block has observed parcels (else none: out of the totals).
+  std::size_t counted(std::size_t e, std::size_t b) const {
+    return board_.observed->analysis.blocks[b].parcels.empty() ? 0 : parcels_[e][b].size();
+  }
+  // The measures of `pooled` (null: the KS left NaN, for the caller), the
+  // per-block count errors and the generated parcels of the blocks with observed ones.
+  FitMeasures fit(const Samples* pooled, std::vector<double> errors, std::size_t generated) const {
     FitMeasures f;
+    if (observedTotal_ > 0) {
+      f.totalCountError = std::fabs(static_cast<double>(generated) / static_cast<double>(observedTotal_) - 1);
+    }
     f.blocks = static_cast<std::int64_t>(blocks_.size());
     if (pooled) {
       f.ksArea = analysis::ksStatistic(observed_[0], (*pooled)[0]);
@@ -190,8 +203,9 @@ private:
   std::vector<std::size_t> position_;         // of each board block in blocks_ (kNone: not measured)
   std::vector<std::vector<Samples>> values_;  // [entry][block], sorted, finite
   Samples observed_, pooled_;
-  std::array<detail::SwappedKs, 3> swappedKs_;  // of each measure's observed and pooled samples
-  std::vector<double> countError_;              // per position in blocks_
+  std::array<detail::SwappedKs, 3> swappedKs_;          // of each measure's observed and pooled samples
+  std::vector<double> countError_;                      // per position in blocks_
+  std::size_t observedTotal_ = 0, generatedTotal_ = 0;  // parcels of the blocks with observed parcels
 };
 
 // The measures over the blocks `blocks`, block b's parcels made by entry `entryOf[b]`.
@@ -342,7 +356,8 @@ std::vector<analysis::ParcelMetrics> generatedMetrics(const Leaderboard& board,
 }
 
 double cityObjective(const FitMeasures& f) {
-  return f.ksArea + f.ksWidth + f.ksAspectRatio + (std::isfinite(f.medianCountError) ? f.medianCountError : 0);
+  return f.ksArea + f.ksWidth + f.ksAspectRatio + (std::isfinite(f.medianCountError) ? f.medianCountError : 0) +
+         (std::isfinite(f.totalCountError) ? f.totalCountError : 0);
 }
 
 double calibrationObjective(const FitMeasures& f, const FitMeasures& paper) {
@@ -568,14 +583,15 @@ Json fitJson(const FitMeasures& f) {
       .set("ks_area", f.ksArea)
       .set("ks_width", f.ksWidth)
       .set("ks_aspect_ratio", f.ksAspectRatio)
-      .set("median_count_error", f.medianCountError);
+      .set("median_count_error", f.medianCountError)
+      .set("total_count_error", f.totalCountError);
 }
 
 std::string fitText(const FitMeasures& f) {
   std::ostringstream s;
   s.precision(3);
   s << "KS area " << f.ksArea << ", width " << f.ksWidth << ", aspect ratio " << f.ksAspectRatio
-    << ", median |n/n_obs - 1| " << f.medianCountError;
+    << ", median |n/n_obs - 1| " << f.medianCountError << ", total |N/N_obs - 1| " << f.totalCountError;
   return s.str();
 }
 

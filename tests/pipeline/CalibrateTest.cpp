@@ -65,6 +65,12 @@ TEST(Calibrate, CalibratedStylesLowerTheCityObjectiveAndTheSessionReproducesThem
     }
   }
   EXPECT_EQ(improvable, 0);
+  // The total count error: every generated parcel against every observed one.
+  std::size_t observedParcels = 0;
+  for (const auto& block : c.board.observed->analysis.blocks) observedParcels += block.parcels.size();
+  const auto generatedParcels = static_cast<double>(generatedMetrics(c.board, after).size());
+  EXPECT_NEAR(c.after.totalCountError, std::fabs(generatedParcels / static_cast<double>(observedParcels) - 1), 1e-12);
+  EXPECT_LE(c.after.totalCountError, c.before.totalCountError + 0.05);
   // No worse than any of its starts: each block's style of least distance, of
   // least count error, and the paper's rule.
   std::vector<std::size_t> nearest(n), counted(n);
