@@ -269,6 +269,13 @@ TEST(Sexton, RandomShapesWithInteriorParcelsTile) {
     ObservedSample observed = sampleOf(n, a / static_cast<double>(n), std::sqrt(a / static_cast<double>(n) / 1.5), 1.5);
     for (double& o : observed.areas) o *= 0.3 + 1.4 * static_cast<double>(rng() % 1000) / 1000.0;
     observed.accessShare = 0.2 + 0.6 * static_cast<double>(rng() % 1000) / 1000.0;
+    if (i % 2 == 1) {  // half the shapes know each observed parcel's access, in the share
+      const auto with = static_cast<std::size_t>(std::round(observed.accessShare * static_cast<double>(n)));
+      observed.access.assign(n, 0);
+      for (std::size_t k = 0; k < with; ++k) observed.access[k] = 1;
+      for (std::size_t k = 0; k < n; ++k) observed.aspectRatios[k] *= observed.access[k] ? 1.5 : 1;
+      observed.accessShare = static_cast<double>(with) / static_cast<double>(n);
+    }
     const std::uint64_t seed = rng();
     const ParameterValues values = {{"a-min", 0.2 * a / static_cast<double>(n)}, {"w-min", 1}, {"tries", 3}};
     const Subdivision s = sexton(block, values, seed, &observed);
