@@ -838,10 +838,11 @@ void MainWindow::fitToObserved() {
     if (!error.isEmpty()) return showError(error);
     controller_.setOverrides(made->session.overrides);
     auto text = [](const pipeline::FitMeasures& f) {
-      return QString("KS area %1, width %2, aspect ratio %3")
+      return QString("KS area %1, width %2, aspect ratio %3, total count error %4")
           .arg(f.ksArea, 0, 'f', 3)
           .arg(f.ksWidth, 0, 'f', 3)
-          .arg(f.ksAspectRatio, 0, 'f', 3);
+          .arg(f.ksAspectRatio, 0, 'f', 3)
+          .arg(f.totalCountError, 0, 'f', 3);
     };
     QStringList chosen;
     for (const auto& [style, blocks] : made->stylesChosen)

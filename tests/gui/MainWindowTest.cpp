@@ -1021,6 +1021,7 @@ private slots:
     QVERIFY(settle());
     QVERIFY2(window_->lastError().isEmpty(), qPrintable(window_->lastError()));
     QVERIFY(window_->notice().contains("After:"));
+    QVERIFY(window_->notice().contains(QString("total count error %1").arg(expected.after.totalCountError, 0, 'f', 3)));
     const auto& overrides = window_->request().overrides;
     QCOMPARE(overrides.size(), expected.session.overrides.size());
     for (const auto& [key, o] : expected.session.overrides) QCOMPARE(overrides.at(key).style, o.style);
