@@ -309,7 +309,9 @@ public:
     // parcels. Where access per parcel is unknown, or one kind is missing,
     // all the observed parcels stand for both.
     if (p.interior && observed && std::isfinite(observed->accessShare)) {
-      const bool byAccess = observed->access.size() == observed->areas.size();
+      const bool byAccess = observed->access.size() == observed->areas.size() &&
+                            observed->access.size() == observed->widths.size() &&
+                            observed->access.size() == observed->aspectRatios.size();
       auto front = [&](std::size_t i) { return !byAccess || observed->access[i] != 0; };
       std::vector<double> lengths, all;
       for (std::size_t i = 0; i < observed->widths.size() && i < observed->aspectRatios.size(); ++i) {
@@ -397,6 +399,14 @@ public:
       // The largest parcel not done first; when it takes no split, random
       // ones; when none does, again with the constraints relaxed one by one
       // (see Relax).
+      // Road parcels are held to cuts along the street only while an
+      // interior parcel is left to split: otherwise (a block of no observed
+      // road parcels starts as one road parcel; or every interior parcel is
+      // done) the closed ones open again and are split as the paper's are.
+      bool interiorOpen = false;
+      for (std::size_t i = 0; i < parcels.size() && !interiorOpen; ++i) interiorOpen = !lots.onRoad[i] && !lots.done(i);
+      const bool roadOnly = roadMade >= roadWanted && interiorLeft_ > 0 && interiorOpen;
+      if (!roadOnly) std::fill(lots.closed.begin(), lots.closed.end(), 0);
       std::size_t largest = 0;
       for (std::size_t i = 1; i < parcels.size(); ++i) {
         if (lots.done(largest) || (!lots.done(i) && areas[i] > areas[largest])) largest = i;
@@ -408,7 +418,7 @@ public:
         const std::size_t pick =
             first ? largest : static_cast<std::size_t>(rng.uniform() * static_cast<double>(parcels.size()));
         Lots pieces;
-        roadOnly_ = roadMade >= roadWanted && interiorLeft_ > 0;
+        roadOnly_ = roadOnly;
         for (int attempt = 0; attempt < (first ? kAttempts : 1) && pieces.empty(); ++attempt) {
           pieces = trySplit(parcels[pick], areas[pick], lots.boxes[pick], lots.onRoad[pick], road[pick],
                             lots.wanted[pick], target + 1 - parcels.size(), static_cast<Relax>(level), rng);

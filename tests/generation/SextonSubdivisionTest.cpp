@@ -235,10 +235,33 @@ TEST(Sexton, TheStreetFrontTakesTheObservedRoadParcels) {
   EXPECT_LE(road, 32);  // twice the observed
   EXPECT_GE(houses, 200);
   // A front 100 m deep is 64 % of the block. Cut at all the observed
-  // parcels' median length (25 m), the road parcels made 58 % (checked).
+  // parcels' median length (25 m), and with interior parcels split into all
+  // the observed areas, the road parcels made 58 % (checked).
   EXPECT_GE(roadArea, 0.62 * area(block));
   std::printf("%zu parcels: %d on the road (%.0f %% of the area), %d houses\n", s.parcels.size(), road,
               100 * roadArea / area(block), houses);
+}
+
+// A block whose observed parcels are all (or all but one) interior starts as
+// one road parcel, already as many as it is to have: road parcels are held to
+// cuts along the street only while an interior parcel is left to split, so
+// it still reaches its count. Held from the start, it stopped at 49 of 100
+// (checked).
+TEST(Sexton, ABlockOfInteriorParcelsOnlyReachesItsCount) {
+  const Polygon block = test::rect(0, 0, 200, 200);
+  for (const int road : {0, 1}) {
+    ObservedSample observed = sampleOf(100, 400, 16, 1.5);
+    observed.access.assign(100, 0);
+    for (int k = 0; k < road; ++k) observed.access[static_cast<std::size_t>(k)] = 1;
+    observed.accessShare = road / 100.0;
+    const ParameterValues values{{"a-min", 57}, {"w-min", 4}, {"tries", 10}};
+    const Subdivision s = sexton(block, values, 1, &observed);
+    const std::string what = std::to_string(road) + " road parcels observed";
+    EXPECT_TILES(block, s.parcels, what);
+    EXPECT_EQ(s.parcels.size(), 100u) << what;
+    EXPECT_GE(s.withoutAccess, 50) << what;
+    std::printf("%s: %zu parcels, %d without street access\n", what.c_str(), s.parcels.size(), s.withoutAccess);
+  }
 }
 
 // The least piece is 75 % of the smaller of a-min and the observed 5th

@@ -71,6 +71,10 @@ TEST(Calibrate, CalibratedStylesLowerTheCityObjectiveAndTheSessionReproducesThem
   const auto generatedParcels = static_cast<double>(generatedMetrics(c.board, after).size());
   EXPECT_NEAR(c.after.totalCountError, std::fabs(generatedParcels / static_cast<double>(observedParcels) - 1), 1e-12);
   EXPECT_LE(c.after.totalCountError, c.before.totalCountError + 0.05);
+  for (const FitMeasures& f : {c.before, c.after}) {
+    EXPECT_NEAR(cityObjective(f), f.ksArea + f.ksWidth + f.ksAspectRatio + f.medianCountError + f.totalCountError,
+                1e-12);
+  }
   // No worse than any of its starts: each block's style of least distance, of
   // least count error, and the paper's rule.
   std::vector<std::size_t> nearest(n), counted(n);

@@ -85,11 +85,13 @@ double cityObjective(const FitMeasures& f);
 /// Weight of a measure's excess over the paper's rule in calibrationObjective().
 constexpr double kExcessWeight = 10;
 
-/// What the calibration lowers: cityObjective(f), plus the largest of its four
-/// measures (so that no measure is left far behind the others), plus
-/// kExcessWeight times each measure's excess over the paper's rule's `paper`
-/// on the same blocks, so that a calibration that can be better than the
-/// paper's rule on every measure is preferred to one better on the sum only.
+/// What the calibration lowers: cityObjective(f), plus the largest of the
+/// three KS and the median count error (so that no measure is left far behind
+/// the others), plus kExcessWeight times each of those four measures' excess
+/// over the paper's rule's `paper` on the same blocks, so that a calibration
+/// that can be better than the paper's rule on every measure the issue bounds
+/// is preferred to one better on the sum only. The total count error counts
+/// once, in cityObjective().
 double calibrationObjective(const FitMeasures& f, const FitMeasures& paper);
 
 /// Runs every concrete style on `request`'s blocks (request.style is ignored)
