@@ -52,7 +52,7 @@ const std::vector<ParameterDescription>& sextonParameterDescriptions() {
     all.push_back(enumParameter(
         "interior-parcels",
         "sexton: none, every parcel on a street (the paper); observed, as many parcels without street access as "
-        "the block's observed share, behind a street front as deep as its observed street parcels are long",
+        "the block's observed share, behind a street front as deep as its observed street parcels",
         {"none", "observed"}, "observed", "Subdivision"));
     return all;
   }();
@@ -304,8 +304,9 @@ public:
   SextonSubdivider(const Polygon& block, const SextonParameters& p, const ObservedSample* observed)
       : block_(block), outline_{block.outer, {}}, p_(p), leastAspect_(leastAspect(observed)) {
     // Interior parcels: the block's observed share without street access,
-    // behind a street front as deep as its observed street parcels are long
-    // (their median length), split into the areas of its observed interior
+    // behind a street front as deep as its observed street parcels (their
+    // median depth: each one's length, or its area over its frontage where
+    // that is less), split into the areas of its observed interior
     // parcels. Where access per parcel is unknown, or one kind is missing,
     // all the observed parcels stand for both.
     if (p.interior && observed && std::isfinite(observed->accessShare)) {
@@ -315,9 +316,13 @@ public:
       auto front = [&](std::size_t i) { return !byAccess || observed->access[i] != 0; };
       std::vector<double> lengths, all;
       for (std::size_t i = 0; i < observed->widths.size() && i < observed->aspectRatios.size(); ++i) {
-        const double l = observed->widths[i] * observed->aspectRatios[i];
+        double l = observed->widths[i] * observed->aspectRatios[i];
         if (!std::isfinite(l) || !(l > 0)) continue;
         all.push_back(l);
+        // A street parcel's depth: its area over its frontage, where known and shorter than its length.
+        if (byAccess && observed->frontages.size() == observed->areas.size() && observed->frontages[i] > 0) {
+          l = std::min(l, observed->areas[i] / observed->frontages[i]);
+        }
         if (front(i)) lengths.push_back(l);
       }
       if (lengths.empty()) lengths = std::move(all);

@@ -17,6 +17,7 @@ std::shared_ptr<generation::ObservedSample> observedSample(const std::vector<ana
     sample->widths.push_back(m.width);
     sample->aspectRatios.push_back(m.aspectRatio);
     sample->access.push_back(m.streetAccess ? 1 : 0);
+    sample->frontages.push_back(m.frontage);
     with += m.streetAccess;
   }
   if (!sample->areas.empty()) sample->accessShare = with / static_cast<double>(sample->areas.size());

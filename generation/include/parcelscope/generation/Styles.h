@@ -23,11 +23,14 @@ struct ObservedSample {
   std::vector<double> areas, widths, aspectRatios;
   /// Per parcel, 1 where it has street access; empty when unknown.
   std::vector<unsigned char> access;
+  /// Per parcel, its length on the block's outline (m); empty when unknown.
+  std::vector<double> frontages;
   double accessShare = NAN;  ///< share of the parcels with street access; NaN when unknown
   /// The same parcels' values, field by field (an unknown share equals an unknown one).
   bool operator==(const ObservedSample& o) const {
     const bool share = accessShare == o.accessShare || (std::isnan(accessShare) && std::isnan(o.accessShare));
-    return share && areas == o.areas && widths == o.widths && aspectRatios == o.aspectRatios && access == o.access;
+    return share && areas == o.areas && widths == o.widths && aspectRatios == o.aspectRatios && access == o.access &&
+           frontages == o.frontages;
   }
 };
 
