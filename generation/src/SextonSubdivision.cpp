@@ -314,13 +314,14 @@ public:
                             observed->access.size() == observed->widths.size() &&
                             observed->access.size() == observed->aspectRatios.size();
       auto front = [&](std::size_t i) { return !byAccess || observed->access[i] != 0; };
+      const bool withFrontage = byAccess && observed->frontages.size() == observed->areas.size();
       std::vector<double> lengths, all;
       for (std::size_t i = 0; i < observed->widths.size() && i < observed->aspectRatios.size(); ++i) {
         double l = observed->widths[i] * observed->aspectRatios[i];
         if (!std::isfinite(l) || !(l > 0)) continue;
         all.push_back(l);
         // A street parcel's depth: its area over its frontage, where known and shorter than its length.
-        if (byAccess && observed->frontages.size() == observed->areas.size() && observed->frontages[i] > 0) {
+        if (withFrontage && observed->frontages[i] > 0) {
           l = std::min(l, observed->areas[i] / observed->frontages[i]);
         }
         if (front(i)) lengths.push_back(l);
@@ -410,8 +411,8 @@ public:
       // done) the closed ones open again and are split as the paper's are.
       bool interiorOpen = false;
       for (std::size_t i = 0; i < parcels.size() && !interiorOpen; ++i) interiorOpen = !lots.onRoad[i] && !lots.done(i);
-      const bool roadOnly = roadMade >= roadWanted && interiorLeft_ > 0 && interiorOpen;
-      if (!roadOnly) std::fill(lots.closed.begin(), lots.closed.end(), 0);
+      roadOnly_ = roadMade >= roadWanted && interiorLeft_ > 0 && interiorOpen;
+      if (!roadOnly_) std::fill(lots.closed.begin(), lots.closed.end(), 0);
       std::size_t largest = 0;
       for (std::size_t i = 1; i < parcels.size(); ++i) {
         if (lots.done(largest) || (!lots.done(i) && areas[i] > areas[largest])) largest = i;
@@ -423,7 +424,6 @@ public:
         const std::size_t pick =
             first ? largest : static_cast<std::size_t>(rng.uniform() * static_cast<double>(parcels.size()));
         Lots pieces;
-        roadOnly_ = roadOnly;
         for (int attempt = 0; attempt < (first ? kAttempts : 1) && pieces.empty(); ++attempt) {
           pieces = trySplit(parcels[pick], areas[pick], lots.boxes[pick], lots.onRoad[pick], road[pick],
                             lots.wanted[pick], target + 1 - parcels.size(), static_cast<Relax>(level), rng);

@@ -81,10 +81,8 @@ public:
       position_[b] = k;
       for (int i : a.blocks[b].parcels) add(observed_, a.metrics[static_cast<std::size_t>(i)]);
       countError_.push_back(countError(choice_[b], b));
-      if (!a.blocks[b].parcels.empty()) {
-        observedTotal_ += a.blocks[b].parcels.size();
-        generatedTotal_ += parcels_[choice_[b]][b].size();
-      }
+      observedTotal_ += a.blocks[b].parcels.size();
+      generatedTotal_ += counted(choice_[b], b);
     }
     for (auto& v : observed_) sortFinite(v);
     std::vector<std::size_t> entries = candidates;
