@@ -156,6 +156,8 @@ std::vector<std::pair<double, std::size_t>> AutoRule::nearest(const AutoFeatures
 
 const std::string& AutoRule::predict(const AutoFeatures& x) const {
   const auto near = nearest(x, neighbours_);
+  static const std::string far = kFarStyle;
+  if (!near.empty() && near.front().first > kFar * kFar) return far;
   // Each neighbour votes with 1 / its distance: a block at a training row's
   // features takes that row's style (its calibration), others lean to the
   // nearer rows. kVoteFloor keeps a zero distance finite.

@@ -89,6 +89,7 @@ constexpr double kSquareEnough = 0.25;      // aspect (width / length) limit of 
 // Aspect (width / length) no piece goes below, even with the constraints
 // relaxed, in a block without observed parcels (see leastAspect).
 constexpr double kSliverAspect = 0.1;
+constexpr double kThinQuantile = 0.95;  // of the observed aspect ratios: the thinnest piece of the thin quota
 
 // The value at quantile `q` of `values` (rank q (n - 1), rounded down); `values` non-empty.
 double quantileOf(std::vector<double> values, double q) {
@@ -112,6 +113,35 @@ double leastAspect(const ObservedSample* observed) {
   if (ratios.empty()) return kSliverAspect;
   return std::min(kSquareEnough, 1.0 / quantileOf(std::move(ratios), 0.9));
 }
+// The block's thin parcels, those of its observed parcels thinner than
+// `least` (leastAspect), where that is thinner than the paper's 1:4: their
+// share, the aspect (width / length) of the thinnest but a few (the block's
+// 95th percentile of aspect ratio) and their 10th percentile of area. A try
+// may make as many pieces thinner than `least` as that share of its target,
+// down to that aspect and of at least that area.
+struct ThinParcels {
+  double share = 0;
+  double least = kSliverAspect;  // aspect
+  double area = 0;
+};
+ThinParcels thinParcels(const ObservedSample* observed, double least) {
+  ThinParcels t{0, least, 0};
+  if (!observed || least >= kSquareEnough || observed->aspectRatios.size() != observed->areas.size()) return t;
+  std::vector<double> ratios, areas;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < observed->aspectRatios.size(); ++i) {
+    const double r = observed->aspectRatios[i];
+    if (!std::isfinite(r) || r < 1) continue;
+    ++n;
+    ratios.push_back(r);
+    if (1.0 / r < least) areas.push_back(observed->areas[i]);
+  }
+  if (areas.empty()) return t;
+  t.share = static_cast<double>(areas.size()) / static_cast<double>(n);
+  t.least = std::min(least, 1.0 / quantileOf(std::move(ratios), kThinQuantile));
+  t.area = quantileOf(std::move(areas), 0.1);
+  return t;
+}
 // The paper's smallest parcel of the block, robustly: the block's observed
 // parcels' 5th percentile of area (infinite without observed parcels). The
 // derived a-min (mean - k sd) is floored at a tenth of the mean, far above the
@@ -119,6 +149,11 @@ double leastAspect(const ObservedSample* observed) {
 double smallestObserved(const ObservedSample* observed) {
   if (!observed || observed->areas.empty()) return std::numeric_limits<double>::infinity();
   return quantileOf(observed->areas, kSmallestQuantile);
+}
+// `share` of `count`, rounded down; a share of k / n of n parcels is k, not
+// one fewer for its rounding.
+std::size_t shareOf(double share, std::size_t count) {
+  return static_cast<std::size_t>(std::floor(share * static_cast<double>(count) + 1e-9));
 }
 constexpr double kMinPieceShare = 0.3;  // of the parcel split, each piece's least area
 constexpr double kPositionSd = 0.15;    // of the side's length: spread of the split position about its middle
@@ -159,6 +194,9 @@ struct Lots {
   // Of a road parcel, once the block has its observed share of them: no cut
   // along the street left it an interior piece, so it is not split again.
   std::vector<char> closed;
+  // Of the pieces of a split: how many are thinner than the block's least
+  // aspect, admitted on its thin quota.
+  std::size_t thinUsed = 0;
   bool empty() const { return polygons.empty(); }
   bool done(std::size_t i) const { return closed[i] || (!onRoad[i] && wanted[i].size() == 1); }
   std::size_t size() const { return polygons.size(); }
@@ -303,6 +341,7 @@ class SextonSubdivider {
 public:
   SextonSubdivider(const Polygon& block, const SextonParameters& p, const ObservedSample* observed)
       : block_(block), outline_{block.outer, {}}, p_(p), leastAspect_(leastAspect(observed)) {
+    thin_ = thinParcels(observed, leastAspect_);
     // Interior parcels: the block's observed share without street access,
     // behind a street front as deep as its observed street parcels (their
     // median depth: each one's length, or its area over its frontage where
@@ -352,11 +391,12 @@ public:
   // One randomized subdivision from `start`, towards `target` parcels.
   Lots subdivide(const std::vector<Polygon>& start, std::size_t target, detail::Rng rng) {
     Lots lots;
-    interiorLeft_ = static_cast<std::size_t>(std::floor(interiorShare_ * static_cast<double>(target)));
+    interiorLeft_ = shareOf(interiorShare_, target);
     // Road parcels the block is to have; once there are as many, a road
     // parcel is only cut along the street (its back piece interior).
     const std::size_t roadWanted = target - std::min(target, interiorLeft_);
     std::size_t roadMade = 0;
+    thinLeft_ = shareOf(thin_.share, target);
     std::vector<std::vector<Side>> road;  // each parcel's road-facing sides
     for (const Polygon& q : start) {
       lots.polygons.push_back(q);
@@ -381,6 +421,7 @@ public:
       interiorLeft_ -= std::min(interiorLeft_, without > replaced ? without - replaced : 0);
       roadMade += pieces.size() - without;
       roadMade -= lots.onRoad[pick] ? 1 : 0;
+      thinLeft_ -= std::min(thinLeft_, pieces.thinUsed);
       for (std::size_t k = 0; k < pieces.size(); ++k) {
         const std::size_t at = k == 0 ? pick : lots.size();
         if (k > 0) {
@@ -603,6 +644,7 @@ private:
       measured.areas.clear();
       measured.boxes.clear();
       measured.onRoad.clear();
+      measured.thinUsed = 0;
       for (const Polygon& q : pieces) {
         const double a = area(q);
         if (a < minArea_) return false;  // minimum size
@@ -614,10 +656,16 @@ private:
       for (const Polygon& q : pieces) {
         measured.boxes.push_back(minimumAreaBox(q.outer));
         const double aspect = aspectOf(measured.boxes.back());
-        if (relax < Relax::Rectangularity) {  // limited rectangularity
-          if (before > leastAspect_ ? aspect < leastAspect_ : aspect <= before) return false;
-        } else if (aspect < leastAspect_ && aspect < before) {
-          return false;  // no sliver thinner than the observed ones, where the parcel split was none
+        // Limited rectangularity, or with it relaxed, no sliver thinner than
+        // the observed ones where the parcel split was none; but for the
+        // block's thin quota, down to its thinnest observed parcels.
+        const bool refused = relax < Relax::Rectangularity
+                                 ? (before > leastAspect_ ? aspect < leastAspect_ : aspect <= before)
+                                 : aspect < leastAspect_ && aspect < before;
+        if (refused) {
+          if (!(before > leastAspect_ || relax == Relax::Rectangularity) || aspect < thin_.least) return false;
+          if (measured.areas[measured.boxes.size() - 1] < thin_.area) return false;
+          if (++measured.thinUsed > thinLeft_) return false;
         }
       }
       std::size_t without = 0;
@@ -682,6 +730,8 @@ private:
   double depth_ = 0;                   // the observed street parcels' median length
   std::vector<double> observedAreas_;  // with interior parcels: the observed interior parcels' areas
   std::size_t interiorLeft_ = 0;       // interior parcels this try may still make
+  ThinParcels thin_;                   // the block's observed parcels thinner than leastAspect_
+  std::size_t thinLeft_ = 0;           // pieces thinner than leastAspect_ this try may still make
   bool roadOnly_ = false;              // the block has its road parcels: road parcels only cut along the street
   double tolerance_ = 1e-6;
   double minArea_ = 0;  // the least area of a piece

@@ -194,6 +194,8 @@ int main(int argc, char** argv) {
     // The skeleton style (observed slice widths) as the prior instead of the paper's rule.
     for (double paper : {1.0, 2.0, 3.0, 100.0}) ways.push_back({3, paper, HUGE_VAL, false, false, "skeleton"});
     for (double far : {4.0, 2.0, 1.0, 0.5}) ways.push_back({3, 0, far, true, false, "skeleton"});
+    // Sexton (which takes the block's own observed count, areas and access) for blocks far from every row.
+    for (double far : {36.0, 16.0, 9.0, 4.0}) ways.push_back({3, 0, far, true, false, "sexton"});
     std::printf(
         "| neighbours | paper's votes | far | weighted | left out: cities / measures better / mean objective | "
         "cross-validated: cities / measures better / mean objective | trained on all six |\n"
@@ -233,9 +235,9 @@ int main(int argc, char** argv) {
           "| %zu | %g | %g | %s%s%s | %d of %zu / %d of %zu / %.3f | %d of %zu / %d of %zu / %.3f | %d / %d / %.3f "
           "|\n%s",
           v.k, v.paperVote, v.far, v.weighted ? "yes" : "no", v.withOthers ? ", halves with the other cities" : "",
-          v.prior ? ", prior skeleton" : "", outTally.cities, runs.size(), outTally.measures, 4 * runs.size(),
-          outTally.objective, cvTally.cities, runs.size(), cvTally.measures, 4 * runs.size(), cvTally.objective,
-          inTally.cities, inTally.measures, inTally.objective, detail.c_str());
+          v.prior ? (std::string(", prior ") + v.prior).c_str() : "", outTally.cities, runs.size(), outTally.measures,
+          4 * runs.size(), outTally.objective, cvTally.cities, runs.size(), cvTally.measures, 4 * runs.size(),
+          cvTally.objective, inTally.cities, inTally.measures, inTally.objective, detail.c_str());
       std::fflush(stdout);
     }
   }

@@ -58,6 +58,17 @@ TEST(AutoRule, NearestRowsVoteByInverseDistanceTiesToTheNearest) {
   EXPECT_EQ(rule.predict(x), "skeleton");  // skeleton 1 / 0.1 against parish 1 / 0.9 + 1 / 1.9
   x[0] = 13;
   EXPECT_EQ(rule.predict(x), "skeleton");  // its own row, whatever the two parish rows say
+  // The rows' standard deviation is sqrt(28) = 5.29: beyond 3 of it from
+  // every row, a block is unlike them all and takes sexton.
+  x[0] = 28;
+  EXPECT_EQ(rule.predict(x), "parish");  // 2.83 from the nearest row: parish 1 / 16 + 1 / 17 against skeleton 1 / 15
+  x[0] = 30;
+  EXPECT_EQ(rule.predict(x), "sexton");  // 3.21
+  x[0] = 12;
+  x[1] = 3.5;                            // a feature the rows all share (0): its scale is 1
+  EXPECT_EQ(rule.predict(x), "sexton");  // 3.5 from parish's row, which the vote would give
+  x[1] = 2.5;
+  EXPECT_EQ(rule.predict(x), "parish");
   const AutoRule pairs({row(0, "obb"), row(1, "sexton"), row(5, "skeleton"), row(6, "template")}, 2);
   x[0] = 0.5;
   EXPECT_EQ(pairs.predict(x), "obb");  // equal votes: the nearer (the first of equals)

@@ -281,6 +281,43 @@ TEST(Sexton, TheLeastPieceFollowsTheObservedSmallParcels) {
   EXPECT_LT(least, 0.75 * 600);  // with a-min alone, no piece below 450 m²
 }
 
+// A block whose observed parcels are thinner than 1:4 at their 90th
+// percentile admits pieces thinner than that up to its thin quota (here 10
+// of 100; on these seeds no other thin parcel arises), no thinner than their
+// 95th percentile and no smaller than their 10th percentile of area; without
+// the quota, none (the limit held every piece to the 90th percentile).
+TEST(Sexton, ThinParcelsFollowTheObservedOnesThinnerThanTheLimit) {
+  const Polygon block = test::rect(0, 0, 300, 60);
+  // 70 parcels of 1:3, 20 of 1:5 (the 90th percentile), 10 of 1:9 (the 95th), all of 180 m².
+  ObservedSample observed = sampleOf(100, 180, std::sqrt(180.0 / 3), 3);
+  for (std::size_t i = 70; i < 100; ++i) {
+    const double r = i < 90 ? 5 : 9;
+    observed.aspectRatios[i] = r;
+    observed.widths[i] = std::sqrt(180.0 / r);
+  }
+  const ParameterValues values{{"a-min", 100}, {"w-min", 2}, {"tries", 10}};
+  for (std::uint64_t seed : {1, 2, 3}) {
+    const Subdivision s = sexton(block, values, seed, &observed);
+    EXPECT_TILES(block, s.parcels, "300 x 60");
+    std::size_t thin = 0;
+    double thinnest = 1, leastThinArea = 1e9;
+    for (const Polygon& p : s.parcels) {
+      const OrientedBox b = minimumAreaBox(p.outer);
+      thinnest = std::min(thinnest, b.width / b.length);
+      if (b.width / b.length < 0.2 - 1e-9) {
+        ++thin;
+        leastThinArea = std::min(leastThinArea, area(p));
+      }
+    }
+    EXPECT_GE(thin, 1u) << "seed " << seed;
+    EXPECT_LE(thin, 10u) << "seed " << seed;
+    EXPECT_GE(thinnest, 1.0 / 9 - 1e-9) << "seed " << seed;
+    if (thin > 0) EXPECT_GE(leastThinArea, 180 * (1 - 1e-9)) << "seed " << seed;
+    std::printf("seed %llu: %zu parcels, %zu thinner than 1:5, thinnest 1:%.1f\n",
+                static_cast<unsigned long long>(seed), s.parcels.size(), thin, 1 / thinnest);
+  }
+}
+
 // Random shapes with observed parcels partly interior: a tiling, valid and
 // reproducible, with no more interior parcels than the observed share allows.
 TEST(Sexton, RandomShapesWithInteriorParcelsTile) {

@@ -63,7 +63,10 @@ public:
 
   /// The style with the most votes of the nearest rows, each voting with 1 /
   /// its standardised distance (ties: the nearest's style). A block whose
-  /// features are a row's takes that row's style.
+  /// features are a row's takes that row's style. A block farther than kFar
+  /// from every row takes kFarStyle: no calibrated block is like it, and
+  /// sexton takes the block's own observed count, areas, street access and
+  /// aspect ratios.
   const std::string& predict(const AutoFeatures& x) const;
   /// The `k` rows nearest `x`, nearest first: (squared standardised distance, row).
   std::vector<std::pair<double, std::size_t>> nearest(const AutoFeatures& x, std::size_t k) const;
@@ -73,6 +76,9 @@ public:
   static constexpr AutoFeatures kWeights = {1, 1, 1, 1, 1, 1, 1};
   /// Added to each distance before its vote is taken (standardised units).
   static constexpr double kVoteFloor = 1e-9;
+  /// Standardised distance beyond which a block is unlike every row.
+  static constexpr double kFar = 3.0;
+  static constexpr const char* kFarStyle = "sexton";
 
 private:
   std::vector<Row> rows_;
