@@ -3,6 +3,7 @@
 // many tries against the observed parcels.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -322,6 +323,7 @@ TEST(Sexton, ThinParcelsFollowTheObservedOnesThinnerThanTheLimit) {
 // reproducible, with no more interior parcels than the observed share allows.
 TEST(Sexton, RandomShapesWithInteriorParcelsTile) {
   std::mt19937_64 rng(20261129);
+  std::size_t thin = 0;  // parcels thinner than the limit in the shapes with thin observed parcels
   for (int i = 0; i < 40 / test::kSanitizerDivisor; ++i) {
     const Polygon block = test::randomShape(rng, i % test::kShapeKinds);
     const double a = area(block);
@@ -336,20 +338,33 @@ TEST(Sexton, RandomShapesWithInteriorParcelsTile) {
       for (std::size_t k = 0; k < n; ++k) observed.aspectRatios[k] *= observed.access[k] ? 1.5 : 1;
       observed.accessShare = static_cast<double>(with) / static_cast<double>(n);
     }
+    if (i % 3 == 0) {  // a third with a tail of thin parcels (1:5 to 1:10): the thin quota
+      for (std::size_t k = 0; k < n; ++k) {
+        if (rng() % 100 < 25) observed.aspectRatios[k] = 5 + static_cast<double>(rng() % 6);
+      }
+    }
+    // The rectangularity limit: the observed 90th percentile of aspect ratio, at most 1:4.
+    std::vector<double> ratios = observed.aspectRatios;
+    std::sort(ratios.begin(), ratios.end());
+    const double least = std::min(0.25, 1 / ratios[static_cast<std::size_t>(0.9 * static_cast<double>(n - 1))]);
     const std::uint64_t seed = rng();
     const ParameterValues values = {{"a-min", 0.2 * a / static_cast<double>(n)}, {"w-min", 1}, {"tries", 3}};
     const Subdivision s = sexton(block, values, seed, &observed);
     const std::string what = "shape " + std::to_string(i) + " kind " + std::to_string(i % test::kShapeKinds);
     ASSERT_FALSE(s.failed) << what << ": " << s.failure;
     EXPECT_TILES(block, s.parcels, what);
-    EXPECT_LE(s.withoutAccess, static_cast<int>(std::floor((1 - observed.accessShare) * static_cast<double>(n))))
+    EXPECT_LE(s.withoutAccess, static_cast<int>(std::floor((1 - observed.accessShare) * static_cast<double>(n) + 1e-9)))
         << what;
     const Subdivision again = sexton(block, values, seed, &observed);
     ASSERT_EQ(again.parcels.size(), s.parcels.size()) << what;
     for (std::size_t k = 0; k < s.parcels.size(); ++k) {
       EXPECT_TRUE(sameVertices(again.parcels[k], s.parcels[k])) << what << " parcel " << k;
+      const OrientedBox b = minimumAreaBox(s.parcels[k].outer);
+      if (i % 3 == 0 && b.width < least * b.length * (1 - 1e-9)) ++thin;
     }
   }
+  EXPECT_GT(thin, 0u);  // the thin quota was used
+  std::printf("parcels thinner than the limit where the observed ones have a thin tail: %zu\n", thin);
 }
 
 // Random shapes: a tiling, valid, reproducible, every parcel with access
