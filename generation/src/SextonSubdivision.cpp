@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <utility>
@@ -103,13 +104,12 @@ double quantileOf(std::vector<double> values, double q) {
 // aspect ratio (length / width), at most kSquareEnough; kSliverAspect without
 // observed parcels. A block that reaches its count only with thinner slivers
 // than its observed parcels stops short.
+// An observed aspect ratio (length / width) the limits read: finite, at least 1.
+bool usableRatio(double r) { return std::isfinite(r) && r >= 1; }
 double leastAspect(const ObservedSample* observed) {
   std::vector<double> ratios;
-  if (observed) {
-    for (double r : observed->aspectRatios) {
-      if (std::isfinite(r) && r >= 1) ratios.push_back(r);
-    }
-  }
+  if (observed)
+    std::copy_if(observed->aspectRatios.begin(), observed->aspectRatios.end(), std::back_inserter(ratios), usableRatio);
   if (ratios.empty()) return kSliverAspect;
   return std::min(kSquareEnough, 1.0 / quantileOf(std::move(ratios), 0.9));
 }
@@ -131,7 +131,7 @@ ThinParcels thinParcels(const ObservedSample* observed, double least) {
   std::size_t n = 0;
   for (std::size_t i = 0; i < observed->aspectRatios.size(); ++i) {
     const double r = observed->aspectRatios[i];
-    if (!std::isfinite(r) || r < 1) continue;
+    if (!usableRatio(r)) continue;
     ++n;
     ratios.push_back(r);
     if (1.0 / r < least) areas.push_back(observed->areas[i]);
@@ -653,20 +653,23 @@ private:
         }
         measured.areas.push_back(a);
       }
-      for (const Polygon& q : pieces) {
-        measured.boxes.push_back(minimumAreaBox(q.outer));
+      // The thin quota may admit what the limit refuses: a piece of a parcel
+      // no thinner than the limit (of any parcel, with rectangularity
+      // relaxed), down to the block's thinnest observed parcels.
+      const bool quotaOpen = before > leastAspect_ || relax == Relax::Rectangularity;
+      for (std::size_t k = 0; k < pieces.size(); ++k) {
+        measured.boxes.push_back(minimumAreaBox(pieces[k].outer));
         const double aspect = aspectOf(measured.boxes.back());
         // Limited rectangularity, or with it relaxed, no sliver thinner than
-        // the observed ones where the parcel split was none; but for the
-        // block's thin quota, down to its thinnest observed parcels.
+        // the observed ones where the parcel split was none.
         const bool refused = relax < Relax::Rectangularity
                                  ? (before > leastAspect_ ? aspect < leastAspect_ : aspect <= before)
                                  : aspect < leastAspect_ && aspect < before;
-        if (refused) {
-          if (!(before > leastAspect_ || relax == Relax::Rectangularity) || aspect < thin_.least) return false;
-          if (measured.areas[measured.boxes.size() - 1] < thin_.area) return false;
-          if (++measured.thinUsed > thinLeft_) return false;
+        if (!refused) continue;
+        if (!quotaOpen || aspect < thin_.least || measured.areas[k] < thin_.area || measured.thinUsed >= thinLeft_) {
+          return false;
         }
+        ++measured.thinUsed;
       }
       std::size_t without = 0;
       for (const Polygon& q : pieces) {

@@ -113,7 +113,7 @@ public:
   FitMeasures with(std::size_t b, std::size_t e) const {
     std::vector<double> errors = countError_;
     errors[position_[b]] = countError(e, b);
-    FitMeasures f = fit(nullptr, std::move(errors), generatedTotal_ - counted(choice_[b], b) + counted(e, b));
+    FitMeasures f = fit(nullptr, std::move(errors), totalWith(b, e));
     double* ks[3] = {&f.ksArea, &f.ksWidth, &f.ksAspectRatio};
     for (std::size_t m = 0; m < 3; ++m) {
       *ks[m] = swappedKs_[m](values_[choice_[b]][b][m], values_[e][b][m]);
@@ -129,7 +129,7 @@ public:
       swappedKs_[m] = detail::SwappedKs(observed_[m], pooled_[m]);
     }
     countError_[position_[b]] = countError(e, b);
-    generatedTotal_ = generatedTotal_ - counted(choice_[b], b) + counted(e, b);
+    generatedTotal_ = totalWith(b, e);
     choice_[b] = e;
   }
 
@@ -172,6 +172,10 @@ private:
   // Entry e's parcels in block b, where the block has observed parcels (else none: out of the totals).
   std::size_t counted(std::size_t e, std::size_t b) const {
     return board_.observed->analysis.blocks[b].parcels.empty() ? 0 : parcels_[e][b].size();
+  }
+  // The generated total with block b's parcels made by entry e.
+  std::size_t totalWith(std::size_t b, std::size_t e) const {
+    return generatedTotal_ - counted(choice_[b], b) + counted(e, b);
   }
   // The measures of `pooled` (null: the KS left NaN, for the caller), the
   // per-block count errors and the generated parcels of the blocks with observed ones.
