@@ -7,6 +7,7 @@
 #include <cstring>
 #include <memory>
 
+#include "SqliteHandles.h"
 #include "parcelscope/core/Error.h"
 
 namespace parcelscope::io::detail {
@@ -73,14 +74,6 @@ void putFloat(unsigned char* p, float f) {
   putBig(p, bits, 4);
 }
 
-struct DbClose {
-  void operator()(sqlite3* db) const { sqlite3_close(db); }
-};
-struct StmtFinalize {
-  void operator()(sqlite3_stmt* s) const { sqlite3_finalize(s); }
-};
-using Stmt = std::unique_ptr<sqlite3_stmt, StmtFinalize>;
-
 }  // namespace
 
 std::string sqlQuoted(const std::string& text, char quote) {
@@ -91,22 +84,10 @@ std::string sqlQuoted(const std::string& text, char quote) {
 
 void fillRtree(const std::string& path, const std::string& rtreeName, std::vector<RtreeEntry> entries,
                const std::string& afterSql) {
-  sqlite3* raw = nullptr;
-  const int opened = sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READWRITE, nullptr);
-  std::unique_ptr<sqlite3, DbClose> db(raw);
-  auto fail = [&](const std::string& what) {
-    return ioError(path + ": cannot build the spatial index " + rtreeName + ": " + what + " (" +
-                   (db ? sqlite3_errmsg(db.get()) : "out of memory") + ")");
-  };
-  if (opened != SQLITE_OK) throw fail("cannot open");
-  auto exec = [&](const std::string& sql) {
-    if (sqlite3_exec(db.get(), sql.c_str(), nullptr, nullptr, nullptr) != SQLITE_OK) throw fail(sql);
-  };
-  auto prepare = [&](const std::string& sql) {
-    sqlite3_stmt* s = nullptr;
-    if (sqlite3_prepare_v2(db.get(), sql.c_str(), -1, &s, nullptr) != SQLITE_OK) throw fail(sql);
-    return Stmt(s);
-  };
+  Connection db(path, SQLITE_OPEN_READWRITE, "cannot build the spatial index " + rtreeName + ": ");
+  auto fail = [&](const std::string& what) { return db.fail(what); };
+  auto exec = [&](const std::string& sql) { db.exec(sql); };
+  auto prepare = [&](const std::string& sql) { return db.prepare(sql); };
   auto step = [&](sqlite3_stmt* s, const char* what) {
     if (sqlite3_step(s) != SQLITE_DONE) throw fail(what);
     sqlite3_reset(s);
@@ -218,7 +199,7 @@ void fillRtree(const std::string& path, const std::string& rtreeName, std::vecto
   }
   if (!afterSql.empty()) exec(afterSql);
   exec("COMMIT");
-  if (sqlite3_close(db.release()) != SQLITE_OK) throw ioError(path + ": cannot close after the spatial index");
+  db.close("cannot close after the spatial index");
 }
 
 }  // namespace parcelscope::io::detail

@@ -7,10 +7,12 @@
 
 #include <algorithm>
 #include <charconv>
+#include <deque>
 #include <fstream>
 #include <future>
 #include <stdexcept>
 
+#include "GpkgFeatures.h"
 #include "GpkgRtree.h"
 #include "OgrConvert.h"
 #include "parcelscope/core/Error.h"
@@ -197,8 +199,7 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
 
 namespace {
 // Mapped back, checked and repaired in the CRS written (fileGeometry).
-std::unique_ptr<OGRMultiPolygon> fileMultiPolygon(std::vector<Polygon> parts, const LocalFrame& frame, bool& repaired,
-                                                  bool& emptied) {
+std::vector<Polygon> fileParts(std::vector<Polygon> parts, const LocalFrame& frame, bool& repaired, bool& emptied) {
   for (Polygon& p : parts) {
     for (Point& q : p.outer) q = frame.toSource(q);
     for (Ring& h : p.holes)
@@ -206,15 +207,34 @@ std::unique_ptr<OGRMultiPolygon> fileMultiPolygon(std::vector<Polygon> parts, co
   }
   parts = geos::validMultiPolygon(std::move(parts), repaired);
   emptied = repaired && parts.empty();
-  return detail::toOgr(parts);
+  return parts;
+}
+
+detail::Envelope envelopeOf(const std::vector<Polygon>& parts) {
+  detail::Envelope e;
+  auto cover = [&e](const Ring& ring) {
+    for (const Point& q : ring) {
+      if (e.empty) {
+        e = {false, q.x, q.x, q.y, q.y};
+      } else {
+        e.minx = std::min(e.minx, q.x);
+        e.maxx = std::max(e.maxx, q.x);
+        e.miny = std::min(e.miny, q.y);
+        e.maxy = std::max(e.maxy, q.y);
+      }
+    }
+  };
+  for (const Polygon& p : parts) {
+    cover(p.outer);
+    for (const Ring& h : p.holes) cover(h);
+  }
+  return e;
 }
 }  // namespace
 
 FileGeometry fileGeometry(std::vector<Polygon> parts, const LocalFrame& frame) {
   FileGeometry g;
-  const auto multi = fileMultiPolygon(std::move(parts), frame, g.repaired, g.emptied);
-  g.wkb.resize(static_cast<std::size_t>(multi->WkbSize()));
-  multi->exportToWkb(wkbNDR, reinterpret_cast<unsigned char*>(g.wkb.data()), wkbVariantIso);
+  detail::appendMultiPolygonWkb(g.wkb, fileParts(std::move(parts), frame, g.repaired, g.emptied));
   return g;
 }
 
@@ -244,39 +264,106 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
   OGRLayer* layer = ds->CreateLayer(layerName.c_str(), &srs, wkbMultiPolygon, layerOptions.List());
   if (!layer) throw fail("cannot create layer " + layerName);
   createFields(*layer, attributes.columns, fail);
-  // The R-tree is built in bulk after the features are in (detail::fillRtree):
-  // GDAL makes the empty tree, its triggers and its extension entry now, and
-  // the insert trigger is taken away while the features are written, then
-  // restored as GDAL wrote it. Without that trigger, GDAL's own deferred build
-  // is left in place.
-  std::string rtreeName, insertTrigger;
-  if (!geojson && spatialIndex) {
-    const std::string table = layer->GetName(), column = layer->GetGeometryColumn();
-    if (layer->SyncToDisk() != OGRERR_NONE) throw fail("cannot create layer " + layerName);
-    const std::string trigger = "rtree_" + table + "_" + column + "_insert";
-    if (OGRLayer* found = ds->ExecuteSQL(
-            ("SELECT sql FROM sqlite_master WHERE type = 'trigger' AND name = " + detail::sqlQuoted(trigger, '\''))
-                .c_str(),
-            nullptr, nullptr)) {
-      if (auto f = std::unique_ptr<OGRFeature>(found->GetNextFeature())) insertTrigger = f->GetFieldAsString(0);
-      ds->ReleaseResultSet(found);
-    }
-    if (!insertTrigger.empty()) {
-      rtreeName = "rtree_" + table + "_" + column;
-      ds->ExecuteSQL(("DROP TRIGGER " + detail::sqlQuoted(trigger, '"')).c_str(), nullptr, nullptr);
-      if (CPLGetLastErrorType() == CE_Failure) throw fail("cannot prepare the spatial index");
-    }
-  }
-  std::vector<detail::RtreeEntry> boxes;
-  if (!rtreeName.empty()) boxes.reserve(attributes.rows);
-  if (!geojson && ds->StartTransaction() != OGRERR_NONE) throw fail("cannot start transaction");
-  // Geometries are taken back to the source CRS, checked and repaired there,
-  // and converted in batches on a second thread while this one inserts the
-  // batch before.
-  constexpr std::size_t kBatch = 4096;
   LayerWrite report;
   const std::size_t count = attributes.rows;
   report.features = static_cast<std::int64_t>(count);
+  constexpr std::size_t kBatch = 4096;
+  if (!geojson) {
+    // GDAL made the file, the table and its metadata; the rows go in through
+    // SQLite (detail::insertGpkgFeatures), prepared in batches on other
+    // threads (mapped back, checked, repaired, encoded) while this one inserts.
+    const std::string table = layer->GetName(), column = layer->GetGeometryColumn();
+    std::vector<Column> fields = attributes.columns;
+    for (std::size_t c = 0; c < fields.size(); ++c) {
+      fields[c].name = layer->GetLayerDefn()->GetFieldDefn(static_cast<int>(c))->GetNameRef();
+    }
+    ds.reset();
+    if (CPLGetLastErrorType() == CE_Failure) throw fail("cannot create layer " + layerName);
+    const std::int32_t srsId = detail::gpkgSrsId(path, table);
+    struct Batch {
+      std::vector<detail::GpkgRow> rows;
+      std::int64_t repaired = 0, emptied = 0;
+    };
+    auto prepare = [&](std::size_t from) {
+      detail::QuietErrors quietHere;  // OGR's conversions of mismatched values warn
+      Batch batch;
+      const std::size_t to = std::min(count, from + kBatch);
+      batch.rows.resize(to - from);
+      std::vector<Polygon> parts;
+      std::string wkb;
+      for (std::size_t i = from; i < to; ++i) {
+        detail::GpkgRow& row = batch.rows[i - from];
+        if (const FileGeometry* made = ready ? ready(i) : nullptr) {
+          row.envelope = detail::multiPolygonWkbEnvelope(made->wkb);
+          detail::appendGpkgGeometry(row.geometry, made->wkb, row.envelope, srsId);
+          batch.repaired += made->repaired;
+          batch.emptied += made->emptied;
+        } else {
+          parts.clear();
+          geometries(i, parts);
+          bool repaired = false, emptied = false;
+          const std::vector<Polygon> written = fileParts(std::move(parts), frame, repaired, emptied);
+          wkb.clear();
+          detail::appendMultiPolygonWkb(wkb, written);
+          row.envelope = envelopeOf(written);
+          detail::appendGpkgGeometry(row.geometry, wkb, row.envelope, srsId);
+          batch.repaired += repaired;
+          batch.emptied += emptied;
+        }
+        attributes.row(i, row.values);
+        detail::convertToColumns(fields, row.values);
+      }
+      return batch;
+    };
+    // Two batches in preparation while one is inserted.
+    constexpr std::size_t kAhead = 2;
+    std::deque<std::future<Batch>> coming;
+    std::size_t nextFrom = 0;
+    auto launch = [&] {
+      while (coming.size() < kAhead && nextFrom < count) {
+        coming.push_back(std::async(std::launch::async, prepare, nextFrom));
+        nextFrom += kBatch;
+      }
+    };
+    Batch current;
+    std::size_t at = 0;
+    launch();
+    const auto next = [&](detail::GpkgRow& row) {
+      if (at == current.rows.size()) {
+        if (coming.empty()) return false;
+        current = coming.front().get();
+        coming.pop_front();
+        launch();
+        report.repaired += current.repaired;
+        report.emptied += current.emptied;
+        at = 0;
+      }
+      row = std::move(current.rows[at++]);
+      return true;
+    };
+    // The R-tree GDAL made is packed from all boxes once the rows are in
+    // (detail::fillRtree), its insert trigger taken away meanwhile.
+    std::vector<detail::RtreeEntry> boxes;
+    if (spatialIndex) boxes.reserve(count);
+    const auto inserted = [&](std::int64_t fid, const detail::GpkgRow& row) {
+      if (spatialIndex && !row.envelope.empty) {
+        boxes.push_back({fid, row.envelope.minx, row.envelope.maxx, row.envelope.miny, row.envelope.maxy});
+      }
+    };
+    detail::GpkgInsert done;
+    try {
+      done = detail::insertGpkgFeatures(path, table, column, fields, next, inserted);
+    } catch (...) {
+      // Batches still in preparation read the caller's data: wait for them.
+      for (auto& f : coming) f.wait();
+      throw;
+    }
+    if (!done.rtreeName.empty()) detail::fillRtree(path, done.rtreeName, std::move(boxes), done.rtreeInsertTrigger);
+    return report;
+  }
+
+  // GeoJSON: features through OGR, geometries converted in batches on a
+  // second thread while this one inserts the batch before.
   using Batch = std::vector<std::unique_ptr<OGRMultiPolygon>>;
   auto prepare = [&](std::size_t from) {
     Batch batch;
@@ -299,7 +386,7 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
       parts.clear();
       geometries(i, parts);
       bool repaired = false, emptied = false;
-      batch.push_back(fileMultiPolygon(std::move(parts), frame, repaired, emptied));
+      batch.push_back(detail::toOgr(fileParts(std::move(parts), frame, repaired, emptied)));
       report.repaired += repaired;
       report.emptied += emptied;
     }
@@ -316,20 +403,14 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
       row.clear();
       attributes.row(i, row);
       setFields(feature, row);
-      OGREnvelope box;
-      const bool indexed = !rtreeName.empty() && !batch[k]->IsEmpty();
-      if (indexed) batch[k]->getEnvelope(&box);
       feature.SetGeometryDirectly(batch[k].release());
       if (layer->CreateFeature(&feature) != OGRERR_NONE) {
         throw fail("cannot write feature " + std::to_string(i));
       }
-      if (indexed) boxes.push_back({feature.GetFID(), box.MinX, box.MaxX, box.MinY, box.MaxY});
     }
   }
-  if (!geojson && ds->CommitTransaction() != OGRERR_NONE) throw fail("cannot commit");
   ds.reset();  // flush and close before the caller renames the file
   if (CPLGetLastErrorType() == CE_Failure) throw fail("closing failed");
-  if (!rtreeName.empty()) detail::fillRtree(path, rtreeName, std::move(boxes), insertTrigger);
   return report;
 }
 

@@ -37,7 +37,9 @@ Json readJson(const std::string& path);
 /// false: GIS tools draw large layers faster with it. GDAL makes the empty
 /// index, its triggers and its extension entry; the tree is packed from all
 /// features' boxes once they are written (about 1 microsecond per feature,
-/// against 10 for GDAL 3.6 inserting them one by one).
+/// against 10 for GDAL 3.6 inserting them one by one). GDAL makes the
+/// GeoPackage, its table and metadata; the rows go in through SQLite, with the
+/// bytes and values GDAL's CreateFeature would store (io/src/GpkgFeatures.h).
 ///
 /// Validity is that of the file, in the CRS written: a polygon valid in local
 /// metres can be invalid once mapped back (edges straight in metres are not
