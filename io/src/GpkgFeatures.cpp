@@ -1,5 +1,6 @@
 #include "GpkgFeatures.h"
 
+#include <cpl_conv.h>
 #include <ogr_feature.h>
 #include <sqlite3.h>
 
@@ -235,7 +236,8 @@ GpkgInsert insertGpkgFeatures(const std::string& path, const std::string& table,
         }
       } else {
         const std::string& text = std::get<std::string>(v);
-        sqlite3_bind_text(s, at, text.data(), static_cast<int>(text.size()), SQLITE_STATIC);
+        // Up to its first NUL, as GDAL binds a C string.
+        sqlite3_bind_text(s, at, text.c_str(), -1, SQLITE_STATIC);
       }
     }
     if (sqlite3_step(s) != SQLITE_DONE) throw fail("cannot write feature " + std::to_string(count));
@@ -256,7 +258,8 @@ GpkgInsert insertGpkgFeatures(const std::string& path, const std::string& table,
     if (inserted) inserted(fid, row);
   }
   insert.reset();
-  {
+  // As GDAL: a layer without features keeps its count (NULL) and its time.
+  if (count > 0) {
     Stmt s =
         prepare("UPDATE gpkg_ogr_contents SET feature_count = ? WHERE lower(table_name) = lower(" + tableName + ")");
     sqlite3_bind_int64(s.get(), 1, count);
@@ -274,8 +277,13 @@ GpkgInsert insertGpkgFeatures(const std::string& path, const std::string& table,
     sqlite3_free(update);
     exec(text);
   }
-  exec("UPDATE gpkg_contents SET last_change = strftime('%Y-%m-%dT%H:%M:%fZ', 'now') WHERE lower(table_name) = lower(" +
-       tableName + ")");
+  if (count > 0) {
+    // The time of the change, or the one GDAL is told to write (OGR_CURRENT_DATE).
+    const char* fixed = CPLGetConfigOption("OGR_CURRENT_DATE", nullptr);
+    exec("UPDATE gpkg_contents SET last_change = " +
+         (fixed ? sqlQuoted(fixed, '\'') : std::string("strftime('%Y-%m-%dT%H:%M:%fZ', 'now')")) +
+         " WHERE lower(table_name) = lower(" + tableName + ")");
+  }
   for (const std::string& t : countTriggers) exec(t);
   exec("COMMIT");
   db.close("cannot close after writing features");

@@ -24,7 +24,8 @@ struct Envelope {
 
 /// `parts` as an ISO WKB MultiPolygon, little-endian, each ring closed by
 /// repeating its first point: the bytes OGR's exportToWkb writes for the
-/// OGRMultiPolygon that detail::toOgr makes of them.
+/// OGRMultiPolygon that detail::toOgr makes of them (a ring without points is
+/// written without points; toOgr's would hold one point it never sets).
 void appendMultiPolygonWkb(std::string& out, const std::vector<Polygon>& parts);
 /// The envelope of a little-endian WKB MultiPolygon (as above), as OGR's
 /// getEnvelope gives it; empty when it has no point. Throws std::logic_error
@@ -62,7 +63,8 @@ struct GpkgInsert {
 /// closed, empty. `next` fills the next row and returns false when there is
 /// none. In one transaction: the table's feature-count triggers are taken away
 /// and put back, gpkg_ogr_contents gets the count, gpkg_contents the extent of
-/// the non-empty geometries and the time of the change; the R-tree's insert
+/// the non-empty geometries and the time of the change (both left as they are
+/// when there is no row, as GDAL leaves them); the R-tree's insert
 /// trigger (rtree_<table>_<column>_insert), if any, is taken away and
 /// returned. `inserted(fid, row)` is called after each row. Throws Error(IO)
 /// naming the file.

@@ -331,8 +331,9 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
     const auto next = [&](detail::GpkgRow& row) {
       if (at == current.rows.size()) {
         if (coming.empty()) return false;
-        current = coming.front().get();
+        std::future<Batch> first = std::move(coming.front());
         coming.pop_front();
+        current = first.get();  // a failure while preparing comes out here, as thrown
         launch();
         report.repaired += current.repaired;
         report.emptied += current.emptied;
@@ -355,7 +356,9 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
       done = detail::insertGpkgFeatures(path, table, column, fields, next, inserted);
     } catch (...) {
       // Batches still in preparation read the caller's data: wait for them.
-      for (auto& f : coming) f.wait();
+      for (auto& f : coming) {
+        if (f.valid()) f.wait();
+      }
       throw;
     }
     if (!done.rtreeName.empty()) detail::fillRtree(path, done.rtreeName, std::move(boxes), done.rtreeInsertTrigger);

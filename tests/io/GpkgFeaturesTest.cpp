@@ -2,6 +2,7 @@
 // values GDAL writes for the same features, feature by feature.
 #include "GpkgFeatures.h"
 
+#include <cpl_conv.h>
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
 #include <ogrsf_frmts.h>
@@ -13,6 +14,7 @@
 
 #include "OgrConvert.h"
 #include "TestUtil.h"
+#include "parcelscope/core/Error.h"
 #include "parcelscope/io/Writers.h"
 
 namespace parcelscope::io {
@@ -104,15 +106,18 @@ std::vector<std::string> dump(const std::string& path, const std::string& table)
     sqlite3_finalize(s);
   };
   query("SELECT * FROM \"" + table + "\" ORDER BY fid");
-  query("SELECT min_x, min_y, max_x, max_y, srs_id FROM gpkg_contents WHERE table_name = '" + table + "'");
+  query("SELECT min_x, min_y, max_x, max_y, srs_id, last_change FROM gpkg_contents WHERE table_name = '" + table + "'");
   query("SELECT feature_count FROM gpkg_ogr_contents WHERE table_name = '" + table + "'");
   sqlite3_close(db);
   return rows;
 }
 
-TEST(GpkgFeatures, RowsAreTheOnesGdalWritesFeatureByFeature) {
-  TempDir dir;
-  const auto features = randomFeatures(700, 11);
+// Writes `features` with writePolygonLayer and, feature by feature, with
+// GDAL's CreateFeature; returns both files' dumps. The time of the change is
+// fixed (OGR_CURRENT_DATE) so that it is compared too.
+std::pair<std::vector<std::string>, std::vector<std::string>> writeBoth(
+    const TempDir& dir, const std::vector<std::vector<Polygon>>& features) {
+  CPLSetConfigOption("OGR_CURRENT_DATE", "2000-01-02T03:04:05.000Z");
   const LocalFrame frame = LocalFrame::geographic(2.35, 48.89);
   CrsInfo crs;
   crs.assumedLonLat = true;
@@ -122,7 +127,8 @@ TEST(GpkgFeatures, RowsAreTheOnesGdalWritesFeatureByFeature) {
                                    std::string("x")};
   const std::vector<Value> reals = {0.1, 1e300, -0.0, std::int64_t{5}, std::string("2.5"), nan};
   const std::vector<Value> texts = {
-      std::string("a,\"b\""), std::string("\xc3\xa9t\xc3\xa9"), std::string(), 0.1, std::int64_t{12}, nan};
+      std::string("a,\"b\""),  std::string("\xc3\xa9t\xc3\xa9"), std::string(), 0.1, std::int64_t{12}, nan,
+      std::string("ab\0cd", 5)};
   RowSource rows;
   rows.columns = {{"n", Column::Type::Integer, ""}, {"x", Column::Type::Real, ""}, {"s", Column::Type::String, ""}};
   rows.rows = features.size();
@@ -139,17 +145,17 @@ TEST(GpkgFeatures, RowsAreTheOnesGdalWritesFeatureByFeature) {
   {
     GDALDatasetUniquePtr ds(
         GetGDALDriverManager()->GetDriverByName("GPKG")->Create(gdals.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
-    ASSERT_TRUE(ds);
+    EXPECT_TRUE(ds);
     OGRSpatialReference srs;
     srs.SetFromUserInput("OGC:CRS84");
     srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
     OGRLayer* layer = ds->CreateLayer("parcels", &srs, wkbMultiPolygon, nullptr);
-    ASSERT_NE(layer, nullptr);
+    EXPECT_NE(layer, nullptr);
     for (const auto& [name, type] : {std::pair{"n", OFTInteger64}, {"x", OFTReal}, {"s", OFTString}}) {
       OGRFieldDefn field(name, type);
-      ASSERT_EQ(layer->CreateField(&field), OGRERR_NONE);
+      EXPECT_EQ(layer->CreateField(&field), OGRERR_NONE);
     }
-    ASSERT_EQ(ds->StartTransaction(), OGRERR_NONE);
+    EXPECT_EQ(ds->StartTransaction(), OGRERR_NONE);
     std::vector<Value> row;
     for (std::size_t i = 0; i < features.size(); ++i) {
       OGRFeature f(layer->GetLayerDefn());
@@ -170,16 +176,53 @@ TEST(GpkgFeatures, RowsAreTheOnesGdalWritesFeatureByFeature) {
       }
       const FileGeometry g = fileGeometry(features[i], frame);
       OGRGeometry* geometry = nullptr;
-      ASSERT_EQ(OGRGeometryFactory::createFromWkb(g.wkb.data(), nullptr, &geometry, g.wkb.size()), OGRERR_NONE);
+      EXPECT_EQ(OGRGeometryFactory::createFromWkb(g.wkb.data(), nullptr, &geometry, g.wkb.size()), OGRERR_NONE);
       f.SetGeometryDirectly(geometry);
-      ASSERT_EQ(layer->CreateFeature(&f), OGRERR_NONE);
+      EXPECT_EQ(layer->CreateFeature(&f), OGRERR_NONE);
     }
-    ASSERT_EQ(ds->CommitTransaction(), OGRERR_NONE);
+    EXPECT_EQ(ds->CommitTransaction(), OGRERR_NONE);
   }
-  const auto a = dump(ours, "parcels"), b = dump(gdals, "parcels");
+  CPLSetConfigOption("OGR_CURRENT_DATE", nullptr);
+  return {dump(ours, "parcels"), dump(gdals, "parcels")};
+}
+
+TEST(GpkgFeatures, RowsAreTheOnesGdalWritesFeatureByFeature) {
+  TempDir dir;
+  const auto features = randomFeatures(700, 11);
+  const auto [a, b] = writeBoth(dir, features);
   ASSERT_EQ(a.size(), features.size() + 2);
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i], b[i]) << "row " << i;
+  EXPECT_NE(a.back().find("700"), std::string::npos);  // the feature count
+}
+
+TEST(GpkgFeatures, ALayerWithoutFeaturesIsLeftAsGdalLeavesIt) {
+  TempDir dir;
+  const auto [a, b] = writeBoth(dir, {});
+  ASSERT_EQ(a.size(), 2u);
+  EXPECT_EQ(a, b);  // no extent, the time of its making, a NULL count
+}
+
+TEST(GpkgFeatures, AFailureWhilePreparingComesOutAsThrown) {
+  TempDir dir;
+  const auto features = randomFeatures(20000, 5);
+  RowSource rows;
+  rows.columns = {{"n", Column::Type::Integer, ""}};
+  rows.rows = features.size();
+  rows.row = [](std::size_t i, std::vector<Value>& out) {
+    if (i == 9000) throw inputError("row 9000 cannot be made");
+    out = {static_cast<std::int64_t>(i)};
+  };
+  CrsInfo crs;
+  crs.assumedLonLat = true;
+  try {
+    writePolygonLayer(
+        dir.file("failed.gpkg"), "parcels", [&](std::size_t i, std::vector<Polygon>& parts) { parts = features[i]; },
+        rows, LocalFrame::geographic(2.35, 48.89), crs);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("row 9000 cannot be made"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -61,7 +61,8 @@ LayerWrite writePolygonLayer(const std::string& path, const std::string& layerNa
 LayerWrite writePolygonLayer(const std::string& path, const std::string& layerName,
                              const std::vector<std::vector<Polygon>>& geometries, const RowSource& attributes,
                              const LocalFrame& frame, const CrsInfo& crs, bool spatialIndex = true);
-/// Feature i's polygons into `parts`, which comes empty; called from another thread.
+/// Feature i's polygons into `parts`, which comes empty; called from other
+/// threads, several at once (features in any order).
 using PolygonSource = std::function<void(std::size_t i, std::vector<Polygon>& parts)>;
 /// A feature's geometry as writePolygonLayer writes it: mapped back with the
 /// frame, checked and repaired in the CRS written, as a MultiPolygon in ISO
@@ -75,7 +76,8 @@ struct FileGeometry {
 /// parts are (a shard of the run), then handed to the writer.
 FileGeometry fileGeometry(std::vector<Polygon> parts, const LocalFrame& frame);
 /// Feature i's geometry made already by fileGeometry with the layer's frame,
-/// or null: the writer makes it from the PolygonSource. Called from another thread.
+/// or null: the writer makes it from the PolygonSource. Called from other
+/// threads, several at once.
 using ReadyGeometry = std::function<const FileGeometry*(std::size_t i)>;
 /// The same with geometries too made feature by feature (attributes.rows
 /// features), or taken from `ready` where it has them.
