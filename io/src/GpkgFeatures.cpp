@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "GpkgRtree.h"
+#include "OgrConvert.h"
 #include "SqliteHandles.h"
 #include "parcelscope/core/Error.h"
 
@@ -71,6 +72,21 @@ struct WkbReader {
   }
 };
 
+// The SQL of the triggers of `db` that meet `condition` (on sqlite_master),
+// and the triggers dropped.
+std::vector<std::string> takeTriggers(const Connection& db, const std::string& condition) {
+  std::vector<std::string> names, sql;
+  {
+    Stmt s = db.prepare("SELECT name, sql FROM sqlite_master WHERE type = 'trigger' AND " + condition);
+    while (sqlite3_step(s.get()) == SQLITE_ROW) {
+      names.emplace_back(reinterpret_cast<const char*>(sqlite3_column_text(s.get(), 0)));
+      sql.emplace_back(reinterpret_cast<const char*>(sqlite3_column_text(s.get(), 1)));
+    }
+  }
+  for (const std::string& n : names) db.exec("DROP TRIGGER " + sqlQuoted(n, '"'));
+  return sql;
+}
+
 }  // namespace
 
 void appendMultiPolygonWkb(std::string& out, const std::vector<Polygon>& parts) {
@@ -95,14 +111,7 @@ Envelope multiPolygonWkbEnvelope(const std::string& wkb) {
     for (std::uint32_t k = 0, rings = r.u32(); k < rings; ++k) {
       for (std::uint32_t i = 0, n = r.u32(); i < n; ++i) {
         const double x = r.real(), y = r.real();
-        if (e.empty) {
-          e = {false, x, x, y, y};
-        } else {
-          e.minx = std::min(e.minx, x);
-          e.maxx = std::max(e.maxx, x);
-          e.miny = std::min(e.miny, y);
-          e.maxy = std::max(e.maxy, y);
-        }
+        e.cover(x, y);
       }
     }
   }
@@ -145,9 +154,7 @@ void convertToColumns(const std::vector<Column>& columns, std::vector<Value>& ro
       defn.reset(new OGRFeatureDefn());
       defn->Reference();
       for (const Column& col : columns) {
-        OGRFieldDefn field(col.name.c_str(), col.type == Column::Type::Integer ? OFTInteger64
-                                             : col.type == Column::Type::Real  ? OFTReal
-                                                                               : OFTString);
+        OGRFieldDefn field(col.name.c_str(), ogrFieldType(col.type));
         defn->AddFieldDefn(&field);
       }
       scratch = std::make_unique<OGRFeature>(defn.get());
@@ -182,41 +189,24 @@ GpkgInsert insertGpkgFeatures(const std::string& path, const std::string& table,
                               const std::vector<Column>& columns, const std::function<bool(GpkgRow&)>& next,
                               const std::function<void(std::int64_t fid, const GpkgRow&)>& inserted) {
   Connection db(path, SQLITE_OPEN_READWRITE, "");
-  auto fail = [&](const std::string& what) { return db.fail(what); };
-  auto exec = [&](const std::string& sql) { db.exec(sql); };
-  auto prepare = [&](const std::string& sql) { return db.prepare(sql); };
   const std::string tableName = sqlQuoted(table, '\'');
-  exec("BEGIN");
+  db.exec("BEGIN");
   // The triggers that count features row by row: the count is set once.
-  std::vector<std::string> countTriggers;
-  {
-    Stmt s = prepare("SELECT name, sql FROM sqlite_master WHERE type = 'trigger' AND lower(tbl_name) = lower(" +
-                     tableName + ") AND name LIKE 'trigger_%_feature_count_%'");
-    std::vector<std::string> names;
-    while (sqlite3_step(s.get()) == SQLITE_ROW) {
-      names.emplace_back(reinterpret_cast<const char*>(sqlite3_column_text(s.get(), 0)));
-      countTriggers.emplace_back(reinterpret_cast<const char*>(sqlite3_column_text(s.get(), 1)));
-    }
-    s.reset();
-    for (const std::string& n : names) exec("DROP TRIGGER " + sqlQuoted(n, '"'));
-  }
+  const std::vector<std::string> countTriggers =
+      takeTriggers(db, "lower(tbl_name) = lower(" + tableName + ") AND name LIKE 'trigger_%_feature_count_%'");
   GpkgInsert done;
-  {
-    const std::string trigger = "rtree_" + table + "_" + geometryColumn + "_insert";
-    Stmt s = prepare("SELECT sql FROM sqlite_master WHERE type = 'trigger' AND name = " + sqlQuoted(trigger, '\''));
-    if (sqlite3_step(s.get()) == SQLITE_ROW) {
-      done.rtreeName = "rtree_" + table + "_" + geometryColumn;
-      done.rtreeInsertTrigger = reinterpret_cast<const char*>(sqlite3_column_text(s.get(), 0));
-    }
-    s.reset();
-    if (!done.rtreeName.empty()) exec("DROP TRIGGER " + sqlQuoted(trigger, '"'));
+  const std::string rtree = "rtree_" + table + "_" + geometryColumn;
+  const std::vector<std::string> rtreeInsert = takeTriggers(db, "name = " + sqlQuoted(rtree + "_insert", '\''));
+  if (!rtreeInsert.empty()) {
+    done.rtreeName = rtree;
+    done.rtreeInsertTrigger = rtreeInsert.front();
   }
   std::string sql = "INSERT INTO " + sqlQuoted(table, '"') + " (" + sqlQuoted(geometryColumn, '"');
   for (const Column& c : columns) sql += ", " + sqlQuoted(c.name, '"');
   sql += ") VALUES (?";
   for (std::size_t c = 0; c < columns.size(); ++c) sql += ", ?";
   sql += ")";
-  Stmt insert = prepare(sql);
+  Stmt insert = db.prepare(sql);
   GpkgRow row;
   std::int64_t count = 0;
   Envelope extent;
@@ -240,30 +230,20 @@ GpkgInsert insertGpkgFeatures(const std::string& path, const std::string& table,
         sqlite3_bind_text(s, at, text.c_str(), -1, SQLITE_STATIC);
       }
     }
-    if (sqlite3_step(s) != SQLITE_DONE) throw fail("cannot write feature " + std::to_string(count));
+    if (sqlite3_step(s) != SQLITE_DONE) throw db.fail("cannot write feature " + std::to_string(count));
     sqlite3_reset(s);
     const std::int64_t fid = sqlite3_last_insert_rowid(db.get());
     ++count;
-    if (!row.envelope.empty) {
-      const Envelope& e = row.envelope;
-      if (extent.empty) {
-        extent = e;
-      } else {
-        extent.minx = std::min(extent.minx, e.minx);
-        extent.maxx = std::max(extent.maxx, e.maxx);
-        extent.miny = std::min(extent.miny, e.miny);
-        extent.maxy = std::max(extent.maxy, e.maxy);
-      }
-    }
+    extent.merge(row.envelope);
     if (inserted) inserted(fid, row);
   }
   insert.reset();
   // As GDAL: a layer without features keeps its count (NULL) and its time.
   if (count > 0) {
     Stmt s =
-        prepare("UPDATE gpkg_ogr_contents SET feature_count = ? WHERE lower(table_name) = lower(" + tableName + ")");
+        db.prepare("UPDATE gpkg_ogr_contents SET feature_count = ? WHERE lower(table_name) = lower(" + tableName + ")");
     sqlite3_bind_int64(s.get(), 1, count);
-    if (sqlite3_step(s.get()) != SQLITE_DONE) throw fail("cannot record the feature count");
+    if (sqlite3_step(s.get()) != SQLITE_DONE) throw db.fail("cannot record the feature count");
   }
   if (!extent.empty) {
     // As GDAL records it: the numbers printed by SQLite's printf (%.18g),
@@ -272,22 +252,21 @@ GpkgInsert insertGpkgFeatures(const std::string& path, const std::string& table,
         "UPDATE gpkg_contents SET min_x = %.18g, min_y = %.18g, max_x = %.18g, max_y = %.18g "
         "WHERE lower(table_name) = lower('%q') AND lower(data_type) = 'features'",
         extent.minx, extent.miny, extent.maxx, extent.maxy, table.c_str());
-    if (!update) throw fail("cannot record the layer's extent");
+    if (!update) throw db.fail("cannot record the layer's extent");
     const std::string text(update);
     sqlite3_free(update);
-    exec(text);
+    db.exec(text);
   }
   if (count > 0) {
     // The time of the change, or the one GDAL is told to write (OGR_CURRENT_DATE).
     const char* fixed = CPLGetConfigOption("OGR_CURRENT_DATE", nullptr);
-    exec("UPDATE gpkg_contents SET last_change = " +
-         (fixed ? sqlQuoted(fixed, '\'') : std::string("strftime('%Y-%m-%dT%H:%M:%fZ', 'now')")) +
-         " WHERE lower(table_name) = lower(" + tableName + ")");
+    db.exec("UPDATE gpkg_contents SET last_change = " +
+            (fixed ? sqlQuoted(fixed, '\'') : std::string("strftime('%Y-%m-%dT%H:%M:%fZ', 'now')")) +
+            " WHERE lower(table_name) = lower(" + tableName + ")");
   }
-  for (const std::string& t : countTriggers) exec(t);
-  exec("COMMIT");
+  for (const std::string& t : countTriggers) db.exec(t);
+  db.exec("COMMIT");
   db.close("cannot close after writing features");
-  done.features = count;
   return done;
 }
 

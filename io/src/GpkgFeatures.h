@@ -6,6 +6,7 @@
 // thousands of small polygons that is most of the time spent inserting. GDAL
 // still makes the file, the table, its metadata and its spatial index; only
 // the rows go through here.
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -20,6 +21,23 @@ namespace parcelscope::io::detail {
 struct Envelope {
   bool empty = true;
   double minx = 0, maxx = 0, miny = 0, maxy = 0;
+  /// Grown to hold the point.
+  void cover(double x, double y) {
+    if (empty) {
+      *this = {false, x, x, y, y};
+      return;
+    }
+    minx = std::min(minx, x);
+    maxx = std::max(maxx, x);
+    miny = std::min(miny, y);
+    maxy = std::max(maxy, y);
+  }
+  /// Grown to hold `e` (unchanged when `e` is empty).
+  void merge(const Envelope& e) {
+    if (e.empty) return;
+    cover(e.minx, e.miny);
+    cover(e.maxx, e.maxy);
+  }
 };
 
 /// `parts` as an ISO WKB MultiPolygon, little-endian, each ring closed by
@@ -54,7 +72,6 @@ void convertToColumns(const std::vector<Column>& columns, std::vector<Value>& ro
 /// made one, and the SQL of its insert trigger, taken away (for fillRtree to
 /// fill the tree and put the trigger back).
 struct GpkgInsert {
-  std::int64_t features = 0;
   std::string rtreeName, rtreeInsertTrigger;
 };
 

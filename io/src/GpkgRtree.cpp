@@ -85,33 +85,30 @@ std::string sqlQuoted(const std::string& text, char quote) {
 void fillRtree(const std::string& path, const std::string& rtreeName, std::vector<RtreeEntry> entries,
                const std::string& afterSql) {
   Connection db(path, SQLITE_OPEN_READWRITE, "cannot build the spatial index " + rtreeName + ": ");
-  auto fail = [&](const std::string& what) { return db.fail(what); };
-  auto exec = [&](const std::string& sql) { db.exec(sql); };
-  auto prepare = [&](const std::string& sql) { return db.prepare(sql); };
   auto step = [&](sqlite3_stmt* s, const char* what) {
-    if (sqlite3_step(s) != SQLITE_DONE) throw fail(what);
+    if (sqlite3_step(s) != SQLITE_DONE) throw db.fail(what);
     sqlite3_reset(s);
   };
   // Shadow table names, quoted as identifiers.
   auto shadow = [&](const char* suffix) { return sqlQuoted(rtreeName + suffix, '"'); };
 
-  exec("BEGIN");
+  db.exec("BEGIN");
   // Node size: that of the empty root SQLite wrote when it made the table (it
   // reads every node at the root's size).
   int nodeSize = 0;
   {
-    Stmt s = prepare("SELECT length(data) FROM " + shadow("_node") + " WHERE nodeno = 1");
+    Stmt s = db.prepare("SELECT length(data) FROM " + shadow("_node") + " WHERE nodeno = 1");
     if (sqlite3_step(s.get()) == SQLITE_ROW) nodeSize = sqlite3_column_int(s.get(), 0);
   }
   constexpr int kCellBytes = 8 + 4 * 4;  // rowid or child node, then minx, maxx, miny, maxy
   const int capacityInt = (nodeSize - 4) / kCellBytes;
-  if (capacityInt < 2) throw fail("unexpected root node of " + std::to_string(nodeSize) + " bytes");
+  if (capacityInt < 2) throw db.fail("unexpected root node of " + std::to_string(nodeSize) + " bytes");
   const auto capacity = static_cast<std::size_t>(capacityInt);
 
   if (!entries.empty()) {
-    exec("DELETE FROM " + shadow("_node"));
-    exec("DELETE FROM " + shadow("_rowid"));
-    exec("DELETE FROM " + shadow("_parent"));
+    db.exec("DELETE FROM " + shadow("_node"));
+    db.exec("DELETE FROM " + shadow("_rowid"));
+    db.exec("DELETE FROM " + shadow("_parent"));
 
     // Levels from the leaves up: each level's nodes (their items) and boxes.
     struct Level {
@@ -153,8 +150,8 @@ void fillRtree(const std::string& path, const std::string& rtreeName, std::vecto
       for (auto& n : number[l]) n = next++;
     }
 
-    Stmt node = prepare("INSERT INTO " + shadow("_node") + " (nodeno, data) VALUES (?, ?)");
-    Stmt parent = prepare("INSERT INTO " + shadow("_parent") + " (nodeno, parentnode) VALUES (?, ?)");
+    Stmt node = db.prepare("INSERT INTO " + shadow("_node") + " (nodeno, data) VALUES (?, ?)");
+    Stmt parent = db.prepare("INSERT INTO " + shadow("_parent") + " (nodeno, parentnode) VALUES (?, ?)");
     std::vector<std::pair<std::int64_t, std::int64_t>> leafOf;  // (fid, leaf node)
     std::vector<unsigned char> data(static_cast<std::size_t>(nodeSize));
     const auto depth = static_cast<std::uint64_t>(levels.size() - 1);
@@ -190,15 +187,15 @@ void fillRtree(const std::string& path, const std::string& rtreeName, std::vecto
       }
     }
     std::sort(leafOf.begin(), leafOf.end());
-    Stmt rowid = prepare("INSERT INTO " + shadow("_rowid") + " (rowid, nodeno) VALUES (?, ?)");
+    Stmt rowid = db.prepare("INSERT INTO " + shadow("_rowid") + " (rowid, nodeno) VALUES (?, ?)");
     for (const auto& [fid, leaf] : leafOf) {
       sqlite3_bind_int64(rowid.get(), 1, fid);
       sqlite3_bind_int64(rowid.get(), 2, leaf);
       step(rowid.get(), "rowid");
     }
   }
-  if (!afterSql.empty()) exec(afterSql);
-  exec("COMMIT");
+  if (!afterSql.empty()) db.exec(afterSql);
+  db.exec("COMMIT");
   db.close("cannot close after the spatial index");
 }
 

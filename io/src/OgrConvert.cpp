@@ -76,6 +76,10 @@ bool collectPolygons(const OGRGeometry& geometry, std::vector<std::unique_ptr<OG
   }
 }
 
+OGRFieldType ogrFieldType(Column::Type type) {
+  return type == Column::Type::Integer ? OFTInteger64 : type == Column::Type::Real ? OFTReal : OFTString;
+}
+
 namespace {
 // Errors raised on this thread while quiet are kept (so CPLGetLastErrorMsg works)
 // but not printed.

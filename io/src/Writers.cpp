@@ -161,10 +161,7 @@ void setFields(OGRFeature& feature, const std::vector<Value>& row) {
 template <typename Fail>
 void createFields(OGRLayer& layer, const std::vector<Column>& columns, const Fail& fail) {
   for (const Column& c : columns) {
-    const OGRFieldType type = c.type == Column::Type::Integer ? OFTInteger64
-                              : c.type == Column::Type::Real  ? OFTReal
-                                                              : OFTString;
-    OGRFieldDefn field(c.name.c_str(), type);
+    OGRFieldDefn field(c.name.c_str(), detail::ogrFieldType(c.type));
     if (layer.CreateField(&field) != OGRERR_NONE) throw fail("cannot create field " + c.name);
   }
 }
@@ -212,21 +209,10 @@ std::vector<Polygon> fileParts(std::vector<Polygon> parts, const LocalFrame& fra
 
 detail::Envelope envelopeOf(const std::vector<Polygon>& parts) {
   detail::Envelope e;
-  auto cover = [&e](const Ring& ring) {
-    for (const Point& q : ring) {
-      if (e.empty) {
-        e = {false, q.x, q.x, q.y, q.y};
-      } else {
-        e.minx = std::min(e.minx, q.x);
-        e.maxx = std::max(e.maxx, q.x);
-        e.miny = std::min(e.miny, q.y);
-        e.maxy = std::max(e.maxy, q.y);
-      }
-    }
-  };
   for (const Polygon& p : parts) {
-    cover(p.outer);
-    for (const Ring& h : p.holes) cover(h);
+    for (const Point& q : p.outer) e.cover(q.x, q.y);
+    for (const Ring& h : p.holes)
+      for (const Point& q : h) e.cover(q.x, q.y);
   }
   return e;
 }
